@@ -1,0 +1,109 @@
+"""Attention: turn the head until the object's image centroid sits at the image centre.
+
+Closed loop on the image, as in the paper: look, find the object's pixels, move the neck by a Newton step on
+the centroid's pixel error (image Jacobian from the model's kinematics), let the servos settle, look again.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from affordance_env.camera import RangeCamera, project
+from affordance_env.physics import TapPhysics
+from affordance_env.robot_model import ACTIVE_JOINTS
+
+#: Neck joints used for gaze: pitch (image rows) and yaw (image columns).
+GAZE_JOINTS = ("neck_pitch", "neck_yaw")
+_GAZE_IDX = np.array([ACTIVE_JOINTS.index(n) for n in GAZE_JOINTS])
+
+
+@dataclass(frozen=True)
+class AttentionResult:
+    """Outcome of :func:`attend`.
+
+    Attributes:
+        success: The centroid ended within ``tolerance`` pixels of the image centre.
+        visible: The object was seen at all.
+        pixel_error: Final distance of the centroid from the image centre [pixels of the attention camera].
+        iterations: Look-move cycles used.
+    """
+
+    success: bool
+    visible: bool
+    pixel_error: float
+    iterations: int
+
+
+def _centroid(camera: RangeCamera, physics: TapPhysics) -> tuple[np.ndarray, np.ndarray] | None:
+    image = camera.capture(physics.data)
+    mask = image.mask_of(physics.active_geom)
+    if not mask.any():
+        return None
+    v, u = np.nonzero(mask)
+    return np.array([u.mean(), v.mean()]), image.p_world_points[mask].mean(axis=0)
+
+
+def _image_jacobian(camera: RangeCamera, physics: TapPhysics, p_world: np.ndarray, scratch: mujoco.MjData) -> np.ndarray:
+    """d(u, v)/d(neck_pitch, neck_yaw) of the world point ``p_world`` at the current configuration."""
+    K = camera.intrinsics
+    scratch.qpos[:] = physics.data.qpos
+    jac = np.empty((2, 2))
+    eps = 1e-4
+    for j, joint in enumerate(_GAZE_IDX):
+        uv = []
+        for sign in (1.0, -1.0):
+            scratch.qpos[physics.robot_qpos[joint]] = physics.data.qpos[physics.robot_qpos[joint]] + sign * eps
+            mujoco.mj_kinematics(physics.model, scratch)
+            mujoco.mj_camlight(physics.model, scratch)
+            p_cam, R_cam = scratch.cam_xpos[camera.camera_id], scratch.cam_xmat[camera.camera_id].reshape(3, 3)
+            uv.append(project(p_world, p_cam, R_cam, K))
+        scratch.qpos[physics.robot_qpos[joint]] = physics.data.qpos[physics.robot_qpos[joint]]
+        jac[:, j] = (uv[0] - uv[1]) / (2 * eps)
+    return jac
+
+
+def attend(
+    physics: TapPhysics,
+    camera: RangeCamera,
+    move_joints,
+    *,
+    max_iterations: int = 6,
+    tolerance: float = 0.5,
+    move_time: float = 0.1,
+    hold_time: float = 0.06,
+) -> AttentionResult:
+    """Centre the object of interest in ``camera``'s image by moving the neck.
+
+    Args:
+        physics: The scene.
+        camera: A (typically low-resolution) range camera on the head used for looking.
+        move_joints: ``move_joints(q_target, duration)`` of :class:`~affordance_env.motion.MotionExecutor`.
+        max_iterations: Look-move cycles at most.
+        tolerance: Accepted centroid error [pixels of ``camera``].
+        move_time: Duration of each neck move [s].
+        hold_time: Time the servos are given to settle before the next look [s].
+    """
+    K = camera.intrinsics
+    centre = np.array([K.cx, K.cy])
+    scratch = mujoco.MjData(physics.model)
+    seen = _centroid(camera, physics)
+    if seen is None:
+        return AttentionResult(False, False, float("inf"), 0)
+    for iteration in range(1, max_iterations + 1):
+        uv, p_world = seen
+        error = uv - centre
+        if np.linalg.norm(error) <= tolerance:
+            return AttentionResult(True, True, float(np.linalg.norm(error)), iteration - 1)
+        jac = _image_jacobian(camera, physics, p_world, scratch)
+        q = physics.joint_targets()
+        q[_GAZE_IDX] -= np.linalg.lstsq(jac, error, rcond=None)[0]
+        move_joints(q, move_time)
+        move_joints(q, hold_time)
+        seen = _centroid(camera, physics)
+        if seen is None:
+            return AttentionResult(False, False, float("inf"), iteration)
+    error = float(np.linalg.norm(seen[0] - centre))
+    return AttentionResult(error <= tolerance, True, error, max_iterations)

@@ -1,0 +1,168 @@
+"""The robot's behaviours: where the hand starts, which way it moves and how fast, for one action.
+
+A behaviour is a straight hand stroke along a horizontal direction, with a fixed hand orientation and a
+contact surface on the hand. :func:`plan_stroke` turns (behaviour, object, action) into Cartesian waypoints;
+it is a pure function, and :mod:`affordance_env.motion` executes the plan on the simulated robot.
+
+The action is three numbers in [-1, 1]; 0 is the paper's canonical tap:
+
+==========  ===============================================================  ======================
+index       meaning                                                          range
+==========  ===============================================================  ======================
+0           height of the palm centre above the canonical contact height     -1.5 .. +1.5 cm
+1           lateral offset of the stroke, across the stroke direction        -2 .. +2 cm
+2           hand speed along the stroke                                      0.15 .. 0.45 m/s
+==========  ===============================================================  ======================
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from affordance_env.objects import ObjectGeometry
+
+ACTION_DIM = 3
+HEIGHT_RANGE = 0.015  # [m]
+LATERAL_RANGE = 0.02  # [m]
+SPEED_CANONICAL = 0.3  # [m/s]
+SPEED_RANGE = 0.15  # [m/s]
+#: Gap between hand surface and object before the stroke [m].
+CLEARANCE = 0.03
+#: Distance the hand keeps moving after it first touches the object [m].
+FOLLOW_THROUGH = 0.012
+#: Height above the stroke from which the hand descends to the pre-stroke pose [m].
+APPROACH_HEIGHT = 0.08
+#: Lowest palm-centre height above the table [m]: the hand reaches 3.3 cm below the palm centre.
+MIN_PALM_HEIGHT = 0.04
+
+
+@dataclass(frozen=True)
+class Behavior:
+    """A horizontal hand stroke.
+
+    Attributes:
+        name: Identifier used by ``behavior=`` of the environment.
+        direction: Unit stroke direction in the world x-y plane, (2,).
+        R_world_hand: Orientation of the palm frame during the stroke (columns: fingers, thumb side, palm
+            normal), (3, 3).
+        contact_offset: Distance from the palm frame origin to the hand surface that leads the stroke [m].
+        description: One line for the documentation.
+    """
+
+    name: str
+    direction: np.ndarray
+    R_world_hand: np.ndarray
+    contact_offset: float
+    description: str
+
+
+def _rotation(fingers: tuple[float, float, float], palm_normal: tuple[float, float, float]) -> np.ndarray:
+    x = np.asarray(fingers, dtype=float)
+    z = np.asarray(palm_normal, dtype=float)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+BEHAVIORS: dict[str, Behavior] = {
+    "tap": Behavior(
+        "tap", np.array([0.0, -1.0]), _rotation((-1, 0, 0), (0, -1, 0)), 0.012,
+        "the paper's tap: the palm hits the object from its right side, moving to the robot's left (-y)",
+    ),
+    "tap_back": Behavior(
+        "tap_back", np.array([0.0, 1.0]), _rotation((-1, 0, 0), (0, -1, 0)), 0.039,
+        "tap from the other side: the back of the hand hits the object from its left, moving right (+y)",
+    ),
+    "push": Behavior(
+        "push", np.array([-1.0, 0.0]), _rotation((0, -1, 0), (1, 0, 0)), 0.039,
+        "push from the front: the back of the hand pushes the object's near face away from the robot (-x)",
+    ),
+}
+
+
+def get_behavior(name: str) -> Behavior:
+    """The behaviour called ``name``; raises ValueError listing the valid names."""
+    if name not in BEHAVIORS:
+        raise ValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
+    return BEHAVIORS[name]
+
+
+@dataclass(frozen=True)
+class StrokePlan:
+    """Cartesian plan of one stroke (world frame, metres).
+
+    Attributes:
+        p_above: Palm position above the pre-stroke pose, reached first.
+        p_start: Pre-stroke palm position, ``CLEARANCE`` from the object.
+        p_end: Palm position at maximum travel (the stroke stops earlier on contact).
+        direction: Unit stroke direction (3,).
+        speed: Hand speed along the stroke [m/s].
+        R_world_hand: Hand orientation during the stroke.
+        follow_through: Travel after first contact [m].
+    """
+
+    p_above: np.ndarray
+    p_start: np.ndarray
+    p_end: np.ndarray
+    direction: np.ndarray
+    speed: float
+    R_world_hand: np.ndarray
+    follow_through: float
+
+
+def check_action(action: np.ndarray) -> np.ndarray:
+    """Return ``action`` as a float64 (3,) array, or raise ValueError naming the problem."""
+    a = np.asarray(action, dtype=np.float64)
+    if a.shape != (ACTION_DIM,):
+        raise ValueError(f"action must have shape ({ACTION_DIM},), got shape {a.shape}: {action!r}.")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"action must be finite, got {action!r}.")
+    if np.any(np.abs(a) > 1.0 + 1e-6):
+        raise ValueError(f"action must lie in [-1, 1] in every dimension, got {action!r}.")
+    return np.clip(a, -1.0, 1.0)
+
+
+def half_extent_along(geometry: ObjectGeometry, yaw: float, direction: np.ndarray) -> float:
+    """Half of the object's horizontal extent along ``direction`` (unit, world x-y) at ``yaw`` [m]."""
+    r = geometry.geom_size[0]
+    if geometry.object_type in ("sphere", "vertical_cylinder"):
+        return float(r)
+    c, s = np.cos(yaw), np.sin(yaw)
+    axes = np.array([[c, s], [-s, c]])  # the body's x and y axes in the world plane
+    return float(np.sum(r * np.abs(axes @ direction)))
+
+
+def plan_stroke(
+    behavior: Behavior, geometry: ObjectGeometry, p_world_object: np.ndarray, yaw: float, table_top: float,
+    action: np.ndarray,
+) -> StrokePlan:
+    """Plan the stroke of ``behavior`` against an object resting on the table.
+
+    Args:
+        behavior: The behaviour.
+        geometry: The object's geometry (the paper takes shape, size and position from the simulator).
+        p_world_object: Object centre [m], (3,).
+        yaw: Object yaw [rad].
+        table_top: Height of the table top [m].
+        action: (3,) in [-1, 1]; see the module documentation.
+    """
+    a = check_action(action)
+    d2 = behavior.direction
+    d = np.array([d2[0], d2[1], 0.0])
+    across = np.array([-d2[1], d2[0], 0.0])
+    height = max(geometry.half_height, MIN_PALM_HEIGHT) + a[0] * HEIGHT_RANGE
+    height = max(height, MIN_PALM_HEIGHT - HEIGHT_RANGE / 2)
+    half = half_extent_along(geometry, yaw, d2)
+    centre = np.array([p_world_object[0], p_world_object[1], table_top + height]) + a[1] * LATERAL_RANGE * across
+    p_start = centre - d * (half + behavior.contact_offset + CLEARANCE)
+    # Without contact the hand travels through where the object was, then stops.
+    p_end = centre + d * (half - behavior.contact_offset + FOLLOW_THROUGH)
+    return StrokePlan(
+        p_above=p_start + np.array([0.0, 0.0, APPROACH_HEIGHT]),
+        p_start=p_start,
+        p_end=p_end,
+        direction=d,
+        speed=SPEED_CANONICAL + a[2] * SPEED_RANGE,
+        R_world_hand=behavior.R_world_hand,
+        follow_through=FOLLOW_THROUGH,
+    )

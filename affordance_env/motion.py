@@ -1,0 +1,127 @@
+"""Executing behaviours on the simulated robot: joint-space moves, the Cartesian stroke, and waiting.
+
+The Cartesian stroke is turned into a joint trajectory by Pinocchio IK (one solve per control tick, warm
+started from the previous one) and tracked by MuJoCo's position servos, so the hand's real motion includes
+the servo lag and the arm's momentum.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from affordance_env.behaviors import StrokePlan
+from affordance_env.kinematics import IKResult, Kinematics
+from affordance_env.physics import TapPhysics
+
+#: Period of the servo set-point updates [s].
+CONTROL_DT = 0.01
+#: Time to move from home to above the object, and from there down to the pre-stroke pose [s].
+REACH_TIME, DESCEND_TIME = 0.35, 0.15
+#: Time to back off after the stroke, and to return home [s].
+BACKOFF_TIME, HOME_TIME = 0.12, 0.3
+#: IK tolerances for the stroke waypoints: position [m] and orientation [rad].
+IK_POSITION_TOLERANCE, IK_ORIENTATION_TOLERANCE = 0.005, 0.35
+
+
+@dataclass(frozen=True)
+class StrokeOutcome:
+    """What happened during a stroke.
+
+    Attributes:
+        ik_success: Every waypoint of the stroke was reached by the IK within tolerance.
+        ik_position_error: Largest IK position error over the waypoints [m].
+        ik_orientation_error: Largest IK orientation error over the waypoints [rad].
+        contact: The hand touched the object.
+        contact_time: Simulation time of the first touch [s] (NaN without contact).
+        hand_speed: Hand speed at first touch [m/s] (0 without contact).
+        hand_travel: Distance the palm travelled along the stroke direction [m].
+    """
+
+    ik_success: bool
+    ik_position_error: float
+    ik_orientation_error: float
+    contact: bool
+    contact_time: float
+    hand_speed: float
+    hand_travel: float
+
+
+class MotionExecutor:
+    """Runs strokes on ``physics`` using ``kinematics`` (both describe the same robot)."""
+
+    def __init__(self, physics: TapPhysics, kinematics: Kinematics) -> None:
+        self.physics = physics
+        self.kinematics = kinematics
+        self.steps_per_tick = max(1, round(CONTROL_DT / physics.model.opt.timestep))
+
+    def _tick(self, q: np.ndarray) -> None:
+        self.physics.set_joint_targets(q)
+        self.physics.step(self.steps_per_tick)
+
+    def move_joints(self, q_target: np.ndarray, duration: float) -> None:
+        """Ramp the servo targets linearly from their current value to ``q_target`` over ``duration`` [s]."""
+        q_from = self.physics.joint_targets()
+        n = max(1, round(duration / CONTROL_DT))
+        for k in range(1, n + 1):
+            self._tick(q_from + (q_target - q_from) * (k / n))
+
+    def _ik(self, p: np.ndarray, q_init: np.ndarray, plan: StrokePlan) -> IKResult:
+        return self.kinematics.solve_ik(
+            p, q_init, plan.R_world_hand, position_tolerance=1e-3, orientation_tolerance=IK_ORIENTATION_TOLERANCE
+        )
+
+    def plan_joint_path(self, plan: StrokePlan) -> tuple[list[IKResult], np.ndarray]:
+        """IK of the approach poses and of the stroke line sampled every control tick.
+
+        Returns the IK results (above, start, then every stroke point) and the stroke's joint path (n, nq).
+        """
+        q = self.physics.joint_targets()
+        above = self._ik(plan.p_above, q, plan)
+        start = self._ik(plan.p_start, above.q, plan)
+        length = float(np.dot(plan.p_end - plan.p_start, plan.direction))
+        n = max(2, int(np.ceil(length / (plan.speed * CONTROL_DT))) + 1)
+        results = [above, start]
+        path = np.empty((n, self.kinematics.nq))
+        q_prev = start.q
+        for k, s in enumerate(np.linspace(0.0, length, n)):
+            res = self._ik(plan.p_start + s * plan.direction, q_prev, plan)
+            results.append(res)
+            path[k] = q_prev = res.q
+        return results, path
+
+    def stroke(self, plan: StrokePlan) -> StrokeOutcome:
+        """Reach, stroke until contact plus follow-through (or full travel), and back off; not the return home."""
+        physics = self.physics
+        results, path = self.plan_joint_path(plan)
+        pos_err = max(r.position_error for r in results)
+        rot_err = max(r.orientation_error for r in results)
+        ik_ok = pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE
+        self.move_joints(results[0].q, REACH_TIME)
+        self.move_joints(results[1].q, DESCEND_TIME)
+        p_hand_start = physics.hand_position()
+        contact, contact_time, hand_speed = False, float("nan"), 0.0
+        extra_ticks = int(np.ceil(plan.follow_through / (plan.speed * CONTROL_DT)))
+        stop_at = len(path)
+        k = 0
+        dt = physics.model.opt.timestep
+        while k < stop_at:
+            physics.set_joint_targets(path[k])
+            for _ in range(self.steps_per_tick):
+                p_before = physics.hand_position()
+                physics.step()
+                if not contact and physics.hand_touches_object():
+                    contact = True
+                    contact_time = float(physics.data.time)
+                    hand_speed = float(np.linalg.norm(physics.hand_position() - p_before) / dt)
+                    stop_at = min(len(path), k + 1 + extra_ticks)
+            k += 1
+        travel = float(np.dot(physics.hand_position() - p_hand_start, plan.direction))
+        # Back off to the pre-stroke pose so that the hand leaves the object alone.
+        self.move_joints(results[1].q, BACKOFF_TIME)
+        return StrokeOutcome(ik_ok, pos_err, rot_err, contact, contact_time, hand_speed, travel)
+
+    def go_home(self, q_home: np.ndarray) -> None:
+        """Return to ``q_home`` through the pose above the stroke."""
+        self.move_joints(q_home, HOME_TIME)

@@ -1,0 +1,189 @@
+"""Named access to the simulated scene: the robot's joints, the hand, the object and the table.
+
+In the manner of dm_control's ``Physics`` helpers: every index into MuJoCo's arrays is looked up once, by name,
+here, and the rest of the project asks geometric questions (``hand_position()``, ``object_pose()``) instead of
+indexing ``MjData`` itself.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from affordance_env.objects import PRIMITIVES, ObjectGeometry
+from affordance_env.robot_model import ACTIVE_JOINTS, CONTACT_LINKS
+
+#: Geom group that hides the scene's inactive object primitives from the range camera and the renderer.
+HIDDEN_GEOM_GROUP = 3
+OBJECT_RGBA = np.array([0.85, 0.2, 0.15, 1.0])
+
+
+def _id(model: mujoco.MjModel, kind: mujoco.mjtObj, name: str) -> int:
+    index = mujoco.mj_name2id(model, kind, name)
+    if index < 0:
+        raise ValueError(f"The model has no {kind.name.removeprefix('mjOBJ_').lower()} named {name!r}.")
+    return index
+
+
+class TapPhysics:
+    """The model and data of the tap scene with named queries.
+
+    Args:
+        model: A model built by :func:`affordance_env.scene.build_model`. It is modified in place when the
+            object changes (sizes, masses), so give each ``TapPhysics`` its own model.
+    """
+
+    def __init__(self, model: mujoco.MjModel) -> None:
+        self.model = model
+        self.data = mujoco.MjData(model)
+        self._scratch = mujoco.MjData(model)
+        obj = mujoco.mjtObj
+        self.object_body = _id(model, obj.mjOBJ_BODY, "object")
+        self.object_geoms = {p: _id(model, obj.mjOBJ_GEOM, f"object_{p}") for p in PRIMITIVES}
+        joint = _id(model, obj.mjOBJ_JOINT, "object_free")
+        self.object_qpos = int(model.jnt_qposadr[joint])
+        self.object_qvel = int(model.jnt_dofadr[joint])
+        self.robot_qpos = np.array([model.jnt_qposadr[_id(model, obj.mjOBJ_JOINT, n)] for n in ACTIVE_JOINTS])
+        self.robot_qvel = np.array([model.jnt_dofadr[_id(model, obj.mjOBJ_JOINT, n)] for n in ACTIVE_JOINTS])
+        self.actuators = np.array([_id(model, obj.mjOBJ_ACTUATOR, n) for n in ACTIVE_JOINTS])
+        self.palm_site = _id(model, obj.mjOBJ_SITE, "palm")
+        self.head_site = _id(model, obj.mjOBJ_SITE, "head")
+        touch = _id(model, obj.mjOBJ_SENSOR, "palm_touch")
+        self.touch_adr = int(model.sensor_adr[touch])
+        self.table_geom = _id(model, obj.mjOBJ_GEOM, "table_top")
+        self.home_key = _id(model, obj.mjOBJ_KEY, "home")
+        contact_bodies = {_id(model, obj.mjOBJ_BODY, n) for n in CONTACT_LINKS}
+        self.hand_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] in contact_bodies])
+        self.ctrl_low = model.actuator_ctrlrange[self.actuators, 0].copy()
+        self.ctrl_high = model.actuator_ctrlrange[self.actuators, 1].copy()
+        self.active_geom = self.object_geoms["sphere"]
+        self.geometry: ObjectGeometry | None = None
+
+    # --- the table -------------------------------------------------------------------------------------------
+    @property
+    def table_top(self) -> float:
+        """Height of the table's top surface [m]."""
+        mujoco.mj_kinematics(self.model, self.data) if self.data.time == 0 else None
+        return float(self.data.geom_xpos[self.table_geom][2] + self.model.geom_size[self.table_geom][2])
+
+    def table_extent(self) -> tuple[np.ndarray, np.ndarray]:
+        """(lower, upper) corners of the table top in world x, y [m]."""
+        centre = self.data.geom_xpos[self.table_geom][:2]
+        half = self.model.geom_size[self.table_geom][:2]
+        return centre - half, centre + half
+
+    # --- the robot -------------------------------------------------------------------------------------------
+    def reset_home(self) -> None:
+        """Reset the whole state to the ``home`` keyframe and recompute derived quantities."""
+        mujoco.mj_resetDataKeyframe(self.model, self.data, self.home_key)
+        mujoco.mj_forward(self.model, self.data)
+
+    def joint_positions(self) -> np.ndarray:
+        """Robot joint angles in ACTIVE_JOINTS order [rad]."""
+        return self.data.qpos[self.robot_qpos].copy()
+
+    def joint_velocities(self) -> np.ndarray:
+        """Robot joint velocities in ACTIVE_JOINTS order [rad/s]."""
+        return self.data.qvel[self.robot_qvel].copy()
+
+    def set_joint_targets(self, q: np.ndarray) -> None:
+        """Command the position servos to ``q`` [rad] (ACTIVE_JOINTS order), clipped to the joint ranges."""
+        self.data.ctrl[self.actuators] = np.clip(q, self.ctrl_low, self.ctrl_high)
+
+    def joint_targets(self) -> np.ndarray:
+        """Current servo targets [rad]."""
+        return self.data.ctrl[self.actuators].copy()
+
+    def hand_position(self) -> np.ndarray:
+        """``p_world_hand``: palm centre in the world frame [m]."""
+        return self.data.site_xpos[self.palm_site].copy()
+
+    def palm_touch(self) -> float:
+        """Normal force on the palm's touch sensor [N]."""
+        return float(self.data.sensordata[self.touch_adr])
+
+    def hand_touches_object(self) -> bool:
+        """Whether any contact joins the hand (or wrist, forearm) and the object."""
+        ncon = self.data.ncon
+        if ncon == 0:
+            return False
+        g1 = self.data.contact.geom1[:ncon]
+        g2 = self.data.contact.geom2[:ncon]
+        obj = self.active_geom
+        return bool(np.any(((g1 == obj) & np.isin(g2, self.hand_geoms)) | ((g2 == obj) & np.isin(g1, self.hand_geoms))))
+
+    # --- the object ------------------------------------------------------------------------------------------
+    def set_object(self, geometry: ObjectGeometry, xy: np.ndarray, yaw: float) -> None:
+        """Make ``geometry`` the object of interest and place it at rest on the table.
+
+        Args:
+            geometry: From :func:`affordance_env.objects.object_geometry`.
+            xy: Position of the object's centre on the table, world x and y [m].
+            yaw: Rotation about the vertical axis [rad].
+        """
+        m = self.model
+        for primitive, g in self.object_geoms.items():
+            active = primitive == geometry.primitive
+            m.geom_contype[g] = m.geom_conaffinity[g] = 1 if active else 0
+            m.geom_group[g] = 0 if active else HIDDEN_GEOM_GROUP
+            m.geom_rgba[g] = OBJECT_RGBA if active else 0.0
+        g = self.object_geoms[geometry.primitive]
+        m.geom_size[g] = geometry.geom_size
+        m.geom_rbound[g] = geometry.rbound
+        half = geometry.geom_size if geometry.primitive == "box" else (
+            np.full(3, geometry.geom_size[0]) if geometry.primitive == "sphere"
+            else np.array([geometry.geom_size[0], geometry.geom_size[0], geometry.geom_size[1]])
+        )
+        m.geom_aabb[g] = np.concatenate([np.zeros(3), half])
+        m.body_mass[self.object_body] = geometry.mass
+        m.body_inertia[self.object_body] = geometry.inertia
+        m.body_ipos[self.object_body] = 0.0
+        m.body_iquat[self.object_body] = [1.0, 0.0, 0.0, 0.0]
+        self.active_geom = g
+        self.geometry = geometry
+        mujoco.mj_setConst(m, self._scratch)  # on scratch data: it resets the state it is given to qpos0
+        quat_yaw = np.array([np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)])
+        quat = np.empty(4)
+        mujoco.mju_mulQuat(quat, quat_yaw, geometry.quat_rest)
+        a = self.object_qpos
+        self.data.qpos[a : a + 3] = [xy[0], xy[1], self.table_top + geometry.half_height + 1e-4]
+        self.data.qpos[a + 3 : a + 7] = quat
+        self.data.qvel[self.object_qvel : self.object_qvel + 6] = 0.0
+        mujoco.mj_forward(m, self.data)
+
+    def object_pose(self) -> np.ndarray:
+        """Object pose: position [m] and orientation quaternion (w, x, y, z), (7,)."""
+        a = self.object_qpos
+        return self.data.qpos[a : a + 7].copy()
+
+    def object_speed(self) -> float:
+        """Linear speed of the object [m/s]."""
+        v = self.data.qvel[self.object_qvel : self.object_qvel + 3]
+        return float(np.linalg.norm(v))
+
+    def object_angular_speed(self) -> float:
+        """Angular speed of the object [rad/s]."""
+        w = self.data.qvel[self.object_qvel + 3 : self.object_qvel + 6]
+        return float(np.linalg.norm(w))
+
+    def object_on_table(self) -> bool:
+        """Whether the object's centre is above the table top and within its extent."""
+        p = self.data.qpos[self.object_qpos : self.object_qpos + 3]
+        low, high = self.table_extent()
+        return bool(p[2] > self.table_top and np.all(p[:2] >= low) and np.all(p[:2] <= high))
+
+    # --- stepping --------------------------------------------------------------------------------------------
+    def step(self, n: int = 1) -> None:
+        """Advance the simulation by ``n`` timesteps."""
+        mujoco.mj_step(self.model, self.data, n)
+
+    def unstable(self) -> str | None:
+        """A description of a simulation fault (MuJoCo warning, non-finite state), or None if healthy."""
+        for kind in (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQVEL,
+                     mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_CONTACTFULL,
+                     mujoco.mjtWarning.mjWARN_CNSTRFULL):
+            if self.data.warning[kind].number > 0:
+                return f"MuJoCo warning {kind.name}"
+        if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
+            return "non-finite state"
+        return None

@@ -1,0 +1,154 @@
+"""Build the MuJoCo model: the iCub from its URDF, attached into the table scene of ``assets/scene.xml``.
+
+Every step that changes the URDF robot is listed in ``assets/README.md``; :func:`build_spec` is that list in code.
+"""
+
+from __future__ import annotations
+
+import warnings
+
+import mujoco
+import numpy as np
+
+from affordance_env.assets_path import assets_dir
+from affordance_env.robot_model import (
+    ACTIVE_JOINTS,
+    ARM_JOINTS,
+    CONTACT_LINKS,
+    HAND_FRAME,
+    HEAD_FRAME,
+    NECK_JOINTS,
+    TORSO_JOINTS,
+    icub_urdf,
+)
+
+#: Collision bits. World geoms (table, floor, object) are type 1 / affinity 1; robot links in CONTACT_LINKS are
+#: type 2 / affinity 1, so they touch the world but never each other; all other robot geoms touch nothing.
+ROBOT_CONTYPE, ROBOT_CONAFFINITY = 2, 1
+
+#: Geom group of the robot's geoms (the world's are in group 0), so sensors can choose whether to see the robot.
+ROBOT_GEOM_GROUP = 1
+
+#: Sliding friction of the hand's contact geoms (they take priority over the object's friction).
+HAND_FRICTION = 0.3
+
+#: Position-servo stiffness per joint group [N m / rad].
+SERVO_KP: dict[str, float] = {"torso": 300.0, "neck": 50.0, "arm": 60.0, "wrist": 10.0}
+#: Joint armature added for a stable servo [kg m^2].
+ARMATURE = 0.02
+#: Joint damping [N m s / rad].
+DAMPING = 1.0
+
+#: Range camera: position in the head frame [m] (about eye height, in front of the head origin) and its
+#: orientation (MuJoCo cameras look along their -z axis; this one looks along the head's z axis, image up =
+#: head y).
+RANGE_CAMERA_POS_HEAD = (0.0, 0.035, 0.06)
+RANGE_CAMERA_QUAT_HEAD = (0.0, 0.0, 1.0, 0.0)
+RANGE_CAMERA_FOVY_DEG = 50.0
+
+#: The ``home`` keyframe: arm raised above the table beside the workspace, head looking down at the table.
+HOME_QPOS: dict[str, float] = {
+    "torso_pitch": 0.4,
+    "torso_roll": 0.0,
+    "torso_yaw": 0.0,
+    "neck_pitch": -0.5,
+    "neck_roll": 0.0,
+    "neck_yaw": 0.0,
+    "r_shoulder_pitch": -1.0,
+    "r_shoulder_roll": 0.45,
+    "r_shoulder_yaw": 0.0,
+    "r_elbow": 1.2,
+    "r_wrist_prosup": 0.0,
+    "r_wrist_pitch": 0.0,
+    "r_wrist_yaw": 0.0,
+}
+
+
+def _servo_kp(joint: str) -> float:
+    if joint in TORSO_JOINTS:
+        return SERVO_KP["torso"]
+    if joint in NECK_JOINTS:
+        return SERVO_KP["neck"]
+    if joint in ARM_JOINTS[4:]:
+        return SERVO_KP["wrist"]
+    return SERVO_KP["arm"]
+
+
+def robot_spec() -> mujoco.MjSpec:
+    """The iCub as MuJoCo reads its URDF, made simulable (see ``assets/README.md``)."""
+    spec = mujoco.MjSpec.from_string(icub_urdf())
+    # 1. Lock every joint the project does not move (legs, left arm): the bodies become static and are fused.
+    for joint in list(spec.joints):
+        if joint.name not in ACTIVE_JOINTS:
+            spec.delete(joint)
+    # 2. Collisions: only the right hand, wrist and forearm touch the world; nothing touches the robot itself.
+    for body in spec.bodies:
+        for i, geom in enumerate(body.geoms):
+            geom.name = f"{body.name}_collision" + (f"_{i}" if i else "")
+            contact = body.name in CONTACT_LINKS
+            geom.contype = ROBOT_CONTYPE if contact else 0
+            geom.conaffinity = ROBOT_CONAFFINITY if contact else 0
+            geom.rgba = [0.75, 0.75, 0.78, 1.0]
+            geom.group = ROBOT_GEOM_GROUP
+            if contact:
+                # The hand's shell is smooth plastic: low friction, and it wins over the object's friction.
+                geom.friction = [HAND_FRICTION, 0.005, 0.0001]
+                geom.priority = 1
+        # 3. Gravity compensation on every link, as the iCub's own controllers do.
+        if body.name != "world":
+            body.gravcomp = 1.0
+    # 4. Joint damping and armature for stable position servos.
+    for joint in spec.joints:
+        joint.damping = [DAMPING, 0.0, 0.0]
+        joint.armature = ARMATURE
+    # 5. Palm site (for the touch sensor and hand queries) and the range camera in the head.
+    palm = spec.body(HAND_FRAME)
+    palm.add_site(name="palm", size=[0.005, 0.005, 0.005], rgba=[0.2, 0.8, 0.2, 0.0])
+    palm.add_site(name="palm_touch", pos=[0.0, -0.02, 0.0], size=[0.055, 0.045, 0.03],
+                  type=mujoco.mjtGeom.mjGEOM_BOX, rgba=[0.2, 0.8, 0.2, 0.0])
+    head = spec.body(HEAD_FRAME)
+    head.add_site(name="head", size=[0.01, 0.01, 0.01], rgba=[0, 0, 0, 0])
+    head.add_camera(name="range_camera", pos=list(RANGE_CAMERA_POS_HEAD), quat=list(RANGE_CAMERA_QUAT_HEAD),
+                    fovy=RANGE_CAMERA_FOVY_DEG)
+    return spec
+
+
+def build_spec() -> mujoco.MjSpec:
+    """The full scene: table, object and lights from ``assets/scene.xml`` with the robot attached."""
+    spec = mujoco.MjSpec.from_file(str(assets_dir() / "scene.xml"))
+    spec.compiler.fusestatic = True  # the URDF's fixed links (frames, sensors) fold into their moving parents
+    robot = robot_spec()
+    frame = spec.worldbody.add_frame(name="robot_base")
+    with warnings.catch_warnings():
+        # Names stay exactly those of the URDF (no prefix), so MuJoCo and Pinocchio share them. MuJoCo warns
+        # that an unprefixed attachment may not round-trip through XML; we never save the attached spec.
+        warnings.filterwarnings("ignore", message="Attaching a spec with an empty prefix")
+        frame.attach_body(robot.body("root_link"))
+    # 6. Position actuators on every active joint, and the touch sensor on the palm.
+    for name in ACTIVE_JOINTS:
+        joint = spec.joint(name)
+        act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        act.set_to_position(kp=_servo_kp(name), dampratio=1.0)
+        act.ctrlrange = joint.range
+        act.ctrllimited = True
+    spec.add_sensor(name="palm_touch", type=mujoco.mjtSensor.mjSENS_TOUCH, objtype=mujoco.mjtObj.mjOBJ_SITE,
+                    objname="palm_touch")
+    # 7. The home keyframe.
+    model = _compile(spec)
+    qpos = model.qpos0.copy()
+    for name, value in HOME_QPOS.items():
+        qpos[model.jnt_qposadr[model.joint(name).id]] = value
+    ctrl = np.array([HOME_QPOS[name] for name in ACTIVE_JOINTS])
+    spec.add_key(name="home", qpos=qpos.tolist(), ctrl=ctrl.tolist())
+    return spec
+
+
+def build_model() -> mujoco.MjModel:
+    """Compile :func:`build_spec` (about 1 s: the robot meshes are processed)."""
+    return _compile(build_spec())
+
+
+def _compile(spec: mujoco.MjSpec) -> mujoco.MjModel:
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Attaching a spec with an empty prefix")
+        return spec.compile()

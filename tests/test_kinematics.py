@@ -1,0 +1,69 @@
+"""Pinocchio and MuJoCo read the same URDF: they agree on frames; the IK reaches the tap workspace."""
+
+import mujoco
+import numpy as np
+import pytest
+
+from affordance_env.behaviors import BEHAVIORS
+from affordance_env.kinematics import Kinematics
+from affordance_env.robot_model import ACTIVE_JOINTS
+
+
+@pytest.fixture(scope="module")
+def kinematics():
+    return Kinematics()
+
+
+def test_mujoco_and_pinocchio_agree_on_hand_and_head(model, kinematics):
+    data = mujoco.MjData(model)
+    qadr = [model.jnt_qposadr[model.joint(n).id] for n in ACTIVE_JOINTS]
+    palm, head = model.site("palm").id, model.site("head").id
+    rng = np.random.default_rng(1)
+    worst = 0.0
+    for _ in range(50):
+        q = rng.uniform(kinematics.lower, kinematics.upper)
+        data.qpos[qadr] = q
+        mujoco.mj_kinematics(model, data)
+        for site, pose in ((palm, kinematics.hand_pose(q)), (head, kinematics.head_pose(q))):
+            worst = max(worst, np.linalg.norm(data.site_xpos[site] - pose.translation))
+            np.testing.assert_allclose(data.site_xmat[site].reshape(3, 3), pose.rotation, atol=1e-6)
+    assert worst < 1e-3
+
+
+def test_ik_reaches_the_tap_workspace(kinematics):
+    rng = np.random.default_rng(2)
+    q_home = np.zeros(kinematics.nq)
+    q_home[ACTIVE_JOINTS.index("r_shoulder_pitch")] = -0.6
+    q_home[ACTIVE_JOINTS.index("r_shoulder_roll")] = 0.45
+    q_home[ACTIVE_JOINTS.index("r_elbow")] = 1.2
+    R = BEHAVIORS["tap"].R_world_hand
+    reached = 0
+    n = 200
+    for _ in range(n):
+        target = rng.uniform([-0.36, -0.05, -0.04], [-0.22, 0.20, 0.10])
+        result = kinematics.solve_ik(target, q_home, R)
+        assert np.all(result.q >= kinematics.lower - 1e-9) and np.all(result.q <= kinematics.upper + 1e-9)
+        reached_pose = kinematics.hand_pose(result.q).translation
+        # the reported error is the true error: a failure is never hidden
+        assert np.linalg.norm(reached_pose - target) == pytest.approx(result.position_error, abs=1e-9)
+        if result.success:
+            assert result.position_error <= 1e-3
+            reached += 1
+    assert reached / n >= 0.95
+
+
+def test_unreachable_target_is_reported_as_failure(kinematics):
+    result = kinematics.solve_ik(np.array([-2.0, 0.0, 0.0]), np.zeros(kinematics.nq))
+    assert not result.success
+    assert result.position_error > 1.0
+
+
+@pytest.mark.parametrize("bad", [np.array([np.nan, 0, 0]), np.zeros(2)])
+def test_bad_targets_raise(kinematics, bad):
+    with pytest.raises(ValueError, match="p_world_target"):
+        kinematics.solve_ik(bad, np.zeros(kinematics.nq))
+
+
+def test_unknown_frame_lists_available_frames():
+    with pytest.raises(ValueError, match="Available frames"):
+        Kinematics(hand_frame="r_hnd")

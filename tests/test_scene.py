@@ -1,0 +1,113 @@
+"""The simulated world: the iCub URDF made simulable, named, stable, and the objects of the paper."""
+
+import mujoco
+import numpy as np
+import pytest
+
+from affordance_env.objects import OBJECT_TYPES, object_geometry
+from affordance_env.physics import TapPhysics
+from affordance_env.robot_model import ACTIVE_JOINTS, CONTACT_LINKS
+from affordance_env.scene import build_model
+
+
+def test_every_element_is_named(model):
+    kinds = {
+        "body": (model.nbody, mujoco.mjtObj.mjOBJ_BODY),
+        "joint": (model.njnt, mujoco.mjtObj.mjOBJ_JOINT),
+        "geom": (model.ngeom, mujoco.mjtObj.mjOBJ_GEOM),
+        "camera": (model.ncam, mujoco.mjtObj.mjOBJ_CAMERA),
+        "sensor": (model.nsensor, mujoco.mjtObj.mjOBJ_SENSOR),
+        "actuator": (model.nu, mujoco.mjtObj.mjOBJ_ACTUATOR),
+        "site": (model.nsite, mujoco.mjtObj.mjOBJ_SITE),
+    }
+    for kind, (count, obj) in kinds.items():
+        assert count > 0, kind
+        for i in range(count):
+            name = mujoco.mj_id2name(model, obj, i)
+            if kind == "body" and i == 0:
+                assert name == "world"
+            assert name, f"{kind} {i} has no name"
+
+
+def test_actuated_joints_and_home_keyframe(model):
+    assert [model.actuator(i).name for i in range(model.nu)] == list(ACTIVE_JOINTS)
+    assert model.key("home").id == 0
+    hinge_names = [model.joint(i).name for i in range(model.njnt) if model.jnt_type[i] == mujoco.mjtJoint.mjJNT_HINGE]
+    assert hinge_names == list(ACTIVE_JOINTS)
+
+
+def test_robot_never_collides_with_itself(model):
+    robot_geoms = [g for g in range(model.ngeom) if model.geom_group[g] == 1]
+    assert len(robot_geoms) > 10
+    for a in robot_geoms:
+        for b in robot_geoms:
+            touches = (model.geom_contype[a] & model.geom_conaffinity[b]) or (
+                model.geom_contype[b] & model.geom_conaffinity[a]
+            )
+            assert not touches, (model.geom(a).name, model.geom(b).name)
+    table = model.geom("table_top").id
+    hand_geoms = [g for g in robot_geoms if model.body(model.geom_bodyid[g]).name in CONTACT_LINKS]
+    assert hand_geoms
+    for g in hand_geoms:
+        assert (model.geom_contype[g] & model.geom_conaffinity[table]) or (
+            model.geom_contype[table] & model.geom_conaffinity[g]
+        )
+
+
+@pytest.mark.parametrize("object_type", OBJECT_TYPES)
+def test_scene_steps_two_seconds_under_control_noise_without_warnings(object_type):
+    physics = TapPhysics(build_model())
+    physics.reset_home()
+    physics.set_object(object_geometry(object_type, 0.07), np.array([-0.30, 0.03]), 0.1)
+    rng = np.random.default_rng(0)
+    home = physics.joint_targets()
+    n = round(2.0 / physics.model.opt.timestep)
+    for _ in range(0, n, 10):
+        physics.set_joint_targets(home + rng.normal(0.0, 0.02, home.shape))
+        physics.step(10)
+    assert physics.unstable() is None
+    assert all(w.number == 0 for w in physics.data.warning)
+    assert physics.object_on_table()
+    # the object rests where it was put; the robot stays near home
+    assert np.linalg.norm(physics.object_pose()[:2] - [-0.30, 0.03]) < 0.01
+    assert np.max(np.abs(physics.joint_positions() - home)) < 0.1
+
+
+def test_objects_rest_on_the_table(physics):
+    for object_type in OBJECT_TYPES:
+        for size in (0.04, 0.10):
+            geometry = object_geometry(object_type, size)
+            physics.reset_home()
+            physics.set_object(geometry, np.array([-0.3, 0.03]), 0.0)
+            z0 = physics.object_pose()[2]
+            physics.step(100)
+            assert abs(physics.object_pose()[2] - z0) < 2e-3, (object_type, size)
+            assert abs(z0 - physics.table_top - geometry.half_height) < 2e-3
+
+
+def test_set_object_keeps_robot_state(physics):
+    q = physics.joint_positions()
+    physics.set_object(object_geometry("box", 0.05), np.array([-0.3, 0.03]), 0.0)
+    np.testing.assert_array_equal(physics.joint_positions(), q)
+
+
+def test_object_geometry_sizes_and_mass():
+    sphere = object_geometry("sphere", 0.06)
+    assert sphere.geom_size[0] == pytest.approx(0.03)
+    assert sphere.mass == pytest.approx(300 * 4 / 3 * np.pi * 0.03**3)
+    lying = object_geometry("horizontal_cylinder", 0.06)
+    standing = object_geometry("vertical_cylinder", 0.06)
+    assert lying.primitive == standing.primitive == "cylinder"
+    assert not np.allclose(lying.quat_rest, standing.quat_rest)
+
+
+@pytest.mark.parametrize("bad", ["cube", "Sphere", ""])
+def test_unknown_object_type_lists_valid_choices(bad):
+    with pytest.raises(ValueError, match="sphere, box, horizontal_cylinder, vertical_cylinder"):
+        object_geometry(bad, 0.05)
+
+
+@pytest.mark.parametrize("bad", [0.0, -0.05, float("nan"), float("inf")])
+def test_non_positive_or_non_finite_size_is_refused(bad):
+    with pytest.raises(ValueError, match="size"):
+        object_geometry("box", bad)
