@@ -156,7 +156,7 @@ class TapAffordanceEnv(gym.Env):
         nq = len(ACTIVE_JOINTS)
         self.observation_space = spaces.Dict(
             {
-                "range": spaces.Box(0.0, np.inf, (H, W), np.float32),
+                "range": spaces.Box(0.0, self.camera.max_range, (H, W), np.float32),
                 "mask": spaces.Box(0, 1, (H, W), np.int8),
                 "features": spaces.Box(-np.inf, np.inf, (len(FEATURE_NAMES),), np.float32),
                 "joints": spaces.Box(

@@ -1,0 +1,132 @@
+"""TapAffordance-v0 as a user meets it: Gymnasium's checker, determinism, the paper's phenomenon, errors."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import affordance_env
+from affordance_env.tap_env import TapAffordanceEnv
+
+
+@pytest.fixture(scope="module")
+def env():
+    env = TapAffordanceEnv()
+    yield env
+    env.close()
+
+
+# Accepted checker warnings: the features are unbounded real numbers (Box(-inf, inf)).
+@pytest.mark.filterwarnings("ignore:.*Box observation space m..imum value is .?infinity")
+def test_gym_make_and_check_env():
+    env = gym.make("TapAffordance-v0", camera_width=48, camera_height=40)
+    with_checker_warnings = check_env(env.unwrapped, skip_render_check=True)
+    assert with_checker_warnings is None
+    obs, info = env.reset(seed=3)
+    assert obs["range"].shape == (40, 48) and obs["mask"].shape == (40, 48)
+    assert obs["features"].shape == (len(affordance_env.FEATURE_NAMES),)
+    env.close()
+
+
+def test_module_colon_id_works():
+    env = gym.make("affordance_env:TapAffordance-v0")
+    assert isinstance(env.unwrapped, TapAffordanceEnv)
+    env.close()
+
+
+def test_same_seed_gives_bit_identical_interaction():
+    results = []
+    for _ in range(2):
+        env = TapAffordanceEnv()
+        obs0, info0 = env.reset(seed=11)
+        obs1, reward, terminated, truncated, info1 = env.step(np.array([0.3, -0.2, 0.5], dtype=np.float32))
+        results.append((obs0, info0, obs1, reward, info1))
+        env.close()
+    (a0, ai0, a1, ar, ai1), (b0, bi0, b1, br, bi1) = results
+    for key in a0:
+        np.testing.assert_array_equal(a0[key], b0[key])
+        np.testing.assert_array_equal(a1[key], b1[key])
+    assert ar == br
+    np.testing.assert_array_equal(ai1["effect"], bi1["effect"])
+    np.testing.assert_array_equal(ai1["object"]["final_pose"], bi1["object"]["final_pose"])
+    assert ai1["rolled"] == bi1["rolled"] and ai1["outcome"] == bi1["outcome"]
+
+
+def test_info_after_step(env):
+    _, info0 = env.reset(seed=5)
+    assert info0["object"]["type"] in affordance_env.OBJECT_TYPES
+    assert 0.04 <= info0["object"]["size"] <= 0.10
+    assert info0["attention"]["success"]
+    obs, reward, terminated, truncated, info = env.step(np.zeros(3))
+    assert terminated and not truncated
+    assert info["effect"].shape == (49,) and np.all(np.isfinite(info["effect"]))
+    np.testing.assert_allclose(info["effect"], info["final_features"] - info["initial_features"], rtol=1e-6)
+    assert reward == pytest.approx(info["displacement"])
+    assert info["ik"]["success"] and info["contact"]
+    assert info["outcome"] in ("rest", "off_table", "timeout")
+
+
+def test_step_before_reset_or_twice_raises():
+    env = TapAffordanceEnv()
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(np.zeros(3))
+    env.reset(seed=0)
+    env.step(np.zeros(3))
+    with pytest.raises(RuntimeError, match="reset"):
+        env.step(np.zeros(3))
+
+
+@pytest.mark.parametrize(
+    "action, match",
+    [(np.array([np.nan, 0, 0]), "finite"), (np.zeros(4), "shape"), (np.array([0, 1.5, 0]), r"\[-1, 1\]")],
+)
+def test_bad_actions_get_clear_errors(env, action, match):
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=match):
+        env.step(action)
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [
+        ({"behavior": "kick"}, "tap, tap_back, push"),
+        ({"object_types": ("cube",)}, "Valid types"),
+        ({"size_range": (0.08, 0.05)}, "size_range"),
+        ({"render_mode": "human"}, "render_mode"),
+    ],
+)
+def test_bad_options_get_clear_errors(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        TapAffordanceEnv(**kwargs)
+
+
+def test_reward_fn_is_used():
+    env = TapAffordanceEnv(reward_fn=lambda info: 1.0 if info["rolled"] else -1.0)
+    env.reset(seed=1)
+    _, reward, _, _, info = env.step(np.zeros(3))
+    assert reward == (1.0 if info["rolled"] else -1.0)
+
+
+@pytest.mark.slow
+def test_tap_rolls_spheres_and_lying_cylinders_but_not_boxes_or_standing_cylinders():
+    rates = {}
+    for object_type in affordance_env.OBJECT_TYPES:
+        env = TapAffordanceEnv(object_types=(object_type,), camera_width=32, camera_height=32)
+        rolled = []
+        for seed in range(20):
+            env.reset(seed=seed)
+            rolled.append(env.step(np.zeros(3))[4]["rolled"])
+        rates[object_type] = np.mean(rolled)
+    assert rates["sphere"] >= 0.9 and rates["horizontal_cylinder"] >= 0.9, rates
+    assert rates["box"] <= 0.1 and rates["vertical_cylinder"] <= 0.1, rates
+
+
+def test_async_vector_env():
+    envs = gym.vector.AsyncVectorEnv(
+        [lambda: gym.make("TapAffordance-v0", camera_width=32, camera_height=32) for _ in range(2)]
+    )
+    obs, infos = envs.reset(seed=[1, 2])
+    assert obs["features"].shape == (2, 49)
+    obs, rewards, terminated, truncated, infos = envs.step(np.zeros((2, 3), dtype=np.float32))
+    assert terminated.all() and rewards.shape == (2,)
+    envs.close()
