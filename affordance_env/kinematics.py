@@ -116,9 +116,7 @@ class Kinematics:
             raise ValueError(f"p_world_target must be 3 finite coordinates [m], got {p_world_target!r}.")
         if R_world_target is not None:
             R_world_target = np.asarray(R_world_target, dtype=float)
-            if R_world_target.shape != (3, 3) or not np.allclose(
-                R_world_target @ R_world_target.T, np.eye(3), atol=1e-6
-            ):
+            if R_world_target.shape != (3, 3) or np.abs(R_world_target @ R_world_target.T - np.eye(3)).max() > 1e-6:
                 raise ValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
         q = np.clip(self._check_q(q_init).copy(), self.lower, self.upper)
         dofs = self.reach_dofs

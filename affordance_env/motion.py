@@ -21,6 +21,8 @@ CONTROL_DT = 0.01
 REACH_TIME, DESCEND_TIME = 0.35, 0.15
 #: Time to back off after the stroke, and to return home [s].
 BACKOFF_TIME, HOME_TIME = 0.12, 0.3
+#: Spacing of the IK solutions along the stroke line [m].
+IK_SPACING = 0.01
 #: IK tolerances for the stroke waypoints: position [m] and orientation [rad].
 IK_POSITION_TOLERANCE, IK_ORIENTATION_TOLERANCE = 0.005, 0.35
 
@@ -81,14 +83,20 @@ class MotionExecutor:
         above = self._ik(plan.p_above, q, plan)
         start = self._ik(plan.p_start, above.q, plan)
         length = float(np.dot(plan.p_end - plan.p_start, plan.direction))
-        n = max(2, int(np.ceil(length / (plan.speed * CONTROL_DT))) + 1)
+        # IK on waypoints every IK_SPACING along the line; joint-space interpolation between them per tick
+        # (the deviation from the straight line is far below the IK tolerance over such short spans).
+        n_ik = max(2, int(np.ceil(length / IK_SPACING)) + 1)
+        s_ik = np.linspace(0.0, length, n_ik)
+        q_ik = np.empty((n_ik, self.kinematics.nq))
         results = [above, start]
-        path = np.empty((n, self.kinematics.nq))
         q_prev = start.q
-        for k, s in enumerate(np.linspace(0.0, length, n)):
+        for k, s in enumerate(s_ik):
             res = self._ik(plan.p_start + s * plan.direction, q_prev, plan)
             results.append(res)
-            path[k] = q_prev = res.q
+            q_ik[k] = q_prev = res.q
+        n = max(2, int(np.ceil(length / (plan.speed * CONTROL_DT))) + 1)
+        s_tick = np.linspace(0.0, length, n)
+        path = np.column_stack([np.interp(s_tick, s_ik, q_ik[:, j]) for j in range(q_ik.shape[1])])
         return results, path
 
     def stroke(self, plan: StrokePlan) -> StrokeOutcome:

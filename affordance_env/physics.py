@@ -7,6 +7,8 @@ indexing ``MjData`` itself.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import mujoco
 import numpy as np
 
@@ -54,10 +56,14 @@ class TapPhysics:
         self.home_key = _id(model, obj.mjOBJ_KEY, "home")
         contact_bodies = {_id(model, obj.mjOBJ_BODY, n) for n in CONTACT_LINKS}
         self.hand_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] in contact_bodies])
+        self._is_hand_geom = np.zeros(model.ngeom, dtype=bool)
+        self._is_hand_geom[self.hand_geoms] = True
         self.ctrl_low = model.actuator_ctrlrange[self.actuators, 0].copy()
         self.ctrl_high = model.actuator_ctrlrange[self.actuators, 1].copy()
         self.active_geom = self.object_geoms["sphere"]
         self.geometry: ObjectGeometry | None = None
+        #: Called as ``on_step(physics)`` after every :meth:`step` call, if set (used to record video frames).
+        self.on_step: Callable[[TapPhysics], None] | None = None
 
     # --- the table -------------------------------------------------------------------------------------------
     @property
@@ -110,7 +116,8 @@ class TapPhysics:
         g1 = self.data.contact.geom1[:ncon]
         g2 = self.data.contact.geom2[:ncon]
         obj = self.active_geom
-        return bool(np.any(((g1 == obj) & np.isin(g2, self.hand_geoms)) | ((g2 == obj) & np.isin(g1, self.hand_geoms))))
+        hand = self._is_hand_geom
+        return bool(np.any(((g1 == obj) & hand[g2]) | ((g2 == obj) & hand[g1])))
 
     # --- the object ------------------------------------------------------------------------------------------
     def set_object(self, geometry: ObjectGeometry, xy: np.ndarray, yaw: float) -> None:
@@ -176,6 +183,8 @@ class TapPhysics:
     def step(self, n: int = 1) -> None:
         """Advance the simulation by ``n`` timesteps."""
         mujoco.mj_step(self.model, self.data, n)
+        if self.on_step is not None:
+            self.on_step(self)
 
     def unstable(self) -> str | None:
         """A description of a simulation fault (MuJoCo warning, non-finite state), or None if healthy."""

@@ -5,8 +5,6 @@ Every step that changes the URDF robot is listed in ``assets/README.md``; :func:
 
 from __future__ import annotations
 
-import warnings
-
 import mujoco
 import numpy as np
 
@@ -21,6 +19,8 @@ from affordance_env.robot_model import (
     TORSO_JOINTS,
     icub_urdf,
 )
+
+_PREFIX = "icub:"
 
 #: Collision bits. World geoms (table, floor, object) are type 1 / affinity 1; robot links in CONTACT_LINKS are
 #: type 2 / affinity 1, so they touch the world but never each other; all other robot geoms touch nothing.
@@ -119,11 +119,14 @@ def build_spec() -> mujoco.MjSpec:
     spec.compiler.fusestatic = True  # the URDF's fixed links (frames, sensors) fold into their moving parents
     robot = robot_spec()
     frame = spec.worldbody.add_frame(name="robot_base")
-    with warnings.catch_warnings():
-        # Names stay exactly those of the URDF (no prefix), so MuJoCo and Pinocchio share them. MuJoCo warns
-        # that an unprefixed attachment may not round-trip through XML; we never save the attached spec.
-        warnings.filterwarnings("ignore", message="Attaching a spec with an empty prefix")
-        frame.attach_body(robot.body("root_link"))
+    # Attach under a prefix (MuJoCo warns that unprefixed attachments may not save), then give the robot's
+    # elements back their URDF names so that MuJoCo and Pinocchio share them. Meshes keep the prefix: geoms
+    # refer to them by name.
+    frame.attach_body(robot.body("root_link"), _PREFIX, "")
+    for elements in (spec.bodies, spec.joints, spec.geoms, spec.sites, spec.cameras):
+        for element in elements:
+            if element.name.startswith(_PREFIX):
+                element.name = element.name.removeprefix(_PREFIX)
     # 6. Position actuators on every active joint, and the touch sensor on the palm.
     for name in ACTIVE_JOINTS:
         joint = spec.joint(name)
@@ -134,7 +137,7 @@ def build_spec() -> mujoco.MjSpec:
     spec.add_sensor(name="palm_touch", type=mujoco.mjtSensor.mjSENS_TOUCH, objtype=mujoco.mjtObj.mjOBJ_SITE,
                     objname="palm_touch")
     # 7. The home keyframe.
-    model = _compile(spec)
+    model = spec.compile()
     qpos = model.qpos0.copy()
     for name, value in HOME_QPOS.items():
         qpos[model.jnt_qposadr[model.joint(name).id]] = value
@@ -145,10 +148,5 @@ def build_spec() -> mujoco.MjSpec:
 
 def build_model() -> mujoco.MjModel:
     """Compile :func:`build_spec` (about 1 s: the robot meshes are processed)."""
-    return _compile(build_spec())
+    return build_spec().compile()
 
-
-def _compile(spec: mujoco.MjSpec) -> mujoco.MjModel:
-    with warnings.catch_warnings():
-        warnings.filterwarnings("ignore", message="Attaching a spec with an empty prefix")
-        return spec.compile()

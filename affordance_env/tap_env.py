@@ -151,6 +151,12 @@ class TapAffordanceEnv(gym.Env):
         self.attention_camera = RangeCamera(self.physics.model, width=32, height=32, fovy_deg=camera_fovy)
         self._renderer = None
         self._render_size = (render_width, render_height)
+        #: With ``render_mode="rgb_array"``: pictures taken every 1/render_fps s of simulated time during the
+        #: last ``reset`` and ``step`` (for videos of an interaction).
+        self.frames: list[np.ndarray] = []
+        self._next_frame_time = 0.0
+        if render_mode == "rgb_array":
+            self.physics.on_step = self._record_frame
 
         H, W = camera_height, camera_width
         nq = len(ACTIVE_JOINTS)
@@ -201,6 +207,8 @@ class TapAffordanceEnv(gym.Env):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         """Place a new object, let it settle, attend to it and take the initial snapshot."""
         super().reset(seed=seed)
+        self.frames = []
+        self._next_frame_time = 0.0
         object_type, size, xy, yaw = self._sample_object()
         physics = self.physics
         physics.reset_home()
@@ -243,6 +251,7 @@ class TapAffordanceEnv(gym.Env):
         action = check_action(action)
         initial, self._initial = self._initial, None
         physics = self.physics
+        self.frames = []
         plan = plan_stroke(self.behavior, initial["geometry"], initial["pose"][:3], initial["yaw"],
                            physics.table_top, action)
         stroke = self.motion.stroke(plan)
@@ -271,6 +280,11 @@ class TapAffordanceEnv(gym.Env):
         }
         reward = float(self.reward_fn(info))
         return obs, reward, True, False, info
+
+    def _record_frame(self, physics: TapPhysics) -> None:
+        if physics.data.time >= self._next_frame_time:
+            self.frames.append(self.render())
+            self._next_frame_time = physics.data.time + 1.0 / self.metadata["render_fps"]
 
     def render(self):
         """An RGB picture (H, W, 3) uint8 of the scene from the ``overview`` camera, if ``render_mode='rgb_array'``."""
