@@ -130,3 +130,29 @@ def test_async_vector_env():
     obs, rewards, terminated, truncated, infos = envs.step(np.zeros((2, 3), dtype=np.float32))
     assert terminated.all() and rewards.shape == (2,)
     envs.close()
+
+
+def _rss_mib() -> float:
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    return float("nan")
+
+
+@pytest.mark.slow
+def test_many_interactions_no_memory_growth_no_home_drift():
+    env = TapAffordanceEnv(camera_width=32, camera_height=32)
+    arm = [affordance_env.ACTIVE_JOINTS.index(n) for n in affordance_env.robot_model.ARM_JOINTS]
+    homes = []
+    for i in range(400):
+        obs, _ = env.reset(seed=i)
+        homes.append(obs["joints"][arm])
+        env.step(env.action_space.sample())
+        if i == 99:
+            rss_start = _rss_mib()
+    growth = _rss_mib() - rss_start
+    assert growth < 15.0, f"memory grew by {growth:.1f} MiB over 300 interactions"
+    homes = np.array(homes)
+    # every interaction starts from the same arm pose: the home pose does not drift
+    assert np.abs(homes - homes[0]).max() < 1e-3

@@ -1,0 +1,111 @@
+"""The ray-cast range camera and attention, against analytic ground truth."""
+
+import mujoco
+import numpy as np
+import pytest
+
+from affordance_env.attention import attend
+from affordance_env.camera import Intrinsics, RangeCamera
+from affordance_env.motion import MotionExecutor
+from affordance_env.kinematics import Kinematics
+from affordance_env.objects import object_geometry
+
+WALL_SCENE = """
+<mujoco>
+  <worldbody>
+    <camera name="cam" pos="0 0 0" xyaxes="1 0 0 0 1 0" fovy="60"/>
+    <geom name="wall" type="box" size="2 2 0.01" pos="0 0 -{d}"/>
+    <geom name="ball" type="sphere" size="0.1" pos="0.3 0.2 -{ball}"/>
+  </worldbody>
+</mujoco>
+"""
+
+
+@pytest.fixture(scope="module")
+def wall():
+    model = mujoco.MjModel.from_xml_string(WALL_SCENE.format(d=1.01, ball=0.8))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    return model, data
+
+
+def test_range_of_a_plane_is_exact(wall):
+    model, data = wall
+    camera = RangeCamera(model, "cam", width=64, height=48)
+    image = camera.capture(data)
+    K = camera.intrinsics
+    u, v = np.meshgrid(np.arange(K.width), np.arange(K.height))
+    # a plane at z = -1 m (front face of the wall), seen head-on: range = 1 / cos(angle off axis)
+    expected = np.sqrt(1.0 + ((u - K.cx) / K.fx) ** 2 + ((v - K.cy) / K.fy) ** 2)
+    wall_pixels = image.mask_of(model.geom("wall").id)
+    assert wall_pixels.sum() > 0.8 * K.width * K.height
+    np.testing.assert_allclose(image.ranges[wall_pixels], expected[wall_pixels], atol=1e-3)
+    # points lie on the plane, and project back onto their own pixel
+    np.testing.assert_allclose(image.p_world_points[wall_pixels][:, 2], -1.0, atol=1e-6)
+    for row, col in [(0, 0), (20, 30), (47, 63)]:
+        if wall_pixels[row, col]:
+            np.testing.assert_allclose(image.project(image.p_world_points[row, col]), [col, row], atol=1e-6)
+
+
+def test_mask_of_a_sphere_matches_its_projection(wall):
+    model, data = wall
+    camera = RangeCamera(model, "cam", width=256, height=256)
+    image = camera.capture(data)
+    mask = image.mask_of(model.geom("ball").id)
+    K = camera.intrinsics
+    centre = np.array([0.3, 0.2, -0.8])
+    d = np.linalg.norm(centre)
+    # a sphere seen at angle theta off the optical axis images as an ellipse of area
+    # pi (f r / sqrt(d^2 - r^2))^2 / cos(theta)^3 (small-angle sphere)
+    cos_theta = 0.8 / d
+    expected = np.pi * (K.fx * 0.1 / np.sqrt(d**2 - 0.1**2)) ** 2 / cos_theta**3
+    assert mask.sum() == pytest.approx(expected, rel=0.02)
+    np.testing.assert_allclose(image.project(centre), np.argwhere(mask).mean(axis=0)[::-1], atol=2.0)
+    assert np.all(np.linalg.norm(image.p_world_points[mask] - centre, axis=1) == pytest.approx(0.1, abs=1e-6))
+
+
+def test_no_hit_is_inf_and_nan():
+    model = mujoco.MjModel.from_xml_string('<mujoco><worldbody><camera name="cam"/></worldbody></mujoco>')
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    image = RangeCamera(model, "cam", width=8, height=8).capture(data)
+    assert np.all(np.isinf(image.ranges)) and np.all(image.geom_ids == -1)
+    assert np.all(np.isnan(image.p_world_points))
+
+
+@pytest.mark.parametrize(
+    "kwargs, match",
+    [({"camera": "eye"}, "Available cameras"), ({"width": 1}, "resolution"), ({"fovy_deg": 0.0}, "fovy"),
+     ({"max_range": -1.0}, "max_range"), ({"geom_groups": (7,)}, "geom_groups")],
+)
+def test_bad_camera_arguments(wall, kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        RangeCamera(wall[0], **{"camera": "cam", **kwargs})
+
+
+def test_intrinsics_from_fovy():
+    K = Intrinsics.from_fovy(128, 96, 90.0)
+    assert K.fy == pytest.approx(48.0) and K.fx == K.fy
+    assert (K.cx, K.cy) == (63.5, 47.5)
+
+
+def test_attention_centres_the_object(physics):
+    camera = RangeCamera(physics.model, width=32, height=32)
+    motion = MotionExecutor(physics, Kinematics())
+    physics.set_object(object_geometry("box", 0.06), np.array([-0.33, 0.0]), 0.0)
+    result = attend(physics, camera, motion.move_joints)
+    assert result.success and result.visible
+    full = RangeCamera(physics.model, width=128, height=128).capture(physics.data)
+    mask = full.mask_of(physics.active_geom)
+    centroid = np.argwhere(mask).mean(axis=0)
+    assert np.linalg.norm(centroid - 63.5) < 3.0  # pixels of the 128 x 128 image
+
+
+def test_attention_reports_an_object_out_of_view(physics):
+    camera = RangeCamera(physics.model, width=32, height=32)
+    motion = MotionExecutor(physics, Kinematics())
+    physics.set_object(object_geometry("sphere", 0.05), np.array([-0.45, -0.30]), 0.0)  # far left corner
+    q_before = physics.joint_targets()
+    result = attend(physics, camera, motion.move_joints)
+    assert not result.visible and not result.success
+    np.testing.assert_array_equal(physics.joint_targets(), q_before)  # did not look elsewhere
