@@ -32,8 +32,10 @@ SPEED_RANGE = 0.15  # [m/s]
 CLEARANCE = 0.03
 #: Distance the hand keeps moving after it first touches the object [m].
 FOLLOW_THROUGH = 0.012
-#: Height above the stroke from which the hand descends to the pre-stroke pose [m].
-APPROACH_HEIGHT = 0.08
+#: Clearance between the lowest point of the hand (3.3 cm below the palm centre) and the top of the object
+#: when the hand passes above it on its way to the pre-stroke pose [m].
+APPROACH_CLEARANCE = 0.06
+HAND_BELOW_PALM = 0.033
 #: Lowest palm-centre height above the table [m]: the hand reaches 3.3 cm below the palm centre.
 MIN_PALM_HEIGHT = 0.04
 
@@ -92,7 +94,7 @@ class StrokePlan:
     """Cartesian plan of one stroke (world frame, metres).
 
     Attributes:
-        p_above: Palm position above the pre-stroke pose, reached first.
+        p_above: Palm position above the pre-stroke pose, high enough to clear the object; reached first.
         p_start: Pre-stroke palm position, ``CLEARANCE`` from the object.
         p_end: Palm position at maximum travel (the stroke stops earlier on contact).
         direction: Unit stroke direction (3,).
@@ -158,7 +160,8 @@ def plan_stroke(
     # Without contact the hand travels through where the object was, then stops.
     p_end = centre + d * (half - behavior.contact_offset + FOLLOW_THROUGH)
     return StrokePlan(
-        p_above=p_start + np.array([0.0, 0.0, APPROACH_HEIGHT]),
+        p_above=np.array([p_start[0], p_start[1], table_top + 2 * geometry.half_height + HAND_BELOW_PALM
+                          + APPROACH_CLEARANCE]),
         p_start=p_start,
         p_end=p_end,
         direction=d,

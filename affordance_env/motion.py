@@ -19,8 +19,11 @@ from affordance_env.physics import TapPhysics
 CONTROL_DT = 0.01
 #: Time to move from home to above the object, and from there down to the pre-stroke pose [s].
 REACH_TIME, DESCEND_TIME = 0.35, 0.15
-#: Time to back off after the stroke, and to return home [s].
-BACKOFF_TIME, HOME_TIME = 0.12, 0.3
+#: Time to back off after the stroke, to lift the hand above the object, and to return home [s].
+BACKOFF_TIME, LIFT_TIME, HOME_TIME = 0.12, 0.15, 0.3
+#: The hand must be this close to the pre-stroke pose before the stroke starts [m], waiting at most
+#: SETTLE_MAX_TIME [s] for the servos.
+SETTLE_TOLERANCE, SETTLE_MAX_TIME = 0.003, 0.4
 #: Spacing of the IK solutions along the stroke line [m].
 IK_SPACING = 0.01
 #: IK tolerances for the stroke waypoints: position [m] and orientation [rad].
@@ -32,7 +35,8 @@ class StrokeOutcome:
     """What happened during a stroke.
 
     Attributes:
-        ik_success: Every waypoint of the stroke was reached by the IK within tolerance.
+        ik_success: Every waypoint of the stroke (pre-stroke pose and the stroke line) was reached by the IK
+            within tolerance.
         ik_position_error: Largest IK position error over the waypoints [m].
         ik_orientation_error: Largest IK orientation error over the waypoints [rad].
         contact: The hand touched the object.
@@ -69,6 +73,20 @@ class MotionExecutor:
         for k in range(1, n + 1):
             self._tick(q_from + (q_target - q_from) * (k / n))
 
+    def settle(self, p_world_target: np.ndarray, tolerance: float = SETTLE_TOLERANCE,
+               max_time: float = SETTLE_MAX_TIME) -> float:
+        """Hold the servo targets until the palm is within ``tolerance`` [m] of ``p_world_target``.
+
+        Returns the remaining distance [m] (larger than ``tolerance`` if ``max_time`` [s] ran out).
+        """
+        q = self.physics.joint_targets()
+        for _ in range(max(1, round(max_time / CONTROL_DT))):
+            error = float(np.linalg.norm(self.physics.hand_position() - p_world_target))
+            if error <= tolerance:
+                return error
+            self._tick(q)
+        return float(np.linalg.norm(self.physics.hand_position() - p_world_target))
+
     def _ik(self, p: np.ndarray, q_init: np.ndarray, plan: StrokePlan) -> IKResult:
         return self.kinematics.solve_ik(
             p, q_init, plan.R_world_hand, position_tolerance=1e-3, orientation_tolerance=IK_ORIENTATION_TOLERANCE
@@ -100,14 +118,18 @@ class MotionExecutor:
         return results, path
 
     def stroke(self, plan: StrokePlan) -> StrokeOutcome:
-        """Reach, stroke until contact plus follow-through (or full travel), and back off; not the return home."""
+        """Reach, stroke until contact plus follow-through (or full travel), back off and lift; not the return home."""
         physics = self.physics
         results, path = self.plan_joint_path(plan)
-        pos_err = max(r.position_error for r in results)
-        rot_err = max(r.orientation_error for r in results)
+        # The pose above the object is a via point that only has to clear it; the stroke itself must be exact.
+        stroke_results = results[1:]
+        pos_err = max(r.position_error for r in stroke_results)
+        rot_err = max(r.orientation_error for r in stroke_results)
         ik_ok = pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE
         self.move_joints(results[0].q, REACH_TIME)
+        self.settle(plan.p_above, tolerance=0.01)
         self.move_joints(results[1].q, DESCEND_TIME)
+        self.settle(plan.p_start)
         p_hand_start = physics.hand_position()
         contact, contact_time, hand_speed = False, float("nan"), 0.0
         extra_ticks = int(np.ceil(plan.follow_through / (plan.speed * CONTROL_DT)))
@@ -126,10 +148,11 @@ class MotionExecutor:
                     stop_at = min(len(path), k + 1 + extra_ticks)
             k += 1
         travel = float(np.dot(physics.hand_position() - p_hand_start, plan.direction))
-        # Back off to the pre-stroke pose so that the hand leaves the object alone.
+        # Back off to the pre-stroke pose and lift above the object, so that the way home never crosses it.
         self.move_joints(results[1].q, BACKOFF_TIME)
+        self.move_joints(results[0].q, LIFT_TIME)
         return StrokeOutcome(ik_ok, pos_err, rot_err, contact, contact_time, hand_speed, travel)
 
     def go_home(self, q_home: np.ndarray) -> None:
-        """Return to ``q_home`` through the pose above the stroke."""
+        """Return to ``q_home`` (after :meth:`stroke`, from above the object)."""
         self.move_joints(q_home, HOME_TIME)
