@@ -1,0 +1,77 @@
+"""Stroke planning is a pure function: where the hand starts and ends, for each behaviour and action."""
+
+import numpy as np
+import pytest
+
+from affordance_env.behaviors import (
+    BEHAVIORS,
+    CLEARANCE,
+    FOLLOW_THROUGH,
+    SPEED_CANONICAL,
+    check_action,
+    get_behavior,
+    half_extent_along,
+    plan_stroke,
+)
+from affordance_env.objects import object_geometry
+
+TABLE = -0.07
+
+
+@pytest.mark.parametrize("name", list(BEHAVIORS))
+def test_hand_orientations_are_rotations(name):
+    R = BEHAVIORS[name].R_world_hand
+    np.testing.assert_allclose(R @ R.T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(R) == pytest.approx(1.0)
+
+
+def test_canonical_tap_starts_beside_the_object_at_clearance():
+    sphere = object_geometry("sphere", 0.06)
+    p_object = np.array([-0.30, 0.03, TABLE + 0.03])
+    plan = plan_stroke(get_behavior("tap"), sphere, p_object, 0.0, TABLE, np.zeros(3))
+    np.testing.assert_allclose(plan.direction, [0, -1, 0])
+    # the palm surface (1.2 cm in front of the palm frame) is CLEARANCE from the sphere's side
+    gap = plan.p_start[1] - 0.012 - (p_object[1] + 0.03)
+    assert gap == pytest.approx(CLEARANCE)
+    assert plan.p_start[0] == pytest.approx(p_object[0])
+    assert plan.speed == pytest.approx(SPEED_CANONICAL)
+    # without contact, the palm surface would end FOLLOW_THROUGH beyond where the object's far side was
+    assert plan.p_end[1] - 0.012 == pytest.approx(p_object[1] - 0.03 - FOLLOW_THROUGH)
+    # the approach pose clears the object's top with the hand's lowest point
+    assert plan.p_above[2] - 0.033 > TABLE + 0.06
+
+
+def test_action_moves_height_lateral_offset_and_speed():
+    box = object_geometry("box", 0.08)
+    p_object = np.array([-0.30, 0.03, TABLE + 0.04])
+    base = plan_stroke(get_behavior("tap"), box, p_object, 0.0, TABLE, np.zeros(3))
+    moved = plan_stroke(get_behavior("tap"), box, p_object, 0.0, TABLE, np.array([1.0, 1.0, 1.0]))
+    assert moved.p_start[2] - base.p_start[2] == pytest.approx(0.015)
+    assert abs(moved.p_start[0] - base.p_start[0]) == pytest.approx(0.02)
+    assert moved.speed == pytest.approx(0.45)
+
+
+def test_push_and_tap_back_move_the_other_ways():
+    assert np.allclose(get_behavior("push").direction, [-1, 0])
+    assert np.allclose(get_behavior("tap_back").direction, [0, 1])
+
+
+def test_box_extent_grows_with_yaw():
+    box = object_geometry("box", 0.06)
+    assert half_extent_along(box, 0.0, np.array([0.0, -1.0])) == pytest.approx(0.03)
+    assert half_extent_along(box, np.pi / 4, np.array([0.0, -1.0])) == pytest.approx(0.03 * np.sqrt(2))
+    sphere = object_geometry("sphere", 0.06)
+    assert half_extent_along(sphere, 0.7, np.array([1.0, 0.0])) == pytest.approx(0.03)
+
+
+@pytest.mark.parametrize(
+    "action, match", [([0, 0], "shape"), ([0, np.inf, 0], "finite"), ([0, 0, -1.01], r"\[-1, 1\]")]
+)
+def test_bad_actions(action, match):
+    with pytest.raises(ValueError, match=match):
+        check_action(np.array(action, dtype=float))
+
+
+def test_unknown_behavior_lists_valid_ones():
+    with pytest.raises(ValueError, match="tap, tap_back, push"):
+        get_behavior("grasp")
