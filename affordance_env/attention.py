@@ -46,7 +46,9 @@ def _centroid(camera: RangeCamera, physics: TapPhysics) -> tuple[np.ndarray, np.
     return np.array([u.mean(), v.mean()]), image.p_world_points[mask].mean(axis=0)
 
 
-def _image_jacobian(camera: RangeCamera, physics: TapPhysics, p_world: np.ndarray, scratch: mujoco.MjData) -> np.ndarray:
+def _image_jacobian(
+    camera: RangeCamera, physics: TapPhysics, p_world: np.ndarray, scratch: mujoco.MjData
+) -> np.ndarray:
     """d(u, v)/d(neck_pitch, neck_yaw) of the world point ``p_world`` at the current configuration."""
     K = camera.intrinsics
     scratch.qpos[:] = physics.data.qpos

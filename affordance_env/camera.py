@@ -120,7 +120,8 @@ class RangeCamera:
             raise ValueError(f"max_range must be positive [m], got {max_range!r}.")
         self.model = model
         self.camera_id = camera_id
-        self.intrinsics = Intrinsics.from_fovy(width, height, model.cam_fovy[camera_id] if fovy_deg is None else fovy_deg)
+        fovy = model.cam_fovy[camera_id] if fovy_deg is None else fovy_deg
+        self.intrinsics = Intrinsics.from_fovy(width, height, fovy)
         self.max_range = float(max_range)
         if any(g not in range(6) for g in geom_groups):
             raise ValueError(f"geom_groups must be within 0..5, got {geom_groups!r}.")

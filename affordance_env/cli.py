@@ -26,7 +26,8 @@ def _demo(args: argparse.Namespace) -> int:
         obj = info["object"]
         print(
             f"  seed {args.seed + i}: {obj['type']:<19} {obj['size'] * 100:4.1f} cm  "
-            f"contact={info['contact']!s:<5} hand {info['hand_speed']:.2f} m/s  moved {info['displacement'] * 100:5.1f} cm "
+            f"contact={info['contact']!s:<5} hand {info['hand_speed']:.2f} m/s  "
+            f"moved {info['displacement'] * 100:5.1f} cm "
             f"({info['outcome']})  rolled={info['rolled']!s:<5}  object pixels {int(obs['mask'].sum())}  "
             f"|effect|={np.linalg.norm(info['effect']):.3g}"
         )

@@ -122,7 +122,7 @@ class Kinematics:
         dofs = self.reach_dofs
         pos_err = rot_err = np.inf
         iteration = 0
-        for iteration in range(1, max_iterations + 1):
+        for iteration in range(1, max_iterations + 1):  # noqa: B007 (the count is returned)
             pin.framesForwardKinematics(self.model, self.data, q)
             T_world_hand = self.data.oMf[self.hand_frame_id]
             e_pos = p_target - T_world_hand.translation

@@ -51,7 +51,7 @@ class SceneRenderer:
                 "importing affordance_env. The range camera does not need OpenGL."
             ) from exc
 
-    def render(self, data) -> "np.ndarray":  # noqa: F821
+    def render(self, data) -> np.ndarray:  # noqa: F821
         """An (height, width, 3) uint8 picture of the current state."""
         self._renderer.update_scene(data, camera=self.camera)
         return self._renderer.render()

@@ -94,7 +94,7 @@ class TapAffordanceEnv(gym.Env):
 
     | argument | default | meaning |
     |----------|---------|---------|
-    | ``behavior`` | ``"tap"`` | ``"tap"``, ``"tap_back"`` (from the other side, back of the hand), ``"push"`` (from the front) |
+    | ``behavior`` | ``"tap"`` | ``"tap"``; ``"tap_back"`` (other side, back of hand); ``"push"`` (from the front) |
     | ``object_types`` | all four | types to sample from |
     | ``size_range`` | (0.04, 0.10) | object size range [m] |
     | ``camera_width``, ``camera_height`` | 128, 128 | range image size [pixels] |
@@ -138,7 +138,9 @@ class TapAffordanceEnv(gym.Env):
         if not settle_timeout > 0:
             raise ValueError(f"settle_timeout must be positive [s], got {settle_timeout!r}.")
         if render_mode not in (None, *self.metadata["render_modes"]):
-            raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}.")
+            raise ValueError(
+                f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}."
+            )
         self.roll_threshold = float(roll_threshold)
         self.settle_timeout = float(settle_timeout)
         self.reward_fn = default_reward if reward_fn is None else reward_fn

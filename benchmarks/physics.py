@@ -69,7 +69,8 @@ def main() -> None:
         mujoco.mj_resetData(bare, bare_data)
         bare_rates.append(steps_per_second(bare, bare_data, args.steps))
     full, bare_rate = max(full_rates), max(bare_rates)
-    print(f"object: {args.object} (6 cm), {args.steps} steps of {physics.model.opt.timestep * 1e3:g} ms, best of {args.repeats}")
+    timestep_ms = physics.model.opt.timestep * 1e3
+    print(f"object: {args.object} (6 cm), {args.steps} steps of {timestep_ms:g} ms, best of {args.repeats}")
     print(f"  tap scene (iCub nq={physics.model.nq}, nu={physics.model.nu}): {full:10,.0f} steps/s")
     print(f"  bare scene (table + object)         : {bare_rate:10,.0f} steps/s")
     print(f"  ratio tap scene / bare scene        : {full / bare_rate:10.2f}")

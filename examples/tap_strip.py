@@ -34,13 +34,14 @@ def main() -> None:
     picks = np.linspace(0, len(frames) - 1, 6).round().astype(int)
 
     fig, axes = plt.subplots(2, 6, figsize=(18, 6))
-    for ax, k in zip(axes[0], picks):
+    for ax, k in zip(axes[0], picks, strict=True):
         ax.imshow(frames[k])
         ax.set_title(f"t = {k / env.metadata['render_fps']:.2f} s")
     for ax, (title, image) in zip(
-        axes[1],
+        axes[1][:4],
         [("initial range [m]", obs0["range"]), ("initial mask", obs0["mask"]), ("final range [m]", obs1["range"]),
          ("final mask", obs1["mask"])],
+        strict=True,
     ):
         shown = ax.imshow(np.where(image > 0, image, np.nan) if "range" in title else image)
         if "range" in title:

@@ -6,8 +6,8 @@ import pytest
 
 from affordance_env.attention import attend
 from affordance_env.camera import Intrinsics, RangeCamera
-from affordance_env.motion import MotionExecutor
 from affordance_env.kinematics import Kinematics
+from affordance_env.motion import MotionExecutor
 from affordance_env.objects import object_geometry
 
 WALL_SCENE = """
