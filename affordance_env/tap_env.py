@@ -184,8 +184,11 @@ class TapAffordanceEnv(gym.Env):
         image = self.camera.capture(self.physics.data)
         mask = image.mask_of(self.physics.active_geom)
         p_world_hand = self.physics.hand_position()
+        uv_hand = image.project(p_world_hand)
+        if not np.all(np.isfinite(uv_hand)):  # hand behind the camera: no image position; use the image centre
+            uv_hand = np.array([image.intrinsics.cx, image.intrinsics.cy])
         features = compute_features(
-            image.p_world_points, image.ranges, mask, image.p_world_camera, p_world_hand, image.project(p_world_hand)
+            image.p_world_points, image.ranges, mask, image.p_world_camera, p_world_hand, uv_hand
         )
         ranges = np.where(np.isfinite(image.ranges), image.ranges, 0.0).astype(np.float32)
         obs = {
