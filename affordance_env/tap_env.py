@@ -12,7 +12,7 @@ from gymnasium import spaces
 from affordance_env.attention import attend
 from affordance_env.behaviors import ACTION_DIM, BEHAVIORS, check_action, get_behavior, plan_stroke
 from affordance_env.camera import RangeCamera
-from affordance_env.features import FEATURE_NAMES, compute_features
+from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features
 from affordance_env.kinematics import Kinematics
 from affordance_env.motion import MotionExecutor
 from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size, object_geometry
@@ -29,6 +29,20 @@ YAW_JITTER = 0.25
 SETTLE_TIME = 0.1
 #: Object at rest: linear [m/s] and angular [rad/s] speed below these.
 REST_SPEED, REST_ANGULAR_SPEED = 0.01, 0.3
+
+
+def _failure_reason(fault: str | None, visible_initially: bool, stroke) -> str | None:
+    """Why an interaction cannot be used, or None; see the class docstring."""
+    if fault is not None:
+        return f"physics: {fault}"
+    if not visible_initially:
+        return "perception: the object was not visible in the initial snapshot"
+    if not stroke.ik_success:
+        return (f"ik: the stroke was not reachable (position error {stroke.ik_position_error * 1e3:.1f} mm, "
+                f"orientation error {stroke.ik_orientation_error:.2f} rad)")
+    if not stroke.contact:
+        return "tap: the hand never touched the object"
+    return None
 
 
 def default_reward(info: dict[str, Any]) -> float:
@@ -88,7 +102,11 @@ class TapAffordanceEnv(gym.Env):
     ``final_features``, ``object`` with ``initial_pose`` and ``final_pose``, ``displacement`` [m], ``rolled``
     (displacement above ``roll_threshold``; the paper's success label), ``outcome`` (``"rest"``, ``"off_table"``
     or ``"timeout"``), ``contact`` (the hand touched the object), ``hand_speed`` [m/s], ``ik`` (``success``,
-    ``position_error`` [m], ``orientation_error`` [rad]), ``visible`` (object seen in the final snapshot).
+    ``position_error`` [m], ``orientation_error`` [rad]), ``visible`` (object seen in the final snapshot),
+    ``failure``: None, or why the interaction is not a valid sample: ``"physics: ..."`` (MuJoCo reported an
+    instability or the state became non-finite; then obs is blank, ``effect`` is zeros and ``outcome`` is
+    ``"fault"``), ``"perception: ..."`` (object not visible initially), ``"ik: ..."`` (stroke not reachable),
+    ``"tap: ..."`` (the hand never touched the object). The next ``reset`` recovers from any of them.
 
     ## Arguments
 
@@ -180,6 +198,15 @@ class TapAffordanceEnv(gym.Env):
         self._q_home = np.zeros(nq)
 
     # ------------------------------------------------------------------------------------------------------
+    def _blank_observation(self) -> dict[str, np.ndarray]:
+        space = self.observation_space
+        return {
+            "range": np.zeros(space["range"].shape, np.float32),
+            "mask": np.zeros(space["mask"].shape, np.int8),
+            "features": NOT_VISIBLE_VALUES.astype(np.float32),
+            "joints": np.clip(self._q_home, space["joints"].low, space["joints"].high).astype(np.float32),
+        }
+
     def _snapshot(self) -> tuple[dict[str, np.ndarray], Any]:
         image = self.camera.capture(self.physics.data)
         mask = image.mask_of(self.physics.active_geom)
@@ -225,7 +252,8 @@ class TapAffordanceEnv(gym.Env):
         self._q_home = physics.joint_targets()  # the arm's home, with the gaze on the object
         obs, features = self._snapshot()
         pose = physics.object_pose()
-        self._initial = {"features": features, "pose": pose, "yaw": yaw, "geometry": geometry}
+        self._initial = {"features": features, "pose": pose, "yaw": yaw, "geometry": geometry,
+                         "visible": features.visible}
         info = {
             "object": {"type": object_type, "size": size, "pose": pose},
             "attention": {"success": attention.success, "visible": attention.visible,
@@ -263,25 +291,40 @@ class TapAffordanceEnv(gym.Env):
         self.motion.go_home(self._q_home)
         t_start = stroke.contact_time if stroke.contact else float(physics.data.time)
         outcome = self._wait_outcome(t_start)
-        obs, features = self._snapshot()
-        final_pose = physics.object_pose()
-        displacement = float(np.linalg.norm(final_pose[:2] - initial["pose"][:2]))
-        effect = (features.values - initial["features"].values).astype(np.float32)
+        fault = physics.unstable()
+        if fault is None:
+            obs, features = self._snapshot()
+            final_features = features.values
+            final_pose = physics.object_pose()
+            visible = features.visible
+        else:  # the state is not to be trusted: nothing of it reaches obs or info
+            obs = self._blank_observation()
+            final_features = NOT_VISIBLE_VALUES
+            final_pose = np.full(7, np.nan)
+            visible = False
+        failure = _failure_reason(fault, initial["visible"], stroke)
+        displacement = 0.0 if fault else float(np.linalg.norm(final_pose[:2] - initial["pose"][:2]))
+        effect = (
+            np.zeros(len(FEATURE_NAMES), np.float32)
+            if fault
+            else (final_features - initial["features"].values).astype(np.float32)
+        )
         info = {
             "object": {"type": initial["geometry"].object_type, "size": initial["geometry"].size,
                        "initial_pose": initial["pose"], "final_pose": final_pose},
             "initial_features": initial["features"].values,
-            "final_features": features.values,
+            "final_features": final_features,
             "effect": effect,
             "displacement": displacement,
             "rolled": displacement > self.roll_threshold,
-            "outcome": outcome,
+            "outcome": "fault" if fault else outcome,
             "contact": stroke.contact,
             "hand_speed": stroke.hand_speed,
             "ik": {"success": stroke.ik_success, "position_error": stroke.ik_position_error,
                    "orientation_error": stroke.ik_orientation_error},
-            "visible": features.visible,
+            "visible": visible,
             "behavior": self.behavior.name,
+            "failure": failure,
         }
         reward = float(self.reward_fn(info))
         return obs, reward, True, False, info

@@ -156,3 +156,42 @@ def test_many_interactions_no_memory_growth_no_home_drift():
     homes = np.array(homes)
     # every interaction starts from the same arm pose: the home pose does not drift
     assert np.abs(homes - homes[0]).max() < 1e-3
+
+
+def test_physics_fault_is_reported_and_the_next_reset_recovers():
+    env = TapAffordanceEnv(camera_width=32, camera_height=32)
+    env.reset(seed=2)
+    physics = env.physics
+    start = physics.data.time
+
+    def corrupt(p):  # an absurd state half a second into the interaction
+        if p.data.time > start + 0.5:
+            p.data.qvel[p.object_qvel] = np.inf
+            p.on_step = None
+
+    physics.on_step = corrupt
+    obs, reward, terminated, truncated, info = env.step(np.zeros(3))
+    assert terminated
+    assert info["failure"].startswith("physics:")
+    assert info["outcome"] == "fault"
+    assert np.all(np.isfinite(info["effect"])) and not info["effect"].any()
+    assert all(np.all(np.isfinite(v)) for v in obs.values())
+    assert env.observation_space.contains(obs)
+    # the next interaction is healthy and identical to one in a fresh env
+    obs_a, _ = env.reset(seed=3)
+    _, _, _, _, info_a = env.step(np.zeros(3))
+    fresh = TapAffordanceEnv(camera_width=32, camera_height=32)
+    obs_b, _ = fresh.reset(seed=3)
+    _, _, _, _, info_b = fresh.step(np.zeros(3))
+    assert info_a["failure"] is None
+    np.testing.assert_array_equal(obs_a["features"], obs_b["features"])
+    np.testing.assert_array_equal(info_a["effect"], info_b["effect"])
+
+
+def test_a_missed_tap_is_reported():
+    env = TapAffordanceEnv(camera_width=32, camera_height=32)
+    env.reset(seed=0)
+    hand = env.physics.hand_geoms
+    env.physics.model.geom_contype[hand] = env.physics.model.geom_conaffinity[hand] = 0  # a ghost hand
+    _, _, _, _, info = env.step(np.zeros(3))
+    assert not info["contact"] and info["failure"].startswith("tap:")
