@@ -24,6 +24,9 @@ BACKOFF_TIME, LIFT_TIME, HOME_TIME = 0.12, 0.15, 0.3
 #: The hand must be this close to the pre-stroke pose before the stroke starts [m], waiting at most
 #: SETTLE_MAX_TIME [s] for the servos.
 SETTLE_TOLERANCE, SETTLE_MAX_TIME = 0.003, 0.4
+#: The robot is still when every joint is within this of its target [rad] and slower than this [rad/s];
+#: it is given at most HOLD_MAX_TIME [s] to get there.
+HOLD_POSITION_TOLERANCE, HOLD_SPEED_TOLERANCE, HOLD_MAX_TIME = 2e-3, 0.01, 1.0
 #: Spacing of the IK solutions along the stroke line [m].
 IK_SPACING = 0.01
 #: IK tolerances for the stroke waypoints: position [m] and orientation [rad].
@@ -43,6 +46,8 @@ class StrokeOutcome:
         contact_time: Simulation time of the first touch [s] (NaN without contact).
         hand_speed: Hand speed at first touch [m/s] (0 without contact).
         hand_travel: Distance the palm travelled along the stroke direction [m].
+        start_error: Distance of the palm from the pre-stroke pose when the stroke started [m].
+        object_moved: How far the object moved before the stroke started (touched during the reach) [m].
     """
 
     ik_success: bool
@@ -52,6 +57,8 @@ class StrokeOutcome:
     contact_time: float
     hand_speed: float
     hand_travel: float
+    start_error: float
+    object_moved: float
 
 
 class MotionExecutor:
@@ -126,33 +133,56 @@ class MotionExecutor:
         pos_err = max(r.position_error for r in stroke_results)
         rot_err = max(r.orientation_error for r in stroke_results)
         ik_ok = pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE
+        p_object_before = physics.object_pose()[:3]
         self.move_joints(results[0].q, REACH_TIME)
         self.settle(plan.p_above, tolerance=0.01)
         self.move_joints(results[1].q, DESCEND_TIME)
-        self.settle(plan.p_start)
+        start_error = self.settle(plan.p_start)
+        object_moved = float(np.linalg.norm(physics.object_pose()[:3] - p_object_before))
         p_hand_start = physics.hand_position()
         contact, contact_time, hand_speed = False, float("nan"), 0.0
-        extra_ticks = int(np.ceil(plan.follow_through / (plan.speed * CONTROL_DT)))
-        stop_at = len(path)
-        k = 0
+        p_contact = p_hand_start
         dt = physics.model.opt.timestep
-        while k < stop_at:
-            physics.set_joint_targets(path[k])
+        stopped = False
+        for q_tick in path:
+            physics.set_joint_targets(q_tick)
             for _ in range(self.steps_per_tick):
                 p_before = physics.hand_position()
                 physics.step()
+                p_hand = physics.hand_position()
                 if not contact and physics.hand_touches_object():
                     contact = True
                     contact_time = float(physics.data.time)
-                    hand_speed = float(np.linalg.norm(physics.hand_position() - p_before) / dt)
-                    stop_at = min(len(path), k + 1 + extra_ticks)
-            k += 1
+                    hand_speed = float(np.linalg.norm(p_hand - p_before) / dt)
+                    p_contact = p_hand
+                # The hand stops once the palm itself has travelled the follow-through past the first touch.
+                if contact and np.dot(p_hand - p_contact, plan.direction) >= plan.follow_through:
+                    physics.set_joint_targets(physics.joint_positions())
+                    stopped = True
+                    break
+            if stopped:
+                break
         travel = float(np.dot(physics.hand_position() - p_hand_start, plan.direction))
         # Back off to the pre-stroke pose and lift above the object, so that the way home never crosses it.
         self.move_joints(results[1].q, BACKOFF_TIME)
         self.move_joints(results[0].q, LIFT_TIME)
-        return StrokeOutcome(ik_ok, pos_err, rot_err, contact, contact_time, hand_speed, travel)
+        return StrokeOutcome(ik_ok, pos_err, rot_err, contact, contact_time, hand_speed, travel, start_error,
+                             object_moved)
 
     def go_home(self, q_home: np.ndarray) -> None:
-        """Return to ``q_home`` (after :meth:`stroke`, from above the object)."""
+        """Return to ``q_home`` (after :meth:`stroke`, from above the object) and hold until the robot is still."""
         self.move_joints(q_home, HOME_TIME)
+        self.hold_still()
+
+    def hold_still(self, max_time: float = HOLD_MAX_TIME) -> bool:
+        """Hold the current servo targets until every joint is within HOLD_POSITION_TOLERANCE of its target and
+        slower than HOLD_SPEED_TOLERANCE (so that a snapshot sees the scene from a still head); at most
+        ``max_time`` [s]. Returns whether the robot came to rest."""
+        physics = self.physics
+        q = physics.joint_targets()
+        for _ in range(max(1, round(max_time / CONTROL_DT))):
+            if (np.max(np.abs(physics.joint_positions() - q)) <= HOLD_POSITION_TOLERANCE
+                    and np.max(np.abs(physics.joint_velocities())) <= HOLD_SPEED_TOLERANCE):
+                return True
+            self._tick(q)
+        return False

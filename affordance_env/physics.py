@@ -18,6 +18,8 @@ from affordance_env.robot_model import ACTIVE_JOINTS, CONTACT_LINKS
 #: Geom group that hides the scene's inactive object primitives from the range camera and the renderer.
 HIDDEN_GEOM_GROUP = 3
 OBJECT_RGBA = np.array([0.85, 0.2, 0.15, 1.0])
+#: Collision bits of the active object (assets/scene.xml): type 1, takes surfaces (1) and the hand (2).
+OBJECT_CONTYPE, OBJECT_CONAFFINITY = 1, 3
 
 
 def _id(model: mujoco.MjModel, kind: mujoco.mjtObj, name: str) -> int:
@@ -53,6 +55,7 @@ class TapPhysics:
         touch = _id(model, obj.mjOBJ_SENSOR, "palm_touch")
         self.touch_adr = int(model.sensor_adr[touch])
         self.table_geom = _id(model, obj.mjOBJ_GEOM, "table_top")
+        self.table_surface = _id(model, obj.mjOBJ_GEOM, "table_surface")
         self.home_key = _id(model, obj.mjOBJ_KEY, "home")
         contact_bodies = {_id(model, obj.mjOBJ_BODY, n) for n in CONTACT_LINKS}
         self.hand_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] in contact_bodies])
@@ -60,23 +63,25 @@ class TapPhysics:
         self._is_hand_geom[self.hand_geoms] = True
         self.ctrl_low = model.actuator_ctrlrange[self.actuators, 0].copy()
         self.ctrl_high = model.actuator_ctrlrange[self.actuators, 1].copy()
+        # The table is static: its top height and extent are fixed once.
+        mujoco.mj_kinematics(model, self._scratch)
+        centre = self._scratch.geom_xpos[self.table_geom]
+        half = model.geom_size[self.table_geom]
+        self.table_top = float(centre[2] + half[2])
+        self.table_low, self.table_high = centre[:2] - half[:2], centre[:2] + half[:2]
+        # Inactive primitives keep these sizes, so the model never depends on earlier objects.
+        self._hidden_size = {p: model.geom_size[g].copy() for p, g in self.object_geoms.items()}
+        self._hidden_aabb = {p: model.geom_aabb[g].copy() for p, g in self.object_geoms.items()}
+        self._hidden_rbound = {p: float(model.geom_rbound[g]) for p, g in self.object_geoms.items()}
         self.active_geom = self.object_geoms["sphere"]
         self.geometry: ObjectGeometry | None = None
         #: Called as ``on_step(physics)`` after every :meth:`step` call, if set (used to record video frames).
         self.on_step: Callable[[TapPhysics], None] | None = None
 
     # --- the table -------------------------------------------------------------------------------------------
-    @property
-    def table_top(self) -> float:
-        """Height of the table's top surface [m]."""
-        mujoco.mj_kinematics(self.model, self.data) if self.data.time == 0 else None
-        return float(self.data.geom_xpos[self.table_geom][2] + self.model.geom_size[self.table_geom][2])
-
     def table_extent(self) -> tuple[np.ndarray, np.ndarray]:
         """(lower, upper) corners of the table top in world x, y [m]."""
-        centre = self.data.geom_xpos[self.table_geom][:2]
-        half = self.model.geom_size[self.table_geom][:2]
-        return centre - half, centre + half
+        return self.table_low.copy(), self.table_high.copy()
 
     # --- the robot -------------------------------------------------------------------------------------------
     def reset_home(self) -> None:
@@ -131,9 +136,14 @@ class TapPhysics:
         m = self.model
         for primitive, g in self.object_geoms.items():
             active = primitive == geometry.primitive
-            m.geom_contype[g] = m.geom_conaffinity[g] = 1 if active else 0
+            m.geom_contype[g] = OBJECT_CONTYPE if active else 0
+            m.geom_conaffinity[g] = OBJECT_CONAFFINITY if active else 0
             m.geom_group[g] = 0 if active else HIDDEN_GEOM_GROUP
             m.geom_rgba[g] = OBJECT_RGBA if active else 0.0
+            if not active:
+                m.geom_size[g] = self._hidden_size[primitive]
+                m.geom_aabb[g] = self._hidden_aabb[primitive]
+                m.geom_rbound[g] = self._hidden_rbound[primitive]
         g = self.object_geoms[geometry.primitive]
         m.geom_size[g] = geometry.geom_size
         m.geom_rbound[g] = geometry.rbound
@@ -176,8 +186,7 @@ class TapPhysics:
     def object_on_table(self) -> bool:
         """Whether the object's centre is above the table top and within its extent."""
         p = self.data.qpos[self.object_qpos : self.object_qpos + 3]
-        low, high = self.table_extent()
-        return bool(p[2] > self.table_top and np.all(p[:2] >= low) and np.all(p[:2] <= high))
+        return bool(p[2] > self.table_top and np.all(p[:2] >= self.table_low) and np.all(p[:2] <= self.table_high))
 
     # --- stepping --------------------------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:

@@ -22,9 +22,9 @@ from affordance_env.robot_model import (
 
 _PREFIX = "icub:"
 
-#: Collision bits. World geoms (table, floor, object) are type 1 / affinity 1; robot links in CONTACT_LINKS are
-#: type 2 / affinity 1, so they touch the world but never each other; all other robot geoms touch nothing.
-ROBOT_CONTYPE, ROBOT_CONAFFINITY = 2, 1
+#: Collision bits (see assets/scene.xml): robot links in CONTACT_LINKS are type 2 (the object takes 2) and take
+#: 4 (the table box), so they touch the object and the table but never each other; other robot geoms touch nothing.
+ROBOT_CONTYPE, ROBOT_CONAFFINITY = 2, 4
 
 #: Geom group of the robot's geoms (the world's are in group 0), so sensors can choose whether to see the robot.
 ROBOT_GEOM_GROUP = 1

@@ -14,7 +14,7 @@ from affordance_env.behaviors import ACTION_DIM, BEHAVIORS, check_action, get_be
 from affordance_env.camera import RangeCamera
 from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features
 from affordance_env.kinematics import Kinematics
-from affordance_env.motion import MotionExecutor
+from affordance_env.motion import CONTROL_DT, MotionExecutor
 from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size, object_geometry
 from affordance_env.physics import TapPhysics
 from affordance_env.robot_model import ACTIVE_JOINTS
@@ -25,8 +25,11 @@ PLACEMENT_CENTRE = np.array([-0.30, 0.03])
 PLACEMENT_HALF_WIDTH = np.array([0.03, 0.03])
 #: Yaw jitter of boxes and lying cylinders [rad].
 YAW_JITTER = 0.25
-#: Time the object is given to settle after placement [s].
-SETTLE_TIME = 0.1
+#: Longest time the object is given to settle after placement [s].
+SETTLE_TIME = 0.5
+#: The hand may start the stroke at most this far from the planned pre-stroke pose [m], and may have moved
+#: the object at most this much before the stroke [m]; otherwise the interaction is marked failed.
+MAX_START_ERROR, MAX_OBJECT_MOVED_BEFORE = 0.01, 0.003
 #: Object at rest: linear [m/s] and angular [rad/s] speed below these.
 REST_SPEED, REST_ANGULAR_SPEED = 0.01, 0.3
 
@@ -40,6 +43,10 @@ def _failure_reason(fault: str | None, visible_initially: bool, stroke) -> str |
     if not stroke.ik_success:
         return (f"ik: the stroke was not reachable (position error {stroke.ik_position_error * 1e3:.1f} mm, "
                 f"orientation error {stroke.ik_orientation_error:.2f} rad)")
+    if stroke.object_moved > MAX_OBJECT_MOVED_BEFORE:
+        return f"reach: the arm moved the object by {stroke.object_moved * 1e3:.1f} mm before the stroke"
+    if stroke.start_error > MAX_START_ERROR:
+        return f"reach: the stroke started {stroke.start_error * 1e3:.1f} mm from the planned pose"
     if not stroke.contact:
         return "tap: the hand never touched the object"
     return None
@@ -94,7 +101,7 @@ class TapAffordanceEnv(gym.Env):
 
     ## Episode End
     The episode terminates after one interaction (``terminated=True``). The object's motion is simulated until it
-    is at rest, has left the table, or ``settle_timeout`` seconds after contact.
+    is at rest, has left the table, or ``settle_timeout`` seconds after the robot is back home and still.
 
     ## Info
     After ``reset``: ``object`` (``type``, ``size`` [m], ``pose`` (7,) position and quaternion), ``attention``.
@@ -106,7 +113,8 @@ class TapAffordanceEnv(gym.Env):
     ``failure``: None, or why the interaction is not a valid sample: ``"physics: ..."`` (MuJoCo reported an
     instability or the state became non-finite; then obs is blank, ``effect`` is zeros and ``outcome`` is
     ``"fault"``), ``"perception: ..."`` (object not visible initially), ``"ik: ..."`` (stroke not reachable),
-    ``"tap: ..."`` (the hand never touched the object). The next ``reset`` recovers from any of them.
+    ``"reach: ..."`` (the arm touched the object before the stroke, or the stroke started more than 1 cm from
+    its planned pose), ``"tap: ..."`` (the hand never touched the object). The next ``reset`` recovers from any of them.
 
     ## Arguments
 
@@ -118,7 +126,7 @@ class TapAffordanceEnv(gym.Env):
     | ``camera_width``, ``camera_height`` | 128, 128 | range image size [pixels] |
     | ``camera_fovy`` | 50 | vertical field of view [deg] |
     | ``roll_threshold`` | 0.05 | displacement above which an interaction is ``rolled`` [m] |
-    | ``settle_timeout`` | 1.0 | longest simulated wait after contact [s] |
+    | ``settle_timeout`` | 2.0 | longest simulated wait for the outcome once the robot is back home [s] |
     | ``reward_fn`` | displacement | ``callable(info) -> float`` |
     | ``render_mode`` | None | ``"rgb_array"``: a picture from an outside camera (headless EGL/OSMesa) |
 
@@ -137,7 +145,7 @@ class TapAffordanceEnv(gym.Env):
         camera_height: int = 128,
         camera_fovy: float = 50.0,
         roll_threshold: float = 0.05,
-        settle_timeout: float = 1.0,
+        settle_timeout: float = 2.0,
         reward_fn: Callable[[dict[str, Any]], float] | None = None,
         render_mode: str | None = None,
         render_width: int = 480,
@@ -247,8 +255,9 @@ class TapAffordanceEnv(gym.Env):
         self._q_home = physics.joint_targets()
         geometry = object_geometry(object_type, size)
         physics.set_object(geometry, xy, yaw)
-        physics.step(round(SETTLE_TIME / physics.model.opt.timestep))
+        self._settle_object()
         attention = attend(physics, self.attention_camera, self.motion.move_joints)
+        self.motion.hold_still()
         self._q_home = physics.joint_targets()  # the arm's home, with the gaze on the object
         obs, features = self._snapshot()
         pose = physics.object_pose()
@@ -262,10 +271,20 @@ class TapAffordanceEnv(gym.Env):
         }
         return obs, info
 
-    def _wait_outcome(self, t_contact: float) -> str:
+    def _settle_object(self) -> None:
+        """Let the freshly placed object come to rest (it is placed 0.1 mm above the table)."""
         physics = self.physics
+        for _ in range(round(SETTLE_TIME / CONTROL_DT)):
+            physics.step(self.motion.steps_per_tick)
+            if physics.object_speed() < 1e-3 and physics.object_angular_speed() < 1e-2:
+                return
+
+    def _wait_outcome(self) -> str:
+        """Simulate until the object is at rest, has left the table, or ``settle_timeout`` has passed."""
+        physics = self.physics
+        t_end = physics.data.time + self.settle_timeout
         rest_ticks = 0
-        while physics.data.time < t_contact + self.settle_timeout:
+        while True:
             if not physics.object_on_table():
                 return "off_table"
             if physics.object_speed() < REST_SPEED and physics.object_angular_speed() < REST_ANGULAR_SPEED:
@@ -274,8 +293,9 @@ class TapAffordanceEnv(gym.Env):
                     return "rest"
             else:
                 rest_ticks = 0
+            if physics.data.time >= t_end:
+                return "timeout"
             physics.step(self.motion.steps_per_tick)
-        return "timeout"
 
     def step(self, action):
         """Execute the behaviour with ``action`` and take the final snapshot; the episode then terminates."""
@@ -289,8 +309,7 @@ class TapAffordanceEnv(gym.Env):
                            physics.table_top, action)
         stroke = self.motion.stroke(plan)
         self.motion.go_home(self._q_home)
-        t_start = stroke.contact_time if stroke.contact else float(physics.data.time)
-        outcome = self._wait_outcome(t_start)
+        outcome = self._wait_outcome()
         fault = physics.unstable()
         if fault is None:
             obs, features = self._snapshot()

@@ -24,7 +24,7 @@ BARE_SCENE = """
   <option timestep="0.002" integrator="implicitfast" cone="elliptic" impratio="10"/>
   <worldbody>
     <geom name="floor" type="plane" size="2 2 0.05" pos="0 0 -0.7"/>
-    <geom name="table_top" type="box" size="0.15 0.32 0.02" pos="-0.33 0 -0.09"/>
+    <geom name="table_surface" type="plane" size="0.15 0.32 0.01" pos="-0.33 0 -0.07"/>
     <body name="object" pos="{x} {y} {z}" quat="{quat}">
       <freejoint/>
       <geom type="{primitive}" size="{size}" condim="6" friction="1 0.005 0.0001" mass="{mass}"/>

@@ -195,3 +195,42 @@ def test_a_missed_tap_is_reported():
     env.physics.model.geom_contype[hand] = env.physics.model.geom_conaffinity[hand] = 0  # a ghost hand
     _, _, _, _, info = env.step(np.zeros(3))
     assert not info["contact"] and info["failure"].startswith("tap:")
+
+
+def test_an_untouched_object_has_no_effect():
+    # A ghost hand never touches the object: the initial and final snapshots then see the same scene from
+    # the same, still head, so the shape and size effects vanish (only the hand-relation features may change).
+    env = TapAffordanceEnv()
+    env.reset(seed=1)
+    hand = env.physics.hand_geoms
+    env.physics.model.geom_contype[hand] = env.physics.model.geom_conaffinity[hand] = 0
+    _, _, _, _, info = env.step(np.zeros(3))
+    groups = np.array([affordance_env.FEATURE_GROUPS[n] for n in affordance_env.FEATURE_NAMES])
+    assert info["displacement"] < 1e-4
+    effect = np.abs(info["effect"])
+    assert effect[groups == "shape"].max() < 0.02
+    assert effect[groups != "relation"][4] < 10  # pixel count changes by a few pixels at most
+
+
+def test_outcome_is_checked_before_the_timeout():
+    env = TapAffordanceEnv(object_types=("box",), settle_timeout=0.05, camera_width=32, camera_height=32)
+    env.reset(seed=0)
+    _, _, _, _, info = env.step(np.zeros(3))
+    assert info["outcome"] == "rest"
+
+
+@pytest.mark.parametrize("behavior", ["tap_back", "push"])
+def test_other_behaviors_run_and_flag_what_they_cannot_do(behavior):
+    env = TapAffordanceEnv(behavior=behavior, camera_width=32, camera_height=32)
+    valid = 0
+    for seed in range(12):
+        env.reset(seed=seed)
+        _, _, _, _, info = env.step(np.zeros(3))
+        assert info["behavior"] == behavior
+        assert np.all(np.isfinite(info["effect"]))
+        if info["failure"] is None:
+            valid += 1
+            assert info["contact"] and info["ik"]["success"]
+        else:
+            assert info["failure"].split(":")[0] in ("reach", "ik", "tap", "perception")
+    assert valid >= 3  # push and tap_back fail their reach more often than tap (see README)
