@@ -49,7 +49,8 @@ def test_robot_never_collides_with_itself(model):
     hand_geoms = [g for g in robot_geoms if model.body(model.geom_bodyid[g]).name in CONTACT_LINKS]
     assert hand_geoms
     def touch(a, b):
-        return bool((model.geom_contype[a] & model.geom_conaffinity[b]) or (model.geom_contype[b] & model.geom_conaffinity[a]))
+        ct, ca = model.geom_contype, model.geom_conaffinity
+        return bool((ct[a] & ca[b]) or (ct[b] & ca[a]))
 
     surface, sphere = model.geom("table_surface").id, model.geom("object_sphere").id
     for g in hand_geoms:
