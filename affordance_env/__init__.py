@@ -14,6 +14,7 @@ from affordance_env.rendering import select_gl_backend
 
 select_gl_backend()  # before anything imports mujoco: headless RGB rendering needs EGL or OSMesa
 
+from affordance_env.dataset import load_dataset  # noqa: E402
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES  # noqa: E402
 from affordance_env.objects import OBJECT_TYPES  # noqa: E402
 from affordance_env.registration import register_envs  # noqa: E402
@@ -23,4 +24,12 @@ register_envs()
 
 __version__ = "0.1.0"
 
-__all__ = ["ACTIVE_JOINTS", "FEATURE_GROUPS", "FEATURE_NAMES", "OBJECT_TYPES", "register_envs", "__version__"]
+__all__ = [
+    "ACTIVE_JOINTS",
+    "FEATURE_GROUPS",
+    "FEATURE_NAMES",
+    "OBJECT_TYPES",
+    "load_dataset",
+    "register_envs",
+    "__version__",
+]

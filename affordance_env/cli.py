@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -37,6 +38,43 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _collect(args: argparse.Namespace) -> int:
+    from affordance_env.dataset import collect, load_dataset
+
+    options = {"behavior": args.behavior, "camera_width": args.camera_width, "camera_height": args.camera_height}
+    if args.object_types:
+        options["object_types"] = args.object_types
+    if args.size_range:
+        options["size_range"] = tuple(args.size_range)
+    start = time.perf_counter()
+    out = collect(args.out, args.episodes, seed=args.seed, workers=args.workers, action=args.action,
+                  env_options=options, chunk_size=args.chunk_size)
+    frame = load_dataset(out)
+    elapsed = time.perf_counter() - start
+    failures = frame.attrs["failures"]
+    print(f"{out}: {len(frame)} interactions ({len(failures)} failed and left out) in {elapsed:.1f} s")
+    return 0
+
+
+def _reproduce(args: argparse.Namespace) -> int:
+    from affordance_learning.reproduce import reproduce
+
+    reproduce(args.out, episodes=args.episodes, trials=args.trials, seed=args.seed, workers=args.workers,
+              dataset=args.dataset)
+    return 0
+
+
+def _train_default(args: argparse.Namespace) -> int:
+    from affordance_env.dataset import collect, load_dataset
+    from affordance_learning.default_model import DEFAULT_MODEL_PATH, train_default_model
+
+    dataset = collect(args.dataset, 1000, seed=0, workers=args.workers)
+    model = train_default_model(load_dataset(dataset), args.out or DEFAULT_MODEL_PATH)
+    print(f"default tap model ({model.n_clusters} categories, {len(model.selected_features_)} features selected: "
+          f"{', '.join(model.selected_feature_names_)}) written to {args.out or DEFAULT_MODEL_PATH}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="affordance", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -46,6 +84,40 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--behavior", default="tap", help="tap | tap_back | push (default tap)")
     demo.add_argument("--object", default=None, help="only this object type (default: all four)")
     demo.set_defaults(func=_demo)
+
+    collect = sub.add_parser("collect", help="collect interactions into a dataset (parallel, resumable)")
+    collect.add_argument("--episodes", type=int, required=True, help="number of interactions")
+    collect.add_argument("--out", type=Path, required=True, help="dataset directory (resumed if it exists)")
+    collect.add_argument("--seed", type=int, default=0, help="dataset seed (default 0)")
+    collect.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+    collect.add_argument("--behavior", default="tap", help="tap | tap_back | push (default tap)")
+    collect.add_argument("--action", default="canonical", choices=("canonical", "random"),
+                         help="the paper's canonical tap, or uniform random actions (default canonical)")
+    collect.add_argument("--object-types", nargs="+", default=None, help="object types to sample (default all)")
+    collect.add_argument("--size-range", nargs=2, type=float, default=None, metavar=("LOW", "HIGH"),
+                         help="object size range [m] (default 0.04 0.10)")
+    collect.add_argument("--camera-width", type=int, default=128)
+    collect.add_argument("--camera-height", type=int, default=128)
+    collect.add_argument("--chunk-size", type=int, default=50, help="interactions per file (default 50)")
+    collect.set_defaults(func=_collect)
+
+    reproduce = sub.add_parser(
+        "reproduce", help="the paper's experiment: collect taps, learn, write results.json, figures and a report"
+    )
+    reproduce.add_argument("--episodes", type=int, default=1000, help="tap interactions (default 1000)")
+    reproduce.add_argument("--trials", type=int, default=20, help="learning trials per setting (default 20)")
+    reproduce.add_argument("--seed", type=int, default=0, help="seed of the dataset and the trials (default 0)")
+    reproduce.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    reproduce.add_argument("--dataset", type=Path, default=None, help="dataset directory (default OUT/dataset)")
+    reproduce.add_argument("--out", type=Path, default=Path("reproduction"), help="output directory")
+    reproduce.set_defaults(func=_reproduce)
+
+    train = sub.add_parser("train-default", help="rebuild the default tap model behind predict_effect")
+    train.add_argument("--dataset", type=Path, default=Path("default-taps"),
+                       help="where the 1000 canonical taps (seed 0) are collected (default ./default-taps)")
+    train.add_argument("--workers", type=int, default=2)
+    train.add_argument("--out", type=Path, default=None, help="model file (default: the package's own)")
+    train.set_defaults(func=_train_default)
     return parser
 
 
@@ -54,7 +126,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except ValueError as exc:
+    except (ValueError, FileNotFoundError) as exc:
         print(f"affordance: error: {exc}", file=sys.stderr)
         return 2
 

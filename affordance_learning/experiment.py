@@ -38,7 +38,9 @@ TEST_SHARE = 0.3
 
 def feature_columns(frame: pd.DataFrame) -> tuple[list[str], list[str], list[str]]:
     """Feature names, and the ``initial_`` and ``effect_`` columns of ``frame`` (in the same order)."""
-    names = [c.removeprefix("initial_") for c in frame.columns if c.startswith("initial_")]
+    from affordance_env.features import FEATURE_NAMES
+
+    names = [n for n in FEATURE_NAMES if f"initial_{n}" in frame.columns]
     missing = [f"effect_{n}" for n in names if f"effect_{n}" not in frame.columns]
     if not names or missing:
         raise ValueError(
