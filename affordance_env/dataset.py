@@ -186,6 +186,8 @@ def collect(
         raise DatasetError(f"{out} exists and is not a TapAffordance dataset (no {MANIFEST}); choose an empty or "
                            "new directory.")
     out.mkdir(parents=True, exist_ok=True)
+    for stale in out.glob(".chunk-*.tmp"):  # left by a run that was killed while writing
+        stale.unlink()
     _write_manifest(out, episodes, settings)
     chunks = _chunk_ranges(episodes, chunk_size)
     todo = [(i, r) for i, r in enumerate(chunks) if not (out / f"chunk-{i:05d}.parquet").exists()]

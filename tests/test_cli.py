@@ -19,3 +19,30 @@ def test_bad_option_is_a_clear_error_not_a_traceback(capsys):
 def test_unknown_command_exits_with_usage():
     with pytest.raises(SystemExit):
         main(["fly"])
+
+
+def test_reproduce_writes_results_figures_and_report(tmp_path, capsys):
+    import json
+
+    out = tmp_path / "repro"
+    assert main(["reproduce", "--episodes", "40", "--trials", "2", "--workers", "1", "--out", str(out)]) == 0
+    results = json.loads((out / "results.json").read_text())
+    assert set(results["uniformity"]) == {str(k) for k in range(2, 11)}
+    assert set(results["svm_accuracy"]) == {"0.0", "0.2", "0.4", "0.6", "0.8"}
+    assert results["config"]["episodes"] == 40
+    for name in ("uniformity.png", "selected_features.png", "case_study_k2.png", "case_study_k4.png",
+                 "svm_accuracy.png", "REPORT.md"):
+        assert (out / name).stat().st_size > 1000
+    # a second run reuses the dataset instead of collecting again
+    assert main(["reproduce", "--episodes", "40", "--trials", "1", "--workers", "1", "--out", str(out)]) == 0
+    assert "40 interactions" in capsys.readouterr().out
+
+
+def test_collect_command(tmp_path, capsys):
+    out = tmp_path / "d"
+    args = ["collect", "--episodes", "6", "--out", str(out), "--camera-width", "32", "--camera-height", "32",
+            "--chunk-size", "3"]
+    assert main(args) == 0
+    assert "6 interactions" in capsys.readouterr().out
+    assert main([*args[:5], "--seed", "9", *args[5:]]) == 2  # other settings: refused, not mixed in
+    assert "other settings" in capsys.readouterr().err
