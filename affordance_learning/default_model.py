@@ -24,11 +24,12 @@ REBUILD = "rebuild it with `affordance train-default` (about a minute)"
 
 
 def _versions() -> dict[str, str]:
+    """Versions a pickled model depends on: scikit-learn exactly (it warns on any other), NumPy's major."""
     import sklearn
 
     from affordance_learning import __version__
 
-    return {"scikit-learn": sklearn.__version__, "numpy": np.__version__, "tap-affordance": __version__}
+    return {"scikit-learn": sklearn.__version__, "numpy": np.__version__.split(".")[0], "tap-affordance": __version__}
 
 
 def train_default_model(frame: pd.DataFrame, path: Path = DEFAULT_MODEL_PATH) -> AffordanceModel:

@@ -1,0 +1,62 @@
+"""predict_effect with the shipped default tap model."""
+
+import joblib
+import numpy as np
+import pandas as pd
+import pytest
+
+import affordance_learning.default_model as default_model
+from affordance_env import FEATURE_NAMES
+from affordance_env.tap_env import TapAffordanceEnv
+from affordance_learning import predict_effect
+
+
+@pytest.fixture(scope="module")
+def observations():
+    env = TapAffordanceEnv()
+    out = {}
+    for object_type in ("sphere", "box"):
+        env = TapAffordanceEnv(object_types=(object_type,))
+        out[object_type] = np.array([env.reset(seed=s)[0]["features"] for s in range(5)])
+    return out
+
+
+def test_spheres_and_boxes_get_different_effects(observations):
+    spheres = predict_effect(observations["sphere"])
+    boxes = predict_effect(observations["box"])
+    assert spheres.category.shape == (5,) and spheres.effect.shape == (5, 49)
+    assert len(set(spheres.category)) == 1 and not set(spheres.category) & set(boxes.category)
+    pixel_count = FEATURE_NAMES.index("pixel_count")
+    # a tapped sphere rolls out of view: its predicted effect removes (nearly) all its pixels; a box stays
+    assert spheres.effect[0, pixel_count] < -0.8 * observations["sphere"][0, pixel_count]
+    assert abs(boxes.effect[0, pixel_count]) < 0.5 * observations["box"][0, pixel_count]
+
+
+def test_one_vector_and_dataframe(observations):
+    one = predict_effect(observations["sphere"][0])
+    assert one.category.shape == (1,)
+    frame = pd.DataFrame(observations["box"], columns=list(FEATURE_NAMES))
+    np.testing.assert_array_equal(predict_effect(frame).category, predict_effect(observations["box"]).category)
+
+
+@pytest.mark.parametrize("bad, match", [(np.zeros(48), "shape"), (np.zeros((2, 3, 49)), "shape"),
+                                        (np.full(49, np.nan), "finite")])
+def test_bad_features(bad, match):
+    with pytest.raises(ValueError, match=match):
+        predict_effect(bad)
+
+
+def test_model_from_other_versions_is_refused(tmp_path, monkeypatch):
+    stored = joblib.load(default_model.DEFAULT_MODEL_PATH)
+    stored["versions"]["scikit-learn"] = "0.1"
+    joblib.dump(stored, tmp_path / "old.joblib")
+    with pytest.raises(RuntimeError, match="scikit-learn 0.1 .model. vs .* .installed.*affordance train-default"):
+        default_model.load_default_model(tmp_path / "old.joblib")
+
+
+def test_corrupt_or_missing_model_is_refused(tmp_path):
+    (tmp_path / "bad.joblib").write_bytes(b"not a pickle")
+    with pytest.raises(RuntimeError, match="could not be read"):
+        default_model.load_default_model(tmp_path / "bad.joblib")
+    with pytest.raises(FileNotFoundError, match="affordance train-default"):
+        default_model.load_default_model(tmp_path / "none.joblib")
