@@ -143,6 +143,7 @@ def collect(
     env_options: dict[str, Any] | None = None,
     chunk_size: int = 50,
     progress: bool | None = None,
+    dask_address: str | None = None,
 ) -> Path:
     """Collect ``episodes`` interactions into the dataset directory ``out`` (resuming if it exists).
 
@@ -155,6 +156,8 @@ def collect(
         env_options: Keyword arguments of ``TapAffordance-v0`` (behavior, object_types, size_range, ...).
         chunk_size: Interactions per file; what a crash can lose at most, per worker.
         progress: Show a progress bar; default: on a terminal, and not when ``CI`` is set.
+        dask_address: Run the chunks on this Dask distributed scheduler (``"tcp://host:8786"``) instead of local
+            processes; the workers must see ``out`` (a shared file system). The dataset is the same.
 
     Returns:
         The dataset directory.
@@ -198,7 +201,9 @@ def collect(
     from tqdm.auto import tqdm
 
     with tqdm(total=episodes, initial=done, unit="interaction", disable=not progress, smoothing=0.1) as bar:
-        if workers == 1:
+        if dask_address is not None:
+            results = _dask_results(dask_address, [(str(out), i, r, seed, action, options_json) for i, r in todo])
+        elif workers == 1:
             results: Iterator[int] = (_collect_chunk(str(out), i, r, seed, action, options_json) for i, r in todo)
         else:
             results = Parallel(n_jobs=workers, return_as="generator_unordered")(
@@ -207,6 +212,18 @@ def collect(
         for n in results:
             bar.update(n)
     return out
+
+
+def _dask_results(address: str, tasks: list[tuple]) -> Iterator[int]:
+    """Run chunk tasks on a Dask distributed cluster, yielding as they complete."""
+    try:
+        from distributed import Client, as_completed
+    except ImportError as exc:
+        raise ImportError("dask_address needs Dask distributed: pip install 'tap-affordance[dask]'") from exc
+    with Client(address) as client:
+        futures = [client.submit(_collect_chunk, *task, pure=False) for task in tasks]
+        for future in as_completed(futures):
+            yield future.result()
 
 
 def _write_manifest(out: Path, episodes: int, settings: dict) -> None:

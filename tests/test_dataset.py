@@ -107,3 +107,12 @@ def test_kill_minus_nine_then_resume_equals_uninterrupted(reference, tmp_path):
     collect(out, 24, seed=5, workers=2, env_options=SMALL, chunk_size=8, progress=False)
     pd.testing.assert_frame_equal(load_dataset(out), reference)
     assert not list(out.glob(".*.tmp"))
+
+
+@pytest.mark.slow
+def test_a_local_dask_cluster_collects_the_same_dataset(reference, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        collect(tmp_path / "dask", 24, seed=5, env_options=SMALL, chunk_size=8, progress=False,
+                dask_address=cluster.scheduler_address)
+    pd.testing.assert_frame_equal(load_dataset(tmp_path / "dask"), reference)
