@@ -48,7 +48,8 @@ def _collect(args: argparse.Namespace) -> int:
         options["size_range"] = tuple(args.size_range)
     start = time.perf_counter()
     out = collect(args.out, args.episodes, seed=args.seed, workers=args.workers, action=args.action,
-                  env_options=options, chunk_size=args.chunk_size, dask_address=args.dask_address)
+                  env_options=options, chunk_size=args.chunk_size, dask_address=args.dask_address,
+                  save_images=args.save_images)
     frame = load_dataset(out)
     elapsed = time.perf_counter() - start
     failures = frame.attrs["failures"]
@@ -99,6 +100,8 @@ def build_parser() -> argparse.ArgumentParser:
     collect.add_argument("--camera-width", type=int, default=128)
     collect.add_argument("--camera-height", type=int, default=128)
     collect.add_argument("--chunk-size", type=int, default=50, help="interactions per file (default 50)")
+    collect.add_argument("--save-images", action="store_true",
+                         help="also store range images and object masks (compressed)")
     collect.add_argument("--dask-address", default=None,
                          help="run on this Dask distributed scheduler (e.g. tcp://host:8786) instead of --workers")
     collect.set_defaults(func=_collect)

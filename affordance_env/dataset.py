@@ -73,9 +73,32 @@ def _full_options(env_options: dict[str, Any]) -> dict[str, Any]:
     return json.loads(json.dumps(full, default=list))
 
 
-def _settings(episodes: int, seed: int, action: str, chunk_size: int, env_options: dict[str, Any]) -> dict:
-    return {"seed": int(seed), "action": action, "chunk_size": int(chunk_size),
+def _settings(seed: int, action: str, chunk_size: int, env_options: dict[str, Any], save_images: bool) -> dict:
+    return {"seed": int(seed), "action": action, "chunk_size": int(chunk_size), "save_images": bool(save_images),
             "env_options": json.loads(json.dumps(env_options, default=list))}
+
+
+def images(frame: pd.DataFrame, column: str) -> np.ndarray:
+    """Decode an image column of a dataset collected with ``save_images=True``.
+
+    Args:
+        frame: From :func:`load_dataset`.
+        column: ``initial_range``, ``final_range`` (metres, float16 on disk; 0 where nothing was hit) or
+            ``initial_mask``, ``final_mask`` (bool).
+
+    Returns:
+        (n, H, W) array: float32 ranges or bool masks.
+    """
+    if column not in ("initial_range", "final_range", "initial_mask", "final_mask"):
+        raise ValueError(f"column must be one of initial_range, final_range, initial_mask, final_mask, got {column!r}.")
+    if column not in frame.columns:
+        raise ValueError(f"the dataset has no {column!r} column: collect it with save_images=True (--save-images).")
+    options = frame.attrs["manifest"]["settings"]["env_options"]
+    shape = (int(options["camera_height"]), int(options["camera_width"]))
+    if column.endswith("range"):
+        return np.stack([np.frombuffer(b, np.float16).reshape(shape).astype(np.float32) for b in frame[column]])
+    n = shape[0] * shape[1]
+    return np.stack([np.unpackbits(np.frombuffer(b, np.uint8))[:n].reshape(shape).astype(bool) for b in frame[column]])
 
 
 @functools.cache
@@ -103,15 +126,16 @@ def _row(episode: int, env_seed: int, action: np.ndarray, info: dict) -> dict[st
     return row
 
 
-def _collect_chunk(out: str, index: int, episodes: range, seed: int, action: str, options_json: str) -> int:
+def _collect_chunk(out: str, index: int, episodes: range, seed: int, action: str, options_json: str,
+                   save_images: bool = False) -> int:
     """Run the interactions of one chunk and write it atomically; returns the number of interactions."""
     env = _env(options_json)
     rows, failures = [], {}
     for episode in episodes:
         env_seed = interaction_seed(seed, episode)
         act = interaction_action(seed, episode, action)
-        env.reset(seed=env_seed)
-        info = env.step(act)[4]
+        obs_initial, _ = env.reset(seed=env_seed)
+        obs_final, _, _, _, info = env.step(act)
         if info["failure"] is not None:
             failures[str(episode)] = info["failure"]
             continue
@@ -119,6 +143,10 @@ def _collect_chunk(out: str, index: int, episodes: range, seed: int, action: str
         if not all(np.isfinite(v) for v in row.values() if isinstance(v, float)):
             failures[str(episode)] = "non-finite values in the interaction's record"
             continue
+        if save_images:
+            for stage, obs in (("initial", obs_initial), ("final", obs_final)):
+                row[f"{stage}_range"] = obs["range"].astype(np.float16).tobytes()
+                row[f"{stage}_mask"] = np.packbits(obs["mask"].astype(bool)).tobytes()
         rows.append(row)
     table = pa.Table.from_pandas(pd.DataFrame(rows), preserve_index=False)
     table = table.replace_schema_metadata({**(table.schema.metadata or {}),
@@ -144,6 +172,7 @@ def collect(
     chunk_size: int = 50,
     progress: bool | None = None,
     dask_address: str | None = None,
+    save_images: bool = False,
 ) -> Path:
     """Collect ``episodes`` interactions into the dataset directory ``out`` (resuming if it exists).
 
@@ -156,6 +185,8 @@ def collect(
         env_options: Keyword arguments of ``TapAffordance-v0`` (behavior, object_types, size_range, ...).
         chunk_size: Interactions per file; what a crash can lose at most, per worker.
         progress: Show a progress bar; default: on a terminal, and not when ``CI`` is set.
+        save_images: Also store the initial and final range images (float16) and object masks (bit-packed),
+            compressed; decode them with :func:`images`.
         dask_address: Run the chunks on this Dask distributed scheduler (``"tcp://host:8786"``) instead of local
             processes; the workers must see ``out`` (a shared file system). The dataset is the same.
 
@@ -175,7 +206,7 @@ def collect(
     env_options = _full_options(dict(env_options or {}))
     _env(json.dumps(env_options, sort_keys=True, default=list))  # bad options fail here, clearly, before any work
     out = Path(out)
-    settings = _settings(episodes, seed, action, chunk_size, env_options)
+    settings = _settings(seed, action, chunk_size, env_options, save_images)
     manifest_path = out / MANIFEST
     if manifest_path.exists():
         existing = _read_manifest(out)
@@ -202,12 +233,15 @@ def collect(
 
     with tqdm(total=episodes, initial=done, unit="interaction", disable=not progress, smoothing=0.1) as bar:
         if dask_address is not None:
-            results = _dask_results(dask_address, [(str(out), i, r, seed, action, options_json) for i, r in todo])
+            tasks = [(str(out), i, r, seed, action, options_json, save_images) for i, r in todo]
+            results = _dask_results(dask_address, tasks)
         elif workers == 1:
-            results: Iterator[int] = (_collect_chunk(str(out), i, r, seed, action, options_json) for i, r in todo)
+            results: Iterator[int] = (
+                _collect_chunk(str(out), i, r, seed, action, options_json, save_images) for i, r in todo
+            )
         else:
             results = Parallel(n_jobs=workers, return_as="generator_unordered")(
-                delayed(_collect_chunk)(str(out), i, r, seed, action, options_json) for i, r in todo
+                delayed(_collect_chunk)(str(out), i, r, seed, action, options_json, save_images) for i, r in todo
             )
         for n in results:
             bar.update(n)

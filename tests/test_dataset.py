@@ -7,6 +7,7 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pandas as pd
 import pytest
 
@@ -116,3 +117,18 @@ def test_a_local_dask_cluster_collects_the_same_dataset(reference, tmp_path):
         collect(tmp_path / "dask", 24, seed=5, env_options=SMALL, chunk_size=8, progress=False,
                 dask_address=cluster.scheduler_address)
     pd.testing.assert_frame_equal(load_dataset(tmp_path / "dask"), reference)
+
+
+def test_saved_images_decode_to_the_observations(tmp_path):
+    from affordance_env.dataset import images, interaction_seed
+    from affordance_env.tap_env import TapAffordanceEnv
+
+    collect(tmp_path / "img", 3, seed=2, env_options=SMALL, chunk_size=3, progress=False, save_images=True)
+    frame = load_dataset(tmp_path / "img")
+    ranges, masks = images(frame, "initial_range"), images(frame, "initial_mask")
+    assert ranges.shape == (len(frame), 32, 32) and masks.dtype == bool
+    obs, _ = TapAffordanceEnv(**SMALL).reset(seed=interaction_seed(2, int(frame.episode[0])))
+    np.testing.assert_array_equal(masks[0], obs["mask"].astype(bool))
+    np.testing.assert_allclose(ranges[0], obs["range"], rtol=1e-3)  # float16 on disk
+    with pytest.raises(ValueError, match="save_images"):
+        images(load_dataset(tmp_path / "img").drop(columns="final_mask"), "final_mask")
