@@ -210,7 +210,8 @@ def collect(
     manifest_path = out / MANIFEST
     if manifest_path.exists():
         existing = _read_manifest(out)
-        differs = {k: (existing["settings"].get(k), v) for k, v in settings.items() if existing["settings"].get(k) != v}
+        stored = {"save_images": False, **existing["settings"]}  # datasets from before save_images existed
+        differs = {k: (stored.get(k), v) for k, v in settings.items() if stored.get(k) != v}
         if differs:
             details = "; ".join(f"{k}: dataset has {old!r}, asked for {new!r}" for k, (old, new) in differs.items())
             raise DatasetError(f"{out} holds a dataset made with other settings ({details}). Use another --out "

@@ -1,30 +1,66 @@
-"""Unsupervised affordance learning (Akgun et al. 2009): SOM of effects -> ReliefF -> SVM.
+"""Unsupervised affordance learning after Akgun et al. 2009: SOM of effects -> ReliefF -> SVM.
 
-- :class:`AffordanceModel`: the learning model, a scikit-learn estimator, for any (initial features, effects).
-- :func:`predict_effect`: the effect of a tap predicted from an object's 49 features, by the shipped model.
-- :func:`run_protocol`: the paper's experiment on a dataset; ``affordance reproduce`` runs it end to end.
+- :class:`AffordanceModel`: the learning model for one behaviour, a scikit-learn estimator
+  (``fit(initial_features, effects)``, ``predict``, ``predict_effect``).
+- :class:`SOMClustering`: a 1 x k self-organising map (minisom) as a scikit-learn clusterer.
+- :func:`relieff_weights`: ReliefF feature weights equal to skrebate's, vectorised.
+- :func:`uniformity`, :func:`cluster_purity`, :func:`adjusted_rand`, :func:`svm_cv_accuracy`: the metrics.
+- :func:`predict_effect`: the effect of a tap predicted from an object's 49 features by the default model.
+- :func:`run_protocol`, :func:`write_figures`, :func:`write_report`: the paper's experiment and its outputs
+  (``affordance reproduce`` runs them end to end).
 """
 
 __version__ = "0.1.0"
 
-from affordance_learning.default_model import load_default_model, predict_effect, train_default_model  # noqa: E402
-from affordance_learning.experiment import run_protocol  # noqa: E402
-from affordance_learning.metrics import adjusted_rand, cluster_purity, uniformity  # noqa: E402
-from affordance_learning.model import AffordanceModel, EffectPrediction  # noqa: E402
-from affordance_learning.relieff import relieff_weights  # noqa: E402
-from affordance_learning.som import SOMClustering  # noqa: E402
+from affordance_learning.default_model import (  # noqa: E402 (after __version__, which it reads)
+    DefaultModelError,
+    DefaultModelMissingError,
+    load_default_model,
+    predict_effect,
+    train_default_model,
+)
+from affordance_learning.metrics import adjusted_rand, cluster_purity, svm_cv_accuracy, uniformity
+from affordance_learning.model import AffordanceModel, EffectPrediction, select_features
+from affordance_learning.relieff import ReliefF, ReliefFScorer, relieff_weights
+from affordance_learning.som import SOMClustering
+
+#: Names loaded on first use, so that ``import affordance_learning`` stays light (no matplotlib).
+_LAZY = {
+    "make_synthetic_frame": "affordance_learning.experiment",
+    "run_protocol": "affordance_learning.experiment",
+    "write_figures": "affordance_learning.figures",
+    "write_report": "affordance_learning.report",
+}
+
+
+def __getattr__(name: str) -> object:
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'affordance_learning' has no attribute {name!r}")
+
 
 __all__ = [
     "AffordanceModel",
+    "DefaultModelError",
+    "DefaultModelMissingError",
     "EffectPrediction",
+    "ReliefF",
+    "ReliefFScorer",
     "SOMClustering",
     "adjusted_rand",
     "cluster_purity",
     "load_default_model",
+    "make_synthetic_frame",
     "predict_effect",
     "relieff_weights",
     "run_protocol",
+    "select_features",
+    "svm_cv_accuracy",
     "train_default_model",
     "uniformity",
+    "write_figures",
+    "write_report",
     "__version__",
 ]

@@ -1,105 +1,221 @@
-"""``predict_effect(features)`` with the default tap model shipped in the package.
+"""``predict_effect(features)``: the effect of a tap predicted by the package's default tap model.
 
-The model is an :class:`AffordanceModel` (1 x 4 map, r = 0.4, the paper's case-study setting) trained by
-``affordance train-default`` on 1000 canonical taps of ``TapAffordance-v0`` (seed 0). It is stored with the
-versions of scikit-learn, NumPy and this package it was trained with; a model that was trained under other
-versions, or a file that is missing or corrupt, is refused with a message that says how to rebuild it.
+The default model is an :class:`AffordanceModel` (1 x 4 map, r = 0.4: the paper's case-study setting and
+its best relevancy) trained by :func:`train_default_model` on a dataset of canonical taps (the command
+``affordance train-default`` builds it) and stored at ``affordance_learning/data/tap_model.joblib`` with the
+bundle format, this package's version, scikit-learn's version and NumPy's major version.
+
+:func:`load_default_model` refuses a file that is missing (:class:`DefaultModelMissingError`, a
+``FileNotFoundError``), unreadable, not a bundle of the current :data:`FORMAT`, or stored under other
+versions (:class:`DefaultModelError`, a ``RuntimeError``), with a message that says how to rebuild it; it
+never uses a model it could not check. :data:`FORMAT` is raised whenever the fitted layout of
+:class:`AffordanceModel` changes, so that an older file is refused rather than half-used. A good load is
+cached, keyed by the file's path, size and modification time, so a rebuilt file is used at the next call.
 """
 
 from __future__ import annotations
 
 import functools
+import os
 from pathlib import Path
+from typing import Any
 
 import joblib
 import numpy as np
 import pandas as pd
+from numpy.typing import ArrayLike
 
 from affordance_learning.model import AffordanceModel, EffectPrediction
 
+#: Where the default tap model is stored.
 DEFAULT_MODEL_PATH = Path(__file__).resolve().parent / "data" / "tap_model.joblib"
+#: Map size and relevancy threshold of the default model.
 DEFAULT_N_CLUSTERS = 4
 DEFAULT_RELEVANCY = 0.4
-REBUILD = "rebuild it with `affordance train-default` (about a minute)"
+#: Layout of the stored bundle and of AffordanceModel's fitted attributes; raise it when either changes.
+FORMAT = 2
+#: The command that rebuilds the default model.
+REBUILD_COMMAND = "affordance train-default"
+_N_FEATURES = 49
 
 
-def _versions() -> dict[str, str]:
-    """Versions a pickled model depends on: scikit-learn exactly (it warns on any other), NumPy's major."""
+class DefaultModelError(RuntimeError):
+    """The default tap model is unusable: unreadable, of another format, or of other library versions."""
+
+
+class DefaultModelMissingError(DefaultModelError, FileNotFoundError):
+    """The default tap model file does not exist."""
+
+
+def _feature_names() -> list[str]:
+    try:
+        from affordance_env.features import FEATURE_NAMES
+    except ImportError:
+        return [f"f{i:02d}" for i in range(_N_FEATURES)]
+    return list(FEATURE_NAMES)
+
+
+def library_versions() -> dict[str, str]:
+    """Versions that must match between storing and loading the default model.
+
+    scikit-learn exactly (it guarantees its pickles only under the version that wrote them), NumPy's major
+    version (pickled arrays are stable within one), and this package exactly (it defines the model).
+    """
     import sklearn
 
     from affordance_learning import __version__
 
-    return {"scikit-learn": sklearn.__version__, "numpy": np.__version__.split(".")[0], "tap-affordance": __version__}
+    return {
+        "scikit-learn": sklearn.__version__,
+        "numpy": np.__version__.split(".")[0],
+        "tap-affordance": __version__,
+    }
 
 
-def train_default_model(frame: pd.DataFrame, path: Path = DEFAULT_MODEL_PATH) -> AffordanceModel:
-    """Fit the default model on a dataset (columns ``initial_<name>``, ``effect_<name>``) and save it."""
-    from affordance_env.features import FEATURE_NAMES
+def train_default_model(
+    df: pd.DataFrame,
+    path: str | Path = DEFAULT_MODEL_PATH,
+    *,
+    n_clusters: int = DEFAULT_N_CLUSTERS,
+    relevancy: float = DEFAULT_RELEVANCY,
+    random_state: int = 0,
+) -> AffordanceModel:
+    """Fit the default tap model on a dataset frame and store it with the library versions.
 
-    missing = [n for n in FEATURE_NAMES if f"initial_{n}" not in frame or f"effect_{n}" not in frame]
+    Args:
+        df: Interactions in the dataset schema: ``initial_<name>`` and ``effect_<name>`` for each of the 49
+            feature names (``affordance_env.features.FEATURE_NAMES``).
+        path: Where to write the model (the directory is created); written to a temporary file first and
+            moved into place, so a reader never sees half a file.
+        n_clusters: Effect categories (map size), in [2, 10].
+        relevancy: Relevancy threshold of the feature selection, in [0, 1].
+        random_state: Seed of the map.
+
+    Returns:
+        The fitted model.
+    """
+    names = _feature_names()
+    missing = [c for n in names for c in (f"initial_{n}", f"effect_{n}") if c not in df.columns]
     if missing:
-        raise ValueError(f"the dataset lacks initial_/effect_ columns for {missing[:5]}.")
-    X = frame[[f"initial_{n}" for n in FEATURE_NAMES]].set_axis(list(FEATURE_NAMES), axis=1)
-    E = frame[[f"effect_{n}" for n in FEATURE_NAMES]].set_axis(list(FEATURE_NAMES), axis=1)
-    model = AffordanceModel(n_clusters=DEFAULT_N_CLUSTERS, relevancy=DEFAULT_RELEVANCY, random_state=0).fit(X, E)
+        raise ValueError(
+            f"the dataset lacks {len(missing)} column(s) that the default model needs, e.g. {missing[:4]}; "
+            "expected initial_<name> and effect_<name> for every name in affordance_env's FEATURE_NAMES."
+        )
+    X = pd.DataFrame(df[[f"initial_{n}" for n in names]].to_numpy(dtype=np.float64), columns=names)
+    E = pd.DataFrame(df[[f"effect_{n}" for n in names]].to_numpy(dtype=np.float64), columns=names)
+    model = AffordanceModel(n_clusters=n_clusters, relevancy=relevancy, random_state=random_state).fit(X, E)
+    bundle = {
+        "format": FORMAT,
+        "model": model,
+        "versions": library_versions(),
+        "feature_names": names,
+        "n_interactions": int(len(df)),
+    }
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(".tmp")
-    joblib.dump({"model": model, "versions": _versions(), "feature_names": list(FEATURE_NAMES),
-                 "n_interactions": int(len(frame))}, tmp, compress=3)
-    tmp.replace(path)
-    load_default_model.cache_clear()
+    partial = path.with_name(f"{path.name}.{os.getpid()}.partial")
+    joblib.dump(bundle, partial, compress=3)
+    partial.replace(path)
+    _load.cache_clear()
     return model
 
 
-@functools.cache
-def load_default_model(path: Path = DEFAULT_MODEL_PATH) -> AffordanceModel:
-    """The shipped model, checked against the installed library versions (cached)."""
-    path = Path(path)
-    if not path.is_file():
-        raise FileNotFoundError(f"The default tap model {path} is missing; {REBUILD}.")
+def _problem(path: Path | str, problem: str) -> str:
+    return (
+        f"The default tap model {path} {problem}. Rebuild it with `{REBUILD_COMMAND}` (it collects or reuses "
+        "1000 canonical taps, trains the model and stores it there)."
+    )
+
+
+@functools.lru_cache(maxsize=4)
+def _load(path: str, size: int, mtime_ns: int) -> tuple[AffordanceModel, tuple[str, ...]]:
+    """Load and check a stored model; ``size`` and ``mtime_ns`` only key the cache."""
     try:
-        stored = joblib.load(path)
-    except Exception as exc:  # unpickling errors come in many types
-        raise RuntimeError(f"The default tap model {path} could not be read ({exc!r}); {REBUILD}.") from exc
-    if not isinstance(stored, dict) or not isinstance(stored.get("model"), AffordanceModel):
-        raise RuntimeError(f"{path} does not hold a TapAffordance model; {REBUILD}.")
-    installed = _versions()
-    changed = {k: (v, installed.get(k)) for k, v in stored.get("versions", {}).items() if installed.get(k) != v}
+        bundle: Any = joblib.load(path)
+    except Exception as exc:  # unpickling a damaged file can raise almost anything
+        raise DefaultModelError(_problem(path, f"could not be read ({type(exc).__name__}: {exc})")) from exc
+    if not isinstance(bundle, dict) or bundle.get("format") != FORMAT:
+        found = bundle.get("format") if isinstance(bundle, dict) else type(bundle).__name__
+        raise DefaultModelError(
+            _problem(path, f"is not a tap model bundle of format {FORMAT} (found {found!r})")
+        )
+    model = bundle.get("model")
+    names = bundle.get("feature_names")
+    if not isinstance(model, AffordanceModel) or not isinstance(names, list) or len(names) != _N_FEATURES:
+        raise DefaultModelError(_problem(path, "does not hold an AffordanceModel over the 49 features"))
+    stored, installed = bundle.get("versions", {}), library_versions()
+    changed = [
+        f"{k} {stored.get(k)} (model) vs {v} (installed)" for k, v in installed.items() if stored.get(k) != v
+    ]
     if changed:
-        details = ", ".join(f"{k} {old} (model) vs {new} (installed)" for k, (old, new) in changed.items())
-        raise RuntimeError(f"The default tap model was trained under other library versions: {details}; {REBUILD}.")
-    return stored["model"]
+        raise DefaultModelError(
+            _problem(path, "was stored under other library versions: " + "; ".join(changed))
+        )
+    return model, tuple(names)
 
 
-def predict_effect(features) -> EffectPrediction:
-    """Predict the tap's effect category, and what that effect looks like, from the object's initial look.
+def _load_checked(path: Path) -> tuple[AffordanceModel, tuple[str, ...]]:
+    try:
+        stat = path.stat()
+    except OSError as exc:
+        raise DefaultModelMissingError(_problem(path, f"is missing ({exc.strerror})")) from exc
+    return _load(str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+
+
+def load_default_model(path: str | Path = DEFAULT_MODEL_PATH) -> AffordanceModel:
+    """The default tap model, checked against the installed library versions (cached).
+
+    Raises:
+        DefaultModelMissingError: The file does not exist (a ``FileNotFoundError``).
+        DefaultModelError: The file is unreadable, not a tap model bundle of the current format, or was
+            stored under other versions (a ``RuntimeError``).
+    """
+    return _load_checked(Path(path))[0]
+
+
+def predict_effect(
+    features: ArrayLike | pd.DataFrame, *, path: str | Path = DEFAULT_MODEL_PATH
+) -> EffectPrediction:
+    """Predict the effect category of a canonical tap, and what the effect looks like, from the 49 features.
 
     Args:
-        features: One (49,) or many (n, 49) feature vectors in the order of ``affordance_env.FEATURE_NAMES``
-            (``obs["features"]`` of ``TapAffordance-v0``), or a DataFrame with those columns.
+        features: One (49,) or many (n, 49) feature vectors of objects before the tap, in the order of
+            ``affordance_env.features.FEATURE_NAMES`` (``obs["features"]`` of ``TapAffordance-v0``), or a
+            DataFrame with those columns (in any order; other columns are ignored); finite.
+        path: The stored model (default: the package's).
 
     Returns:
-        ``.category`` (n,) effect categories and ``.effect`` (n, 49) their prototype effects (final minus
-        initial features, in feature units). A single vector gives arrays of length 1.
-    """
-    from affordance_env.features import FEATURE_NAMES
+        ``category`` (n,) int and ``effect`` (n, 49) float: the category's prototype effect (final minus
+        initial features, in each feature's unit). One (49,) vector gives n = 1.
 
+    Raises:
+        ValueError: ``features`` has another shape or lacks feature columns, or holds NaN or inf.
+        DefaultModelError: The default model is missing, broken or stale (rebuild it with
+            ``affordance train-default``).
+    """
     if isinstance(features, pd.DataFrame):
-        missing = [n for n in FEATURE_NAMES if n not in features.columns]
+        names = _feature_names()
+        missing = [n for n in names if n not in features.columns]
         if missing:
-            raise ValueError(f"features DataFrame lacks the columns {missing[:5]} (expected FEATURE_NAMES).")
-        X = features[list(FEATURE_NAMES)].to_numpy(np.float64)
-    else:
-        X = np.asarray(features, dtype=np.float64)
-        if X.ndim == 1:
-            X = X[None, :]
-    if X.ndim != 2 or X.shape[1] != len(FEATURE_NAMES) or X.shape[0] == 0:
+            raise ValueError(
+                f"the features DataFrame lacks {len(missing)} feature column(s), e.g. {missing[:4]}; "
+                "expected the names of affordance_env's FEATURE_NAMES."
+            )
+        features = features[names].to_numpy()
+    X = np.asarray(features)
+    if X.dtype == object or not (np.issubdtype(X.dtype, np.number) or X.dtype == bool) or np.iscomplexobj(X):
+        raise ValueError(f"features must be real numbers, got dtype {X.dtype}.")
+    if X.ndim not in (1, 2) or X.shape[-1] != _N_FEATURES or (X.ndim == 2 and X.shape[0] == 0):
         raise ValueError(
-            f"features must have shape ({len(FEATURE_NAMES)},) or (n, {len(FEATURE_NAMES)}), got {np.shape(features)}."
+            f"features must have shape ({_N_FEATURES},) or (n, {_N_FEATURES}) with n >= 1, got {X.shape}."
         )
-    if not np.all(np.isfinite(X)):
-        rows = np.flatnonzero(~np.all(np.isfinite(X), axis=1))
-        raise ValueError(f"features must be finite; rows {rows[:10].tolist()} hold NaN or inf.")
-    model = load_default_model()
-    return model.predict_effect(pd.DataFrame(X, columns=list(FEATURE_NAMES)))
+    X = np.atleast_2d(X).astype(np.float64)
+    bad = ~np.isfinite(X)
+    if bad.any():
+        row, col = np.argwhere(bad)[0]
+        raise ValueError(
+            f"features must be finite; row {row}, feature {col} is {float(X[row, col])} "
+            f"({int(bad.sum())} non-finite value(s))."
+        )
+    model, names = _load_checked(Path(path))
+    return model.predict_effect(pd.DataFrame(X, columns=list(names)))

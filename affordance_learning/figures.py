@@ -1,117 +1,186 @@
-"""Figures in the manner of the paper's Figs. 7-11, drawn from a results dict of :func:`run_protocol`."""
+"""Figures of the experiment in the manner of the paper's Figs. 7-11, from :func:`run_protocol` results.
+
+Drawn with matplotlib's object API on the Agg canvas (no pyplot, no display, no global backend setting):
+
+- ``uniformity.png`` (Fig. 7): uniformity against rolled/not rolled versus k, mean and standard deviation.
+- ``selected_features.png`` (Fig. 8): share of shape features among the selected ones, and their number,
+  versus k, one line per relevancy threshold r.
+- ``case_study_k2.png``, ``case_study_k4.png`` (Figs. 9, 10): per cluster of the 1 x 2 and 1 x 4 maps, the
+  rolled/not-rolled counts, the object types and the spread of object sizes.
+- ``svm_accuracy.png`` (Fig. 11): SVM accuracy on held-out interactions versus k, one line per r, with the
+  accuracy of always answering the most common category.
+- ``clusters_vs_type.png`` (not in the paper): purity and adjusted Rand index of the clusters against the
+  object type versus k.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
-import matplotlib
+import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
-matplotlib.use("Agg")  # headless: files only
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-TYPE_ORDER = ("sphere", "horizontal_cylinder", "box", "vertical_cylinder")
-
-
-def _ks(per_k: dict) -> list[int]:
-    return sorted(int(k) for k in per_k)
-
-
-def _series(per_k: dict) -> tuple[list[int], np.ndarray, np.ndarray]:
-    ks = _ks(per_k)
-    return ks, np.array([per_k[str(k)]["mean"] for k in ks]), np.array([per_k[str(k)]["std"] for k in ks])
+_REQUIRED = ("uniformity", "svm_accuracy", "shape_fraction", "n_selected", "case_studies")
+_TYPE_COLOURS = {
+    "sphere": "tab:red",
+    "horizontal_cylinder": "tab:orange",
+    "box": "tab:blue",
+    "vertical_cylinder": "tab:cyan",
+}
+_DPI = 120
 
 
-def uniformity_figure(results: dict, path: Path) -> Path:
-    """Fig. 7: uniformity of the effect clusters against rolled / not rolled, versus k."""
-    ks, mean, std = _series(results["uniformity"])
-    fig, ax = plt.subplots(figsize=(5, 3.5))
-    ax.errorbar(ks, mean, yerr=std, marker="o", capsize=3, label="tap (this reproduction)")
-    ax.axhline(80, color="grey", ls="--", lw=1, label="paper: above 80 % on average")
-    ax.set(xlabel="number of clusters k", ylabel="uniformity [%]", ylim=(0, 105), title="Uniformity of effect clusters")
-    ax.legend(loc="lower right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+def _series(per_k: Mapping[str, Mapping[str, float | None]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """k, mean and std arrays (NaN where a value is None), sorted by k."""
+    ks = sorted(per_k, key=int)
+    mean = np.array([np.nan if per_k[k]["mean"] is None else per_k[k]["mean"] for k in ks], dtype=float)
+    std = np.array([np.nan if per_k[k]["std"] is None else per_k[k]["std"] for k in ks], dtype=float)
+    return np.array([int(k) for k in ks]), mean, std
+
+
+def _new_figure(width: float, height: float, ncols: int = 1, nrows: int = 1) -> tuple[Figure, np.ndarray]:
+    fig = Figure(figsize=(width, height), dpi=_DPI, layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = np.atleast_1d(fig.subplots(nrows, ncols))
+    return fig, axes.ravel()
+
+
+def _save(fig: Figure, path: Path) -> Path:
+    fig.savefig(path, dpi=_DPI)
     return path
 
 
-def selected_features_figure(results: dict, path: Path) -> Path:
-    """Fig. 8: share of shape features among the selected ones, and their number, versus k for each r."""
-    fig, (top, bottom) = plt.subplots(2, 1, figsize=(5.5, 6), sharex=True)
-    for r in sorted(results["shape_fraction"], key=float):
-        ks, share, _ = _series(results["shape_fraction"][r])
-        top.plot(ks, 100 * share, marker="o", label=f"r = {r}")
-        ks, count, std = _series(results["n_selected"][r])
-        bottom.errorbar(ks, count, yerr=std, marker="o", capsize=2, label=f"r = {r}")
-    top.axhline(100 * 24 / 49, color="grey", ls=":", lw=1, label="all 49 features")
-    top.set(ylabel="shape features [%]", ylim=(0, 105), title="Selected features")
-    bottom.set(xlabel="number of clusters k", ylabel="number selected")
-    top.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+def _uniformity(results: Mapping[str, Any], path: Path) -> Path:
+    fig, (ax,) = _new_figure(5.5, 3.8)
+    k, mean, std = _series(results["uniformity"])
+    ax.errorbar(k, mean, yerr=std, marker="o", capsize=3, label="ours (mean ± std over trials)")
+    ax.axhline(80.0, color="grey", linestyle="--", linewidth=1, label="paper: above 80 % on average")
+    ax.axhline(95.0, color="grey", linestyle=":", linewidth=1, label="paper: up to 95 %")
+    ax.set(
+        xlabel="number of clusters k",
+        ylabel="uniformity [%]",
+        title="Uniformity of effect clusters (cf. Fig. 7)",
+    )
+    ax.set_xticks(k)
+    ax.set_ylim(0, 102)
+    ax.legend(loc="lower right", fontsize="small")
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
 
 
-def case_study_figure(results: dict, k: str, path: Path) -> Path:
-    """Figs. 9-10: per cluster of a 1 x k map, rolled / not rolled, object types and sizes."""
-    clusters = results["case_studies"][k]
-    fig, axes = plt.subplots(1, 3, figsize=(12, 3.6))
-    idx = np.arange(len(clusters))
-    rolled = [c["rolled"] for c in clusters]
-    not_rolled = [c["not_rolled"] for c in clusters]
-    axes[0].bar(idx - 0.2, rolled, 0.4, label="rolled")
-    axes[0].bar(idx + 0.2, not_rolled, 0.4, label="not rolled")
-    axes[0].set(xlabel="cluster", ylabel="interactions", title="Rolled / not rolled")
-    axes[0].legend(fontsize=8)
-    bottom = np.zeros(len(clusters))
-    types = [t for t in TYPE_ORDER if any(t in c["types"] for c in clusters)]
-    types += sorted({t for c in clusters for t in c["types"]} - set(types))
-    for t in types:
-        counts = np.array([c["types"].get(t, 0) for c in clusters])
-        axes[1].bar(idx, counts, bottom=bottom, label=t.replace("_", " "))
-        bottom += counts
-    axes[1].set(xlabel="cluster", title="Object types")
-    axes[1].legend(fontsize=7)
-    sizes = [np.array(c["sizes"]) * 100 for c in clusters]
-    axes[2].boxplot([s if len(s) else [np.nan] for s in sizes], positions=idx)
-    axes[2].set(xlabel="cluster", ylabel="object size [cm]", title="Sizes")
-    for ax in axes:
-        ax.set_xticks(idx)
-    fig.suptitle(f"Case study: 1 x {k} map")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+def _per_r(ax: Any, per_rk: Mapping[str, Mapping[str, Any]], scale: float = 1.0) -> None:
+    for r in sorted(per_rk, key=float):
+        k, mean, std = _series(per_rk[r])
+        ax.errorbar(k, mean * scale, yerr=std * scale, marker="o", markersize=3, capsize=2, label=f"r = {r}")
+        ax.set_xticks(k)
+    ax.grid(alpha=0.3)
 
 
-def svm_accuracy_figure(results: dict, path: Path) -> Path:
-    """Fig. 11: accuracy of the SVM predicting the effect cluster, versus k for each r."""
-    fig, ax = plt.subplots(figsize=(5.5, 3.8))
-    for r in sorted(results["svm_accuracy"], key=float):
-        ks, mean, std = _series(results["svm_accuracy"][r])
-        ax.errorbar(ks, 100 * mean, yerr=100 * std, marker="o", capsize=2, label=f"r = {r}")
-    if "svm_majority_baseline" in results:
-        ks, base, _ = _series(results["svm_majority_baseline"])
-        ax.plot(ks, 100 * base, color="grey", ls="--", lw=1, label="most common cluster")
-    ax.set(xlabel="number of clusters k", ylabel="test accuracy [%]", ylim=(0, 102), title="Effect prediction (SVM)")
-    ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+def _selected_features(results: Mapping[str, Any], path: Path) -> Path:
+    fig, (top, bottom) = _new_figure(6.0, 6.5, nrows=2)
+    _per_r(top, results["shape_fraction"], 100.0)
+    top.set(
+        ylabel="shape features [%]", ylim=(0, 102), title="Shape share of the selected features (cf. Fig. 8a)"
+    )
+    top.legend(fontsize="small", ncols=3)
+    _per_r(bottom, results["n_selected"])
+    bottom.set(
+        xlabel="number of clusters k",
+        ylabel="selected features",
+        ylim=(0, None),
+        title="Number of selected features (cf. Fig. 8b)",
+    )
+    return _save(fig, path)
 
 
-def write_figures(results: dict, out_dir) -> list[Path]:
-    """Write every figure as PNG into ``out_dir``; returns their paths."""
+def _case_study(clusters: list[Mapping[str, Any]], k: str, path: Path) -> Path:
+    fig, (ax_roll, ax_type, ax_size) = _new_figure(12.0, 3.8, ncols=3)
+    index = np.array([c["cluster"] for c in clusters])
+    rolled = np.array([c["rolled"] for c in clusters])
+    not_rolled = np.array([c["not_rolled"] for c in clusters])
+    ax_roll.bar(index, rolled, color="tab:green", label="rolled (success)")
+    ax_roll.bar(index, not_rolled, bottom=rolled, color="tab:gray", label="not rolled (fail)")
+    ax_roll.set(xlabel="cluster", ylabel="interactions", title="(a) hand labels")
+    ax_roll.legend(fontsize="small")
+
+    types = list(dict.fromkeys(t for c in clusters for t in c["types"]))
+    width = 0.8 / max(len(types), 1)
+    for i, t in enumerate(types):
+        counts = [c["types"].get(t, 0) for c in clusters]
+        ax_type.bar(
+            index - 0.4 + width * (i + 0.5),
+            counts,
+            width,
+            label=t.replace("_", " "),
+            color=_TYPE_COLOURS.get(t),
+        )
+    ax_type.set(xlabel="cluster", ylabel="interactions", title="(b) object types")
+    ax_type.legend(fontsize="small")
+
+    sizes = [np.asarray(c["sizes"], dtype=float) * 100.0 for c in clusters]
+    filled = [i for i, s in enumerate(sizes) if s.size]
+    if filled:
+        ax_size.boxplot([sizes[i] for i in filled], positions=index[filled], widths=0.6)
+    ax_size.set(xlabel="cluster", ylabel="object size [cm]", title="(c) object sizes")
+    for ax in (ax_roll, ax_type, ax_size):
+        ax.set_xticks(index)
+        ax.grid(alpha=0.3, axis="y")
+    fig.suptitle(f"1 x {k} map, first trial (cf. Figs. 9, 10)")
+    return _save(fig, path)
+
+
+def _svm_accuracy(results: Mapping[str, Any], path: Path) -> Path:
+    fig, (ax,) = _new_figure(6.0, 4.0)
+    _per_r(ax, results["svm_accuracy"], 100.0)
+    if "svm_baseline" in results:
+        k, mean, _ = _series(results["svm_baseline"])
+        ax.plot(k, mean * 100.0, color="black", linestyle="--", linewidth=1, label="most common category")
+    ax.set(
+        xlabel="number of clusters k",
+        ylabel="accuracy on held-out interactions [%]",
+        ylim=(0, 102),
+        title="SVM prediction of the effect category (cf. Fig. 11)",
+    )
+    ax.legend(fontsize="small", ncols=2)
+    return _save(fig, path)
+
+
+def _clusters_vs_type(results: Mapping[str, Any], path: Path) -> Path:
+    fig, (ax,) = _new_figure(5.5, 3.8)
+    for key, label in (("purity", "purity"), ("adjusted_rand", "adjusted Rand index")):
+        k, mean, std = _series(results[key])
+        ax.errorbar(k, mean, yerr=std, marker="o", capsize=3, label=label)
+        ax.set_xticks(k)
+    ax.set(xlabel="number of clusters k", ylabel="agreement with object type", ylim=(-0.05, 1.05))
+    ax.set_title("Effect clusters against object type (not in the paper)")
+    ax.legend(fontsize="small")
+    ax.grid(alpha=0.3)
+    return _save(fig, path)
+
+
+def write_figures(results: Mapping[str, Any], out_dir: str | Path) -> list[Path]:
+    """Write the figures of a results dict into ``out_dir`` (created if needed); returns their paths.
+
+    Args:
+        results: The dict returned by :func:`affordance_learning.experiment.run_protocol` (or read back from
+            its JSON).
+        out_dir: Directory for the PNG files.
+    """
+    missing = [key for key in _REQUIRED if key not in results]
+    if missing:
+        raise ValueError(f"results lack {missing}; expected the dict returned by run_protocol.")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     paths = [
-        uniformity_figure(results, out / "uniformity.png"),
-        selected_features_figure(results, out / "selected_features.png"),
+        _uniformity(results, out / "uniformity.png"),
+        _selected_features(results, out / "selected_features.png"),
     ]
-    for k in sorted(results.get("case_studies", {}), key=int):
-        paths.append(case_study_figure(results, k, out / f"case_study_k{k}.png"))
-    paths.append(svm_accuracy_figure(results, out / "svm_accuracy.png"))
+    for k, clusters in sorted(results["case_studies"].items(), key=lambda item: int(item[0])):
+        paths.append(_case_study(clusters, k, out / f"case_study_k{k}.png"))
+    paths.append(_svm_accuracy(results, out / "svm_accuracy.png"))
+    if "purity" in results and "adjusted_rand" in results:
+        paths.append(_clusters_vs_type(results, out / "clusters_vs_type.png"))
     return paths

@@ -1,52 +1,133 @@
-"""Measures of the paper and of clustering quality: uniformity, purity, adjusted Rand index."""
+"""Measures of the paper and of clustering quality: uniformity, purity, adjusted Rand index, SVM accuracy.
+
+Akgun et al. 2009, section V.A: the uniformity of the effect clusters against the hand-attached success/fail
+(rolled/not rolled) labels is ``U = 100 x sum over clusters c of |S_c - F_c| / T``, with ``S_c`` and ``F_c``
+the successes and failures in cluster ``c`` and ``T`` all instances: 100 when every cluster holds only
+successes or only failures, 0 when every cluster holds as many of each.
+"""
 
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 from sklearn.metrics import adjusted_rand_score
+from sklearn.model_selection import StratifiedKFold, cross_val_score
+from sklearn.pipeline import Pipeline, make_pipeline
+from sklearn.preprocessing import StandardScaler
+from sklearn.svm import SVC
 
 
-def _pair(clusters, labels, name: str) -> tuple[np.ndarray, np.ndarray]:
+def _paired(clusters: ArrayLike, labels: ArrayLike, name: str) -> tuple[np.ndarray, np.ndarray]:
     clusters = np.asarray(clusters)
     labels = np.asarray(labels)
-    if clusters.ndim != 1 or clusters.shape != labels.shape or clusters.size == 0:
+    if clusters.ndim != 1 or labels.ndim != 1 or clusters.shape != labels.shape or clusters.size == 0:
         raise ValueError(
             f"clusters and {name} must be non-empty 1-D arrays of the same length, got shapes "
             f"{clusters.shape} and {labels.shape}."
         )
+    for label, values in (("clusters", clusters), (name, labels)):
+        if values.dtype.kind == "f" and np.isnan(values).any():
+            raise ValueError(f"{label} contains NaN; expected a label for every instance.")
     return clusters, labels
 
 
-def uniformity(clusters, success) -> float:
-    """The paper's uniformity: U = 100 * sum over clusters c of |S_c - F_c| / T [%].
+def _as_success(success: np.ndarray) -> np.ndarray:
+    if success.dtype == bool:
+        return success
+    values = np.unique(success)
+    if values.dtype.kind not in "iuf" or not set(values.tolist()) <= {0, 1}:
+        raise ValueError(f"success must be boolean or 0/1, got values {values.tolist()[:10]}.")
+    return success.astype(bool)
 
-    ``S_c`` and ``F_c`` are the numbers of successful (rolled) and failed interactions in cluster ``c``, ``T``
-    all interactions. 100 when every cluster holds only successes or only failures; 0 when every cluster
-    holds as many of each.
+
+def uniformity(clusters: ArrayLike, success: ArrayLike) -> float:
+    """The paper's uniformity of clusters against success/fail labels, in percent [0, 100].
+
+    Args:
+        clusters: Cluster of each instance, (n,), any hashable labels.
+        success: Success (True, 1: the object rolled) or failure (False, 0) of each instance, (n,).
+
+    Returns:
+        ``100 x sum_c |S_c - F_c| / T`` [%].
     """
-    clusters, success = _pair(clusters, success, "success")
-    if success.dtype != bool:
-        values = set(np.unique(success).tolist())
-        if not values <= {0, 1}:
-            raise ValueError(f"success must be boolean (or 0/1), got values {sorted(values)}.")
-        success = success.astype(bool)
+    clusters, success = _paired(clusters, success, "success")
+    success = _as_success(success)
     _, index = np.unique(clusters, return_inverse=True)
-    s = np.bincount(index, weights=success.astype(float))
-    f = np.bincount(index, weights=(~success).astype(float))
-    return float(100.0 * np.abs(s - f).sum() / clusters.size)
+    n_success = np.bincount(index, weights=success.astype(np.float64))
+    n_failure = np.bincount(index, weights=(~success).astype(np.float64))
+    return float(100.0 * np.abs(n_success - n_failure).sum() / clusters.size)
 
 
-def cluster_purity(clusters, labels) -> float:
-    """Share of rows whose label is their cluster's most common label [0, 1]."""
-    clusters, labels = _pair(clusters, labels, "labels")
+def _contingency(clusters: np.ndarray, labels: np.ndarray) -> np.ndarray:
     _, ci = np.unique(clusters, return_inverse=True)
     _, li = np.unique(labels, return_inverse=True)
-    table = np.zeros((ci.max() + 1, li.max() + 1))
+    table = np.zeros((ci.max() + 1, li.max() + 1), dtype=np.int64)
     np.add.at(table, (ci, li), 1)
-    return float(table.max(axis=1).sum() / clusters.size)
+    return table
 
 
-def adjusted_rand(clusters, labels) -> float:
-    """Adjusted Rand index of the clusters against known labels (1: identical partitions, ~0: chance)."""
-    clusters, labels = _pair(clusters, labels, "labels")
+def cluster_purity(clusters: ArrayLike, labels: ArrayLike) -> float:
+    """Share of instances whose label is the most common label of their cluster, in [0, 1].
+
+    Args:
+        clusters: Cluster of each instance, (n,).
+        labels: Known class of each instance (for example the object type), (n,).
+    """
+    clusters, labels = _paired(clusters, labels, "labels")
+    return float(_contingency(clusters, labels).max(axis=1).sum() / clusters.size)
+
+
+def adjusted_rand(clusters: ArrayLike, labels: ArrayLike) -> float:
+    """Adjusted Rand index of the clusters against known labels: 1 for the same partition, about 0 by chance.
+
+    Args:
+        clusters: Cluster of each instance, (n,).
+        labels: Known class of each instance, (n,).
+    """
+    clusters, labels = _paired(clusters, labels, "labels")
     return float(adjusted_rand_score(labels, clusters))
+
+
+def make_svm(C: float = 1.0, gamma: float | str = "scale") -> Pipeline:
+    """The model's classifier: standardisation, then a multi-class (one-vs-one) RBF support vector machine.
+
+    Args:
+        C: Regularisation (larger fits the training rows more closely), > 0.
+        gamma: RBF kernel coefficient [1 / (standardised feature unit)^2], ``"scale"``, ``"auto"`` or > 0.
+    """
+    return make_pipeline(StandardScaler(), SVC(C=C, gamma=gamma, kernel="rbf"))
+
+
+def svm_cv_accuracy(
+    X: ArrayLike,
+    y: ArrayLike,
+    *,
+    n_splits: int = 5,
+    C: float = 1.0,
+    gamma: float | str = "scale",
+    random_state: int | None = 0,
+) -> float:
+    """Mean stratified k-fold accuracy of :func:`make_svm` predicting ``y`` from ``X``, in [0, 1].
+
+    Args:
+        X: Features, (n, d).
+        y: Classes, (n,); every class needs at least ``n_splits`` members.
+        n_splits: Folds.
+        C: SVM regularisation.
+        gamma: RBF kernel coefficient.
+        random_state: Seed of the fold shuffling.
+    """
+    X = np.asarray(X, dtype=np.float64)
+    y = np.asarray(y)
+    if X.ndim != 2 or y.shape != (X.shape[0],):
+        raise ValueError(f"X must be (n, d) and y (n,), got shapes {X.shape} and {y.shape}.")
+    classes, counts = np.unique(y, return_counts=True)
+    if classes.size < 2:
+        raise ValueError(f"y needs at least 2 classes for an SVM, got only {classes.tolist()}.")
+    if counts.min() < n_splits:
+        raise ValueError(
+            f"every class needs at least n_splits={n_splits} members for stratified folds; class "
+            f"{classes[np.argmin(counts)]!r} has {counts.min()}."
+        )
+    folds = StratifiedKFold(n_splits=n_splits, shuffle=True, random_state=random_state)
+    return float(np.mean(cross_val_score(make_svm(C, gamma), X, y, cv=folds)))

@@ -1,69 +1,140 @@
 """The paper's learning model for one behaviour: SOM of effects -> ReliefF -> SVM.
 
-``fit(X_initial, E_effect)`` (scikit-learn's ``fit(X, y)``, with the effects as ``y``):
+Akgun et al. 2009, section IV, as a scikit-learn estimator. ``fit(X, y)`` takes the initial features as ``X``
+and the effects E (final minus initial features) as ``y``; scikit-learn's contract names the second argument
+``y``, and E plays its role:
 
-1. standardise the effects (each effect dimension to zero mean and unit variance; constant dimensions stay 0);
-2. cluster them with a 1 x k self-organising map: the cluster of each interaction is its effect category;
-3. weigh the initial features with ReliefF against those categories, keep the features whose weight exceeds
-   ``relevancy`` x the largest weight (always at least the best one): perceptual economy;
-4. train a multi-class RBF SVM (on standardised selected features) to predict the category from the object's
-   look before the interaction.
+1. standardise the effects (each effect dimension to zero mean and unit variance; a constant dimension is
+   only centred, so it stays 0 rather than becoming NaN);
+2. cluster them with a 1 x k self-organising map (:class:`SOMClustering`): the map node of each interaction
+   is its effect category;
+3. standardise the initial features and weigh them with ReliefF (:func:`relieff_weights`) by how well they
+   separate the categories; keep the features whose weight exceeds ``relevancy`` x the largest weight, and
+   always at least the best one (:func:`select_features`): perceptual economy;
+4. train a multi-class RBF SVM (standardisation + ``SVC``, :func:`make_svm`) to predict the category from the
+   selected initial features.
 
-``predict_effect(X)`` answers with the category and the category's prototype effect: the mean effect of its
-training members, in the effect's own units.
+``predict(X)`` gives the categories; ``predict_effect(X)`` also what each category's effect looks like: its
+prototype, the mean effect of the category's training interactions in the effect's own units.
+
+If the map puts every interaction in one node there is nothing to separate: every feature weight is 0 (so
+the selection rule keeps only the first feature, unused), no SVM is trained, and ``predict`` answers that
+single category for every row.
 """
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 from sklearn.base import BaseEstimator
-from sklearn.pipeline import make_pipeline
+from sklearn.pipeline import Pipeline
 from sklearn.preprocessing import StandardScaler
-from sklearn.svm import SVC
-from sklearn.utils.validation import check_is_fitted, check_random_state, validate_data
+from sklearn.utils import Tags
+from sklearn.utils.validation import check_is_fitted, validate_data
 
-from affordance_learning.relieff import relieff_weights
-from affordance_learning.som import SOMClustering
+from affordance_learning.metrics import make_svm
+from affordance_learning.relieff import MULTICLASS_THRESHOLD, relieff_weights
+from affordance_learning.som import SOMClustering, som_seed
 
 
 @dataclass(frozen=True)
 class EffectPrediction:
-    """What :meth:`AffordanceModel.predict_effect` predicts.
+    """What :meth:`AffordanceModel.predict_effect` predicts for n rows of initial features.
 
     Attributes:
-        category: Effect category of each row, (n,) int.
-        effect: Prototype effect of that category, (n, n_effects), in the effect's units.
+        category: Effect category (map node index) of each row, (n,) int.
+        effect: Prototype effect of that category, (n, n_effects) float, in the effect's own units (for the
+            49 features of this project: final minus initial feature, in each feature's unit).
     """
 
     category: np.ndarray
     effect: np.ndarray
 
 
-class AffordanceModel(BaseEstimator):
-    """Unsupervised affordance learning of Akgun et al. (2009) for one behaviour.
+def select_features(weights: ArrayLike, relevancy: float) -> np.ndarray:
+    """Indices of the features whose weight exceeds ``relevancy`` x the largest weight, plus the best one.
+
+    The paper's relevancy threshold. With ``relevancy = 0`` the features of positive weight are kept. When
+    no weight passes the threshold (for example all weights <= 0, or ``relevancy = 1``) only the feature of
+    largest weight (the first one on a tie) is kept, so the classifier always has an input.
 
     Args:
-        n_clusters: Nodes of the 1 x k self-organising map of effects (k >= 1; k = 1 is one category).
-        relevancy: Relevancy threshold r in [0, 1]: keep the features whose ReliefF weight exceeds r x the largest
-            weight.
-        n_neighbors: ReliefF's nearest hits and misses per class.
-        som_iterations: Training iterations of the map.
-        svm_C: Regularisation of the SVM.
-        svm_gamma: RBF width of the SVM (``"scale"`` or a positive float).
-        random_state: Seed of the map (initial weights and training order).
+        weights: ReliefF weight of every feature, (d,).
+        relevancy: Threshold r in [0, 1] (dimensionless).
 
-    Fitted attributes:
-        labels_: Effect category of each training row.
-        n_categories_: Number of categories that hold training rows.
-        feature_weights_: ReliefF weight of every initial feature.
-        selected_features_: Indices of the kept initial features.
-        selected_feature_names_: Their names (``feature_names_in_`` when X had column names, else ``x0``, ...).
-        cluster_effects_: (n_clusters, n_effects) prototype effect of each category (the mean effect of its
-            members; the map node, in effect units, for a node that won no row).
-        effect_names_: Names of the effect dimensions (E's columns, or ``e0``, ...).
-        som_: The fitted :class:`SOMClustering`; effect_scaler_: its standardisation; svm_: the classifier.
+    Returns:
+        Sorted feature indices, (m,) int, 1 <= m <= d.
+    """
+    weights = np.asarray(weights, dtype=np.float64)
+    if weights.ndim != 1 or weights.size == 0 or not np.all(np.isfinite(weights)):
+        raise ValueError(
+            f"weights must be a non-empty 1-D array of finite numbers, got shape {weights.shape}."
+        )
+    relevancy = _check_relevancy(relevancy)
+    best = int(np.argmax(weights))
+    kept = np.flatnonzero(weights > relevancy * weights[best])
+    return np.union1d(kept, [best]).astype(np.intp)
+
+
+def _check_relevancy(relevancy: object) -> float:
+    if (
+        isinstance(relevancy, bool)
+        or not isinstance(relevancy, numbers.Real)
+        or not np.isfinite(relevancy)
+        or not 0.0 <= float(relevancy) <= 1.0
+    ):
+        raise ValueError(
+            f"relevancy must be a number in [0, 1] (a share of the largest weight), got {relevancy!r}."
+        )
+    return float(relevancy)
+
+
+def _check_int(name: str, value: object, low: int, high: int | None = None) -> int:
+    if (
+        isinstance(value, bool)
+        or not isinstance(value, numbers.Integral)
+        or value < low
+        or (high is not None and value > high)
+    ):
+        bound = f"in [{low}, {high}]" if high is not None else f">= {low}"
+        raise ValueError(f"{name} must be an integer {bound}, got {value!r}.")
+    return int(value)
+
+
+class AffordanceModel(BaseEstimator):
+    """Unsupervised affordance learning of Akgun et al. (2009) for one behaviour (see the module docstring).
+
+    Args:
+        n_clusters: Nodes k of the 1 x k self-organising map of effects, in [2, 10] (ReliefF is replicated
+            for at most 10 classes).
+        relevancy: Relevancy threshold r in [0, 1]: keep the features whose ReliefF weight exceeds r x the
+            largest weight (always at least the best one).
+        n_neighbors: ReliefF's nearest hits, and nearest misses per other category, >= 1.
+        som_iterations: Training steps of the map (one effect each), >= 1.
+        svm_C: SVM regularisation, > 0.
+        svm_gamma: RBF kernel coefficient of the SVM on standardised features: ``"scale"``, ``"auto"`` or > 0.
+        random_state: Seed of the map (initial weights and training order): int, generator or None.
+
+    Attributes:
+        labels_: Effect category (map node) of each training row, (n_samples,) int.
+        cluster_sizes_: Training rows in each category, (n_clusters,) int; a node can stay empty.
+        cluster_effects_: Prototype effect of each category, (n_clusters, n_effects), in the effect's units:
+            the mean effect of its training rows; for an empty node (never predicted) its map weight, brought
+            back to the effect's units.
+        feature_weights_: ReliefF weight of every initial feature, (n_features,).
+        selected_features_: Indices of the kept initial features, sorted, (m,) int.
+        selected_feature_names_: Their names: ``feature_names_in_`` when X had string column names, else
+            ``"x0"`` ... ``"x{d-1}"``.
+        n_features_in_: Number of initial features.
+        feature_names_in_: Initial feature names, when X had string column names.
+        n_effects_: Number of effect dimensions (1 when E was 1-D).
+        effect_names_: Effect names, when E had string column names (a DataFrame or a named Series).
+        effect_scaler_: The fitted standardisation of the effects.
+        som_: The fitted :class:`SOMClustering` (on standardised effects).
+        classifier_: The fitted SVM pipeline on the selected features; None with a single category.
     """
 
     def __init__(
@@ -71,10 +142,10 @@ class AffordanceModel(BaseEstimator):
         n_clusters: int = 2,
         relevancy: float = 0.4,
         n_neighbors: int = 10,
-        som_iterations: int = 2000,
-        svm_C: float = 10.0,
-        svm_gamma="scale",
-        random_state=None,
+        som_iterations: int = 5000,
+        svm_C: float = 1.0,
+        svm_gamma: float | str = "scale",
+        random_state: int | np.random.RandomState | np.random.Generator | None = None,
     ) -> None:
         self.n_clusters = n_clusters
         self.relevancy = relevancy
@@ -85,95 +156,130 @@ class AffordanceModel(BaseEstimator):
         self.random_state = random_state
 
     def _check_params(self) -> None:
-        if not isinstance(self.n_clusters, int | np.integer) or self.n_clusters < 1:
-            raise ValueError(f"n_clusters must be an integer >= 1, got {self.n_clusters!r}.")
-        if not isinstance(self.relevancy, int | float | np.number) or not 0.0 <= float(self.relevancy) <= 1.0:
-            raise ValueError(f"relevancy must be a number in [0, 1], got {self.relevancy!r}.")
-        if not isinstance(self.n_neighbors, int | np.integer) or self.n_neighbors < 1:
-            raise ValueError(f"n_neighbors must be a positive integer, got {self.n_neighbors!r}.")
+        _check_int("n_clusters", self.n_clusters, 2, MULTICLASS_THRESHOLD)
+        _check_relevancy(self.relevancy)
+        _check_int("n_neighbors", self.n_neighbors, 1)
+        _check_int("som_iterations", self.som_iterations, 1)
+        C = self.svm_C
+        if isinstance(C, bool) or not isinstance(C, numbers.Real) or not np.isfinite(C) or C <= 0:
+            raise ValueError(f"svm_C must be a finite number > 0, got {C!r}.")
+        gamma = self.svm_gamma
+        if isinstance(gamma, str):
+            if gamma not in ("scale", "auto"):
+                raise ValueError(f"svm_gamma must be 'scale', 'auto' or a number > 0, got {gamma!r}.")
+        elif (
+            isinstance(gamma, bool)
+            or not isinstance(gamma, numbers.Real)
+            or not np.isfinite(gamma)
+            or gamma <= 0
+        ):
+            raise ValueError(f"svm_gamma must be 'scale', 'auto' or a number > 0, got {gamma!r}.")
 
-    def fit(self, X, y):
-        """Learn effect categories from the effects and their prediction from the initial features.
+    def fit(self, X: ArrayLike, y: ArrayLike) -> AffordanceModel:
+        """Learn effect categories from the effects, and their prediction from the initial features.
 
         Args:
-            X: Initial features, (n, n_features), array or DataFrame.
-            y: Effects, (n, n_effects) or (n,), array or DataFrame (named ``y`` for scikit-learn's contract).
+            X: Initial features, (n_samples, n_features), array or DataFrame, finite.
+            y: Effects E, (n_samples, n_effects) or (n_samples,) for a single effect, array or DataFrame,
+                finite; in any units (they are standardised).
+
+        Returns:
+            self.
         """
         self._check_params()
-        effect_columns = getattr(y, "columns", None)
+        effect_names = _column_names(y)
         X, E = validate_data(self, X, y, multi_output=True, y_numeric=True, dtype=np.float64)
         E = np.asarray(E, dtype=np.float64)
         if E.ndim == 1:
             E = E[:, None]
-        self.effect_names_ = (
-            [str(c) for c in effect_columns] if effect_columns is not None else [f"e{i}" for i in range(E.shape[1])]
-        )
-        rng = check_random_state(self.random_state)
-        seed = int(rng.randint(0, 2**31 - 1))
+        self.n_effects_ = E.shape[1]
+        if effect_names is not None:
+            self.effect_names_ = np.asarray(effect_names, dtype=object)
 
         self.effect_scaler_ = StandardScaler().fit(E)
-        Z = self.effect_scaler_.transform(E)
-        self.som_ = SOMClustering(self.n_clusters, n_iterations=self.som_iterations, random_state=seed).fit(Z)
+        self.som_ = SOMClustering(
+            n_clusters=self.n_clusters,
+            n_iterations=self.som_iterations,
+            random_state=som_seed(self.random_state),
+        ).fit(self.effect_scaler_.transform(E))
         labels = self.som_.labels_
         self.labels_ = labels
-        categories = np.unique(labels)
-        self.n_categories_ = len(categories)
+        self.cluster_sizes_ = np.bincount(labels, minlength=self.n_clusters).astype(np.int64)
         nodes = self.effect_scaler_.inverse_transform(self.som_.cluster_centers_)
         self.cluster_effects_ = np.array(
-            [E[labels == c].mean(axis=0) if np.any(labels == c) else nodes[c] for c in range(self.n_clusters)]
+            [
+                E[labels == c].mean(axis=0) if self.cluster_sizes_[c] else nodes[c]
+                for c in range(self.n_clusters)
+            ]
         )
 
-        n_features = X.shape[1]
-        if self.n_categories_ >= 2 and len(X) >= 3:
-            k = int(min(self.n_neighbors, len(X) - 1))
-            self.feature_weights_ = relieff_weights(X, labels, n_neighbors=k)
-        else:  # one category: nothing to separate
-            self.feature_weights_ = np.zeros(n_features)
-        best = int(np.argmax(self.feature_weights_))
-        top = self.feature_weights_[best]
-        selected = np.flatnonzero(self.feature_weights_ > float(self.relevancy) * top) if top > 0 else np.array([])
-        self.selected_features_ = np.union1d(selected, [best]).astype(int)
-        names = list(getattr(self, "feature_names_in_", [f"x{i}" for i in range(n_features)]))
-        self.selected_feature_names_ = [str(names[i]) for i in self.selected_features_]
-
-        if self.n_categories_ >= 2:
-            self.svm_ = make_pipeline(
-                StandardScaler(), SVC(C=self.svm_C, gamma=self.svm_gamma, random_state=seed)
-            ).fit(X[:, self.selected_features_], labels)
-        else:  # a single category: every prediction is that category
-            self.svm_ = None
-        self.single_category_ = int(categories[0])
+        names = getattr(self, "feature_names_in_", None)
+        if names is None:
+            names = np.array([f"x{i}" for i in range(X.shape[1])], dtype=object)
+        categories = np.flatnonzero(self.cluster_sizes_)
+        if categories.size >= 2:
+            standardised = StandardScaler().fit_transform(X)
+            self.feature_weights_ = relieff_weights(standardised, labels, n_neighbors=self.n_neighbors)
+            self.selected_features_ = select_features(self.feature_weights_, self.relevancy)
+            self.classifier_: Pipeline | None = make_svm(self.svm_C, self.svm_gamma).fit(
+                X[:, self.selected_features_], labels
+            )
+        else:
+            self.feature_weights_ = np.zeros(X.shape[1])
+            self.selected_features_ = select_features(self.feature_weights_, self.relevancy)
+            self.classifier_ = None
+        self.selected_feature_names_ = np.asarray(names, dtype=object)[self.selected_features_]
         return self
 
-    def _transform(self, X) -> np.ndarray:
-        check_is_fitted(self, "selected_features_")
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """Effect category of each row of initial features ``X`` (n_samples, n_features): (n_samples,) int."""
+        check_is_fitted(self)
         X = validate_data(self, X, reset=False, dtype=np.float64)
-        return X[:, self.selected_features_]
+        if self.classifier_ is None:
+            return np.full(X.shape[0], int(np.argmax(self.cluster_sizes_)), dtype=np.int64)
+        return self.classifier_.predict(X[:, self.selected_features_]).astype(np.int64)
 
-    def predict(self, X) -> np.ndarray:
-        """Effect category of each row of ``X`` (initial features)."""
-        Xs = self._transform(X)
-        if self.svm_ is None:
-            return np.full(len(Xs), self.single_category_, dtype=int)
-        return self.svm_.predict(Xs).astype(int)
-
-    def predict_effect(self, X) -> EffectPrediction:
+    def predict_effect(self, X: ArrayLike) -> EffectPrediction:
         """Effect category and its prototype effect (in the effect's units) for each row of ``X``."""
         category = self.predict(X)
         return EffectPrediction(category=category, effect=self.cluster_effects_[category])
 
-    def score(self, X, y) -> float:
-        """Accuracy of the categories predicted from ``X`` against those the map gives the effects ``y``."""
-        predicted = self.predict(X)
+    def categorize_effects(self, y: ArrayLike) -> np.ndarray:
+        """Category the fitted map gives observed effects ``y`` (n_samples, n_effects) or (n_samples,)."""
+        check_is_fitted(self)
         E = np.asarray(y, dtype=np.float64)
         if E.ndim == 1:
             E = E[:, None]
-        target = self.som_.predict(self.effect_scaler_.transform(E))
-        return float(np.mean(predicted == target))
+        if E.ndim != 2 or E.shape[1] != self.n_effects_:
+            raise ValueError(f"effects must have {self.n_effects_} column(s), got shape {np.shape(y)}.")
+        if not np.all(np.isfinite(E)):
+            raise ValueError("effects contain NaN or inf; expected finite values.")
+        return self.som_.predict(self.effect_scaler_.transform(E))
 
-    def __sklearn_tags__(self):
+    def score(self, X: ArrayLike, y: ArrayLike) -> float:
+        """Accuracy in [0, 1] of the categories predicted from ``X`` against those of the effects ``y``."""
+        predicted = self.predict(X)
+        observed = self.categorize_effects(y)
+        if observed.shape != predicted.shape:
+            raise ValueError(f"X has {predicted.size} rows but y has {observed.size}.")
+        return float(np.mean(predicted == observed))
+
+    def __sklearn_tags__(self) -> Tags:
+        """scikit-learn's tags: the effects (``y``) are required and may have one or many columns."""
         tags = super().__sklearn_tags__()
         tags.target_tags.required = True
-        tags.target_tags.multi_output = True
         tags.target_tags.single_output = True
+        tags.target_tags.multi_output = True
         return tags
+
+
+def _column_names(y: object) -> list[str] | None:
+    """String column names of a DataFrame, or the name of a named Series; None otherwise."""
+    columns = getattr(y, "columns", None)
+    if columns is not None:
+        names = list(columns)
+        return [str(c) for c in names] if all(isinstance(c, str) for c in names) else None
+    name = getattr(y, "name", None)
+    if getattr(y, "ndim", None) == 1 and isinstance(name, str):
+        return [name]
+    return None

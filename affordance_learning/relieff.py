@@ -53,7 +53,7 @@ DISCRETE_THRESHOLD = 10
 #: skrebate's default: more distinct labels than this make the endpoint continuous (not replicated here).
 MULTICLASS_THRESHOLD = 10
 #: Number of (instance, neighbour) pairs whose feature differences are held in memory at once.
-_PAIR_CHUNK = 16384
+_PAIR_CHUNK = 32768
 
 DataType = Literal["continuous", "discrete", "mixed"]
 
@@ -80,7 +80,7 @@ def _check_features(X: ArrayLike) -> np.ndarray:
     if bad.any():
         row, col = np.argwhere(bad)[0]
         raise ValueError(
-            f"X has {int(bad.sum())} non-finite value(s), the first X[{row}, {col}] = {X[row, col]!r}; "
+            f"X has {int(bad.sum())} non-finite value(s), the first X[{row}, {col}] = {float(X[row, col])}; "
             "missing data (skrebate's NaN handling) is not replicated, expected finite values."
         )
     return X
@@ -123,7 +123,7 @@ class ReliefFScorer:
         self._ranks: dict[int, np.ndarray] = {}
 
     def _distance_matrix(self) -> np.ndarray:
-        """Instance distances exactly as skrebate's ``_distarray_no_missing``, self-distance ``sys.maxsize``."""
+        """Instance distances as skrebate's ``_distarray_no_missing``, self-distance ``sys.maxsize``."""
         cidx = np.flatnonzero(~self.discrete)
         didx = np.flatnonzero(self.discrete)
         if self.data_type == "discrete":
@@ -162,28 +162,43 @@ class ReliefFScorer:
                 cols.append(np.tile(members, n))
                 continue
             sub = self.distances[:, members]
-            part = np.partition(sub, (k - 1, k), axis=1)
-            kth = part[:, k - 1]
-            chosen = sub <= kth[:, None]
-            for i in np.flatnonzero(part[:, k] == kth):
+            nearest = np.argpartition(sub, (k - 1, k), axis=1)
+            edge = np.take_along_axis(sub, nearest[:, k - 1 : k + 1], axis=1)
+            chosen = nearest[:, :k]
+            for i in np.flatnonzero(edge[:, 0] == edge[:, 1]):
                 # A tie across the k-th place: rank as skrebate's argsort of the whole row does.
-                member_ranks = self._rank_row(int(i))[members]
-                chosen[i] = False
-                chosen[i, np.argsort(member_ranks)[:k]] = True
-            r, j = np.nonzero(chosen)
-            rows.append(r)
-            cols.append(members[j])
+                chosen[i] = np.argsort(self._rank_row(int(i))[members])[:k]
+            rows.append(np.repeat(np.arange(n), k))
+            cols.append(members[chosen].ravel())
         return np.concatenate(rows), np.concatenate(cols)
 
-    def _pair_differences(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-        """skrebate's per-feature difference of each pair, (n_pairs, n_features), in [0, 1]."""
-        a, b = self.X[rows], self.X[cols]
-        raw = np.abs(a - b)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            scaled = raw / self.range
-        if self.data_type == "mixed":
-            scaled = np.where(raw > self.std, 1.0, scaled)
-        return np.where(self.discrete, (a != b).astype(np.float64), scaled)
+    def _weighted_differences(
+        self, pair_weight: np.ndarray, rows: np.ndarray, cols: np.ndarray
+    ) -> np.ndarray:
+        """``sum over pairs of pair_weight x (skrebate's difference of the pair)`` per feature, (n_features,).
+
+        A pair's difference is 0 or 1 for a discrete feature (values differ), ``|a - b| / (max - min)`` for a
+        continuous one, and 1 instead when the data are mixed and ``|a - b|`` exceeds the feature's standard
+        deviation.
+        """
+        total = np.zeros(self.n_features)
+        cont = ~self.discrete
+        for start in range(0, rows.size, _PAIR_CHUNK):
+            stop = start + _PAIR_CHUNK
+            raw = np.take(self.X, rows[start:stop], axis=0)
+            raw -= np.take(self.X, cols[start:stop], axis=0)
+            np.abs(raw, out=raw)
+            w = pair_weight[start:stop]
+            if self.data_type != "discrete":
+                spread = raw[:, cont]
+                if self.data_type == "mixed":
+                    spread = np.where(spread > self.std[cont], self.range[cont], spread)
+                total[cont] += w @ spread
+            if self.data_type != "continuous":
+                # Exact for finite floats: a - b == 0 exactly when a == b.
+                total[self.discrete] += w @ (raw[:, self.discrete] != 0).astype(np.float64)
+        total[cont] /= self.range[cont]
+        return total
 
     def weights(self, y: ArrayLike, n_neighbors: int = 10) -> np.ndarray:
         """ReliefF weight of every feature for the labels ``y``.
@@ -193,12 +208,16 @@ class ReliefFScorer:
             n_neighbors: Nearest hits, and nearest misses per other class, used for each instance.
 
         Returns:
-            Weights, (n_features,), each in [-1, 1] (dimensionless); larger means more relevant.
+            Weights, (n_features,), dimensionless; larger means more relevant. In [-1, 1] for two classes;
+            with C classes skrebate's miss normalisation can reach up to C - 1 when a class has fewer
+            members than ``n_neighbors``.
         """
         k = _check_n_neighbors(n_neighbors)
         y = np.asarray(y)
         if y.ndim != 1 or y.shape[0] != self.n_samples:
-            raise ValueError(f"y must be 1-D with one label per row of X ({self.n_samples}), got shape {y.shape}.")
+            raise ValueError(
+                f"y must be 1-D with one label per row of X ({self.n_samples}), got shape {y.shape}."
+            )
         if y.dtype.kind == "f" and np.isnan(y).any():
             raise ValueError("y contains NaN; expected a class label for every instance.")
         classes, codes = np.unique(y, return_inverse=True)
@@ -207,8 +226,8 @@ class ReliefFScorer:
             raise ValueError(f"ReliefF needs at least 2 classes, but every label is {classes[0]!r}.")
         if n_classes > MULTICLASS_THRESHOLD:
             raise ValueError(
-                f"y has {n_classes} classes; skrebate treats more than {MULTICLASS_THRESHOLD} distinct labels as "
-                "a continuous endpoint, which is not replicated here. Expected 2 to 10 classes."
+                f"y has {n_classes} classes; skrebate treats more than {MULTICLASS_THRESHOLD} distinct "
+                "labels as a continuous endpoint, which is not replicated here. Expected 2 to 10 classes."
             )
         rows, cols = self._neighbour_pairs(codes, n_classes, k)
         hit = codes[rows] == codes[cols]
@@ -220,22 +239,20 @@ class ReliefFScorer:
                 n_misses = np.bincount(rows[~hit], minlength=n).astype(np.float64)
                 miss_weight = 1.0 / n_misses[rows]
             else:
-                per_class = np.bincount(rows * n_classes + codes[cols], minlength=n * n_classes).reshape(n, -1)
+                per_class = np.bincount(rows * n_classes + codes[cols], minlength=n * n_classes).reshape(
+                    n, -1
+                )
                 per_class[np.arange(n), codes] = 0
                 n_misses = per_class.sum(axis=1).astype(np.float64)
                 miss_weight = per_class[rows, codes[cols]] * (n_classes - 1) / n_misses[rows] ** 2
         pair_weight = np.where(hit, hit_weight, miss_weight)
-        scores = np.zeros(self.n_features)
-        for start in range(0, rows.size, _PAIR_CHUNK):
-            stop = start + _PAIR_CHUNK
-            scores += pair_weight[start:stop] @ self._pair_differences(rows[start:stop], cols[start:stop])
-        return scores / n
+        return self._weighted_differences(pair_weight, rows, cols) / n
 
 
 def relieff_weights(
     X: ArrayLike, y: ArrayLike, n_neighbors: int = 10, *, discrete_threshold: int = DISCRETE_THRESHOLD
 ) -> np.ndarray:
-    """ReliefF weights of the features of ``X`` for the class labels ``y``, as ``skrebate.ReliefF`` gives them.
+    """ReliefF weights of the features of ``X`` for the class labels ``y``, as skrebate's ``ReliefF``.
 
     Equal to ``skrebate.ReliefF(n_neighbors=n_neighbors).fit(X, y).feature_importances_`` to about 1e-15
     relative, for finite data with continuous and/or discrete features and 2 to 10 classes; see the module
@@ -248,7 +265,8 @@ def relieff_weights(
         discrete_threshold: Features with at most this many distinct values are discrete.
 
     Returns:
-        Weights, (n_features,), each in [-1, 1] (dimensionless).
+        Weights, (n_features,), dimensionless: in [-1, 1] for two classes, up to C - 1 with C classes when a
+        class has fewer members than ``n_neighbors`` (see :meth:`ReliefFScorer.weights`).
     """
     return ReliefFScorer(X, discrete_threshold=discrete_threshold).weights(y, n_neighbors)
 

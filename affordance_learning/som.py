@@ -1,34 +1,80 @@
-"""A 1 x k Kohonen self-organising map (minisom) as a scikit-learn clusterer."""
+"""A 1 x k Kohonen self-organising map (minisom) as a scikit-learn clusterer.
+
+Akgun et al. 2009, section IV: the effects are clustered with a self-organising map of 1-D neighbourhood;
+its number of nodes k is a parameter of the model, and every node is an effect category.
+"""
 
 from __future__ import annotations
 
+import numbers
+
 import numpy as np
 from minisom import MiniSom
+from numpy.typing import ArrayLike
 from sklearn.base import BaseEstimator, ClusterMixin
-from sklearn.utils.validation import check_is_fitted, check_random_state, validate_data
+from sklearn.utils.validation import check_is_fitted, validate_data
+
+#: Largest seed minisom's ``numpy.random.RandomState`` accepts.
+_MAX_SEED = 2**32 - 1
+
+
+def som_seed(random_state: int | np.random.RandomState | np.random.Generator | None) -> int | None:
+    """The ``random_seed`` handed to minisom for a scikit-learn style ``random_state``.
+
+    An integer is used as it is (so ``SOMClustering(random_state=s)`` trains exactly as
+    ``MiniSom(..., random_seed=s)``); a generator gives a seed drawn from it; None gives None (fresh entropy).
+    """
+    if random_state is None:
+        return None
+    if isinstance(random_state, numbers.Integral) and not isinstance(random_state, bool):
+        if not 0 <= int(random_state) <= _MAX_SEED:
+            raise ValueError(f"random_state must be an integer in [0, 2**32 - 1], got {random_state!r}.")
+        return int(random_state)
+    if isinstance(random_state, np.random.RandomState):
+        return int(random_state.randint(0, 2**31 - 1))
+    if isinstance(random_state, np.random.Generator):
+        return int(random_state.integers(0, 2**31 - 1))
+    raise ValueError(
+        f"random_state must be None, an integer, a numpy RandomState or Generator, got {random_state!r}."
+    )
 
 
 class SOMClustering(ClusterMixin, BaseEstimator):
-    """Cluster rows with a one-dimensional (1 x ``n_clusters``) self-organising map.
+    """Cluster rows with a one-dimensional (1 x ``n_clusters``) self-organising map, trained by minisom.
 
-    Each map node is a cluster; a row belongs to its best-matching node. Nodes that win no training row stay
-    empty, so ``labels_`` may use fewer than ``n_clusters`` values.
+    The map's node weights start at random unit vectors and are trained for ``n_iterations`` steps of one
+    row each, the rows taken in a random order (minisom's ``train(random_order=True)``); the initial weights
+    and the order both come from minisom's ``random_seed``, which ``random_state`` sets. Learning rate and
+    neighbourhood radius decay as ``value / (1 + 2 t / n_iterations)`` (minisom's asymptotic decay); the
+    neighbourhood is Gaussian over the node index.
+
+    Every node is a cluster, and a row belongs to the node nearest to it (Euclidean). Node indices follow the
+    map, so neighbouring clusters hold similar rows; a node that wins no training row stays empty, so
+    ``labels_`` may skip values.
 
     Args:
-        n_clusters: Number of map nodes, k >= 1.
-        n_iterations: Training iterations (one random row each).
-        sigma: Neighbourhood radius at the start [nodes]; default ``max(k / 4, 0.5)``.
-        learning_rate: Initial learning rate.
-        random_state: Seed of the initial weights and of the order of training rows.
+        n_clusters: Number of map nodes k, >= 1 (the learning model uses k >= 2).
+        n_iterations: Training steps (one row each), >= 1.
+        sigma: Initial radius of the Gaussian neighbourhood [nodes], > 0.
+        learning_rate: Initial learning rate, > 0.
+        random_state: Seed of the initial weights and of the training order (int, generator or None).
+
+    Attributes:
+        cluster_centers_: Node weights, (n_clusters, n_features), in the units of ``X``.
+        labels_: Node of each training row, (n_samples,) int.
+        quantization_error_: Mean distance of the training rows to their node, in the units of ``X``.
+        n_iter_: Training steps run.
+        n_features_in_: Number of features seen in ``fit``.
+        feature_names_in_: Column names, when ``X`` has string column names.
     """
 
     def __init__(
         self,
         n_clusters: int = 2,
-        n_iterations: int = 2000,
-        sigma: float | None = None,
+        n_iterations: int = 5000,
+        sigma: float = 1.0,
         learning_rate: float = 0.5,
-        random_state=None,
+        random_state: int | np.random.RandomState | np.random.Generator | None = None,
     ) -> None:
         self.n_clusters = n_clusters
         self.n_iterations = n_iterations
@@ -36,30 +82,50 @@ class SOMClustering(ClusterMixin, BaseEstimator):
         self.learning_rate = learning_rate
         self.random_state = random_state
 
-    def fit(self, X, y=None):
-        """Train the map on ``X`` (n, d) and label every row."""
+    def _check_params(self) -> None:
+        for name, low in (("n_clusters", 1), ("n_iterations", 1)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
+                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}.")
+        for name in ("sigma", "learning_rate"):
+            value = getattr(self, name)
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, numbers.Real)
+                or not np.isfinite(value)
+                or value <= 0
+            ):
+                raise ValueError(f"{name} must be a finite number > 0, got {value!r}.")
+
+    def fit(self, X: ArrayLike, y: object = None) -> SOMClustering:
+        """Train the map on the rows of ``X`` (n_samples, n_features) and label them; returns ``self``.
+
+        ``y`` is ignored (present for the scikit-learn API).
+        """
+        self._check_params()
         X = validate_data(self, X, dtype=np.float64)
-        if not isinstance(self.n_clusters, int | np.integer) or self.n_clusters < 1:
-            raise ValueError(f"n_clusters must be an integer >= 1, got {self.n_clusters!r}.")
-        if not isinstance(self.n_iterations, int | np.integer) or self.n_iterations < 1:
-            raise ValueError(f"n_iterations must be a positive integer, got {self.n_iterations!r}.")
-        rng = check_random_state(self.random_state)
-        seed = int(rng.integers(0, 2**31 - 1)) if hasattr(rng, "integers") else int(rng.randint(0, 2**31 - 1))
-        sigma = max(self.n_clusters / 4.0, 0.5) if self.sigma is None else float(self.sigma)
-        som = MiniSom(1, int(self.n_clusters), X.shape[1], sigma=sigma, learning_rate=self.learning_rate,
-                      random_seed=seed)
-        som.random_weights_init(X)
-        # One random row per iteration, drawn from the seeded generator (as minisom's train(random_order=True)).
-        order = np.random.default_rng(seed).integers(0, X.shape[0], int(self.n_iterations))
-        for t, row in enumerate(order):
-            som.update(X[row], som.winner(X[row]), t, int(self.n_iterations))
-        self.cluster_centers_ = som.get_weights()[0].copy()
-        self.labels_ = self.predict(X)
+        som = MiniSom(
+            1,
+            int(self.n_clusters),
+            X.shape[1],
+            sigma=float(self.sigma),
+            learning_rate=float(self.learning_rate),
+            random_seed=som_seed(self.random_state),
+        )
+        som.train(X, int(self.n_iterations), random_order=True)
+        self.cluster_centers_ = np.array(som.get_weights()[0], dtype=np.float64)
+        distances = self._distances(X)
+        self.labels_ = np.argmin(distances, axis=1).astype(np.int64)
+        self.quantization_error_ = float(distances[np.arange(len(X)), self.labels_].mean())
+        self.n_iter_ = int(self.n_iterations)
         return self
 
-    def predict(self, X) -> np.ndarray:
-        """Index of the best-matching node of every row of ``X``."""
-        check_is_fitted(self, "cluster_centers_")
+    def _distances(self, X: np.ndarray) -> np.ndarray:
+        """Euclidean distance of every row to every node, (n_samples, n_clusters), in the units of ``X``."""
+        return np.linalg.norm(X[:, None, :] - self.cluster_centers_[None, :, :], axis=-1)
+
+    def predict(self, X: ArrayLike) -> np.ndarray:
+        """Nearest node of every row of ``X``, (n_samples,) int."""
+        check_is_fitted(self)
         X = validate_data(self, X, dtype=np.float64, reset=False)
-        d2 = ((X[:, None, :] - self.cluster_centers_[None, :, :]) ** 2).sum(axis=2)
-        return np.argmin(d2, axis=1)
+        return np.argmin(self._distances(X), axis=1).astype(np.int64)

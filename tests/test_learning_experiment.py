@@ -1,104 +1,228 @@
-"""The paper's protocol, figures and report on data with a known answer; predict_effect's shipped model."""
+"""The paper's protocol on a dataset frame, its figures and its report."""
 
+from __future__ import annotations
+
+import copy
 import json
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
-from affordance_env.features import FEATURE_NAMES
-from affordance_learning.experiment import run_protocol
-from affordance_learning.figures import write_figures
-from affordance_learning.report import write_report
+from affordance_learning import run_protocol, write_figures, write_report
+from affordance_learning.experiment import feature_groups, feature_names, make_synthetic_frame
+from affordance_learning.report import AGREES, DISAGREES, NOT_COMPUTABLE, evaluate_claims
 
-
-def synthetic_frame(n=120, seed=0) -> pd.DataFrame:
-    """Rolling objects (sphere-like shape features) move far; others barely: a miniature of the tap data."""
-    rng = np.random.default_rng(seed)
-    types = rng.choice(["sphere", "box", "horizontal_cylinder", "vertical_cylinder"], n)
-    rolls = np.isin(types, ["sphere", "horizontal_cylinder"])
-    initial = rng.normal(size=(n, len(FEATURE_NAMES)))
-    initial[:, 3] += 3.0 * rolls  # a shape feature tells rolling objects apart
-    effect = rng.normal(scale=0.1, size=(n, len(FEATURE_NAMES)))
-    effect[:, 24:28] += np.where(rolls, -5.0, 0.0)[:, None]  # they leave the view: size features collapse
-    frame = pd.DataFrame(initial, columns=[f"initial_{f}" for f in FEATURE_NAMES])
-    frame[[f"effect_{f}" for f in FEATURE_NAMES]] = effect
-    frame["type"], frame["rolled"], frame["size"] = types, rolls, rng.uniform(0.04, 0.1, n)
-    return frame
+KS = (2, 3, 4)
+RS = (0.0, 0.4)
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
 
 @pytest.fixture(scope="module")
-def results():
-    return run_protocol(synthetic_frame(), ks=(2, 3, 4, 5), n_trials=3, random_state=1, n_jobs=1)
+def frame() -> pd.DataFrame:
+    return make_synthetic_frame(240, random_state=1)
 
 
-def test_results_schema(results):
-    assert set(results["uniformity"]) == {"2", "3", "4", "5"}
+@pytest.fixture(scope="module")
+def results(frame: pd.DataFrame) -> dict:
+    return run_protocol(
+        frame, ks=KS, relevancies=RS, n_trials=3, random_state=4, n_jobs=1, som_iterations=600
+    )
+
+
+def test_synthetic_frame_has_the_dataset_schema(frame: pd.DataFrame) -> None:
+    names = feature_names(frame)
+    assert len(names) == 49
+    for prefix in ("initial_", "final_", "effect_"):
+        assert all(f"{prefix}{n}" in frame.columns for n in names)
+    np.testing.assert_allclose(
+        frame[[f"final_{n}" for n in names]].to_numpy() - frame[[f"initial_{n}" for n in names]].to_numpy(),
+        frame[[f"effect_{n}" for n in names]].to_numpy(),
+        atol=1e-9,
+    )
+    assert set(frame["type"]) == {"sphere", "box", "horizontal_cylinder", "vertical_cylinder"}
+    assert frame["rolled"].dtype == bool and frame["size"].between(0.04, 0.10).all()
+    assert feature_groups(names).count("shape") == 24
+
+
+def test_results_follow_the_schema(results: dict, frame: pd.DataFrame) -> None:
+    k_keys = [str(k) for k in KS]
+    r_keys = ["0.0", "0.4"]
+    assert list(results["uniformity"]) == k_keys
     for key in ("svm_accuracy", "shape_fraction", "n_selected"):
-        assert set(results[key]) == {"0.0", "0.2", "0.4", "0.6", "0.8"}
-        assert set(results[key]["0.4"]) == {"2", "3", "4", "5"}
-        assert set(results[key]["0.4"]["2"]) == {"mean", "std"}
-    assert set(results["case_studies"]) == {"2", "4"}
-    cluster = results["case_studies"]["2"][0]
-    assert set(cluster) == {"cluster", "rolled", "not_rolled", "types", "sizes"}
-    assert sum(c["rolled"] + c["not_rolled"] for c in results["case_studies"]["2"]) == 120
-    json.dumps(results)  # JSON-ready
+        assert list(results[key]) == r_keys
+        for r in r_keys:
+            assert list(results[key][r]) == k_keys
+            assert all(set(v) == {"mean", "std"} for v in results[key][r].values())
+    for key in ("uniformity", "purity", "adjusted_rand", "n_categories", "svm_baseline", "feature_weights"):
+        assert list(results[key]) == k_keys
+    assert all(0.0 <= v["mean"] <= 100.0 for v in results["uniformity"].values())
+    assert all(0.0 <= v["mean"] <= 1.0 for r in r_keys for v in results["svm_accuracy"][r].values())
+    assert all(1 <= v["mean"] <= 49 for r in r_keys for v in results["n_selected"][r].values())
+    assert list(results["case_studies"]) == ["2", "4"]
+    for k, clusters in results["case_studies"].items():
+        assert [c["cluster"] for c in clusters] == list(range(int(k)))
+        assert all(set(c) == {"cluster", "rolled", "not_rolled", "types", "sizes"} for c in clusters)
+        assert sum(c["rolled"] + c["not_rolled"] for c in clusters) == len(frame)
+        assert sum(len(c["sizes"]) for c in clusters) == len(frame)
+        assert sum(sum(c["types"].values()) for c in clusters) == len(frame)
+    config = results["config"]
+    assert config["n_trials"] == 3 and config["ks"] == list(KS) and config["relevancies"] == list(RS)
+    assert config["feature_groups"] == {"shape": 24, "size": 18, "relation": 7}
+    assert json.loads(json.dumps(results, allow_nan=False)) == results
 
 
-def test_protocol_finds_the_planted_structure(results):
-    assert results["uniformity"]["2"]["mean"] > 95
-    assert results["shape_fraction"]["0.8"]["2"]["mean"] == 1.0  # the one planted shape feature wins
-    assert results["svm_accuracy"]["0.8"]["2"]["mean"] > 0.9
-    counts = [results["n_selected"][r]["2"]["mean"] for r in ("0.0", "0.4", "0.8")]
-    assert counts[0] >= counts[1] >= counts[2]
+def test_protocol_finds_the_papers_structure_in_synthetic_taps(results: dict) -> None:
+    # the synthetic taps roll by shape: clusters follow rolled/not rolled, and shape features are chosen
+    assert results["uniformity"]["3"]["mean"] > 70.0
+    assert results["shape_fraction"]["0.4"]["3"]["mean"] > 0.8
+    assert results["n_selected"]["0.4"]["2"]["mean"] < results["n_selected"]["0.0"]["2"]["mean"]
+    assert results["svm_accuracy"]["0.4"]["2"]["mean"] > results["svm_baseline"]["2"]["mean"]
 
 
-def test_protocol_does_not_depend_on_n_jobs(results):
-    again = run_protocol(synthetic_frame(), ks=(2, 3, 4, 5), n_trials=3, random_state=1, n_jobs=2)
-    assert json.dumps(again, sort_keys=True) == json.dumps(results, sort_keys=True)
+def test_results_do_not_depend_on_n_jobs(frame: pd.DataFrame, results: dict) -> None:
+    parallel = run_protocol(
+        frame, ks=KS, relevancies=RS, n_trials=3, random_state=4, n_jobs=2, som_iterations=600
+    )
+    assert json.dumps(parallel, sort_keys=True) == json.dumps(results, sort_keys=True)
+    other = run_protocol(frame, ks=(4,), relevancies=RS, n_trials=3, random_state=4, som_iterations=600)
+    assert other["uniformity"]["4"] == results["uniformity"]["4"]  # seeds per (trial, k), not per position
 
 
-def test_figures_and_report_are_written(results, tmp_path):
-    paths = write_figures(results, tmp_path)
-    assert {p.name for p in paths} == {"uniformity.png", "selected_features.png", "case_study_k2.png",
-                                       "case_study_k4.png", "svm_accuracy.png"}
-    for path in paths:
-        assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and path.stat().st_size > 10_000
-    report = write_report(results, tmp_path).read_text()
-    assert "| the paper | this reproduction | agrees |" in report
-    assert "Uniformity" in report and "uniformity.png" in report
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"ks": (1, 2)}, "ks must be integers in"),
+        ({"ks": (2, 11)}, "ks must be integers in"),
+        ({"relevancies": (0.0, 1.2)}, "relevancies"),
+        ({"n_trials": 0}, "n_trials"),
+        ({"random_state": None}, "random_state"),
+        ({"test_size": 1.0}, "test_size"),
+        ({"n_neighbors": 0}, "n_neighbors"),
+    ],
+)
+def test_protocol_refuses_bad_arguments(frame: pd.DataFrame, kwargs: dict, match: str) -> None:
+    with pytest.raises(ValueError, match=match):
+        run_protocol(frame, **kwargs)
 
 
-def test_bad_frames():
-    frame = synthetic_frame()
-    with pytest.raises(ValueError, match="rolled"):
-        run_protocol(frame.drop(columns="rolled"), n_trials=1)
-    with pytest.raises(ValueError, match="effect_"):
-        run_protocol(frame.drop(columns=f"effect_{FEATURE_NAMES[0]}"), n_trials=1)
+def test_protocol_refuses_bad_frames(frame: pd.DataFrame) -> None:
+    with pytest.raises(ValueError, match="'rolled'"):
+        run_protocol(frame.drop(columns="rolled"))
+    with pytest.raises(ValueError, match="no initial_"):
+        run_protocol(frame[["type", "size", "rolled"]])
     broken = frame.copy()
-    broken.iloc[0, 0] = np.nan
-    with pytest.raises(ValueError, match="finite"):
-        run_protocol(broken, n_trials=1)
-    with pytest.raises(ValueError, match="relevancies"):
-        run_protocol(frame, relevancies=(0.5, 1.5), n_trials=1)
+    broken.loc[5, "effect_mean_x"] = np.nan
+    with pytest.raises(ValueError, match="row 5, column effect_mean_x"):
+        run_protocol(broken)
+    with pytest.raises(ValueError, match="expected at least 2 of each"):
+        run_protocol(frame.iloc[:5], test_size=0.1)
 
 
-@pytest.mark.slow
-def test_relieff_equals_skrebate_on_real_taps():
-    """The fast ReliefF gives skrebate's weights on real data from the environment."""
-    skrebate = pytest.importorskip("skrebate")
-    from affordance_env.tap_env import TapAffordanceEnv
-    from affordance_learning.model import AffordanceModel
-    from affordance_learning.relieff import relieff_weights
+def test_a_frame_too_small_to_stratify_gets_a_random_split(frame: pd.DataFrame) -> None:
+    lonely = frame.copy()
+    lonely.loc[0, "type"] = "cone"
+    results = run_protocol(lonely, ks=(2,), relevancies=(0.4,), n_trials=1, som_iterations=200)
+    assert (
+        "random, not stratified" in results["config"]["split"] and "'cone': 1" in results["config"]["split"]
+    )
+    assert (
+        "stratified by object type"
+        in run_protocol(frame, ks=(2,), n_trials=1, som_iterations=200)["config"]["split"]
+    )
 
-    env = TapAffordanceEnv(camera_width=48, camera_height=48)
-    initial, effect = [], []
-    for seed in range(120):
-        env.reset(seed=seed)
-        info = env.step(np.zeros(3))[4]
-        initial.append(info["initial_features"])
-        effect.append(info["effect"])
-    X, E = np.array(initial, dtype=np.float64), np.array(effect, dtype=np.float64)
-    labels = AffordanceModel(n_clusters=3, random_state=0).fit(X, E).labels_
-    expected = skrebate.ReliefF(n_neighbors=10).fit(X, labels).feature_importances_
-    np.testing.assert_allclose(relieff_weights(X, labels, n_neighbors=10), expected, atol=1e-6)
+
+def test_feature_groups_fall_back_to_the_papers_order() -> None:
+    groups = feature_groups([f"f{i}" for i in range(49)])
+    assert (
+        groups[:24] == ["shape"] * 24 and groups[24:42] == ["size"] * 18 and groups[42:] == ["relation"] * 7
+    )
+    with pytest.raises(ValueError, match="cannot tell the group"):
+        feature_groups(["a", "b"])
+
+
+def test_figures_and_report_are_written(results: dict, tmp_path: Path) -> None:
+    paths = write_figures(results, tmp_path)
+    names = {p.name for p in paths}
+    assert {
+        "uniformity.png",
+        "selected_features.png",
+        "case_study_k2.png",
+        "case_study_k4.png",
+        "svm_accuracy.png",
+    } <= names
+    for path in paths:
+        data = path.read_bytes()
+        assert data.startswith(PNG_MAGIC) and len(data) > 10_000, path
+    report = write_report(results, tmp_path)
+    text = report.read_text()
+    assert report.name == "REPORT.md"
+    assert "uniformity.png" in text and "| Uniformity on average |" in text
+    assert text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**") == 14
+    again = write_report(json.loads(json.dumps(results)), tmp_path / "again").read_text()
+    assert again.split("## Configuration")[0] == text.split("## Figures")[0]  # same numbers from the JSON
+
+
+def _paper_like(results: dict) -> dict:
+    """The results edited to say what the paper says, claim by claim."""
+    good = copy.deepcopy(results)
+    ks = [str(k) for k in range(2, 11)]
+    rs = ["0.0", "0.2", "0.4", "0.6", "0.8"]
+    good["uniformity"] = {k: {"mean": 80.0 + 1.5 * i, "std": 1.0} for i, k in enumerate(ks)}
+    good["shape_fraction"] = {
+        r: {k: {"mean": 0.45 + 0.1 * j, "std": 0.0} for k in ks} for j, r in enumerate(rs)
+    }
+    good["n_selected"] = {r: {k: {"mean": 30.0 - 6 * j, "std": 0.0} for k in ks} for j, r in enumerate(rs)}
+    accuracy = {2: 0.95, 3: 0.85, 4: 0.88, 5: 0.8, 6: 0.75, 7: 0.7, 8: 0.66, 9: 0.62, 10: 0.6}
+    drop = {"0.0": 0.0, "0.2": 0.002, "0.4": 0.004, "0.6": 0.03, "0.8": 0.06}
+    good["svm_accuracy"] = {
+        r: {str(k): {"mean": a - drop[r], "std": 0.01} for k, a in accuracy.items()} for r in rs
+    }
+    sizes = [0.04, 0.07, 0.1]
+    good["case_studies"] = {
+        "2": [
+            {
+                "cluster": 0,
+                "rolled": 480,
+                "not_rolled": 20,
+                "types": {"sphere": 250, "horizontal_cylinder": 240, "box": 5, "vertical_cylinder": 5},
+                "sizes": sizes,
+            },
+            {
+                "cluster": 1,
+                "rolled": 10,
+                "not_rolled": 490,
+                "types": {"sphere": 0, "horizontal_cylinder": 10, "box": 245, "vertical_cylinder": 245},
+                "sizes": sizes,
+            },
+        ],
+        "4": [
+            {"cluster": c, "rolled": r, "not_rolled": n, "types": {}, "sizes": sizes}
+            for c, (r, n) in enumerate([(240, 5), (230, 20), (5, 245), (10, 245)])
+        ],
+    }
+    return good
+
+
+def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
+    good = _paper_like(results)
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(good)}
+    assert set(verdicts.values()) == {AGREES}, verdicts
+    bad = copy.deepcopy(good)
+    bad["uniformity"] = {k: {"mean": 60.0 - i, "std": 1.0} for i, k in enumerate(good["uniformity"])}
+    bad["svm_accuracy"]["0.4"] = {k: {"mean": 0.5, "std": 0.0} for k in good["svm_accuracy"]["0.4"]}
+    bad["case_studies"]["2"][0]["types"]["sphere"], bad["case_studies"]["2"][1]["types"]["sphere"] = 0, 250
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(bad)}
+    for topic in (
+        "Uniformity on average",
+        "Uniformity rises with k",
+        "Uniformity peak",
+        "1 x 2 map: object types",
+        "r = 0.4 best",
+        "r = 0, 0.2, 0.4 alike",
+    ):
+        assert verdicts[topic] == DISAGREES, topic
+    partial = {"uniformity": good["uniformity"]}
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
+    assert verdicts["Uniformity on average"] == AGREES and verdicts["Bump at k = 4"] == NOT_COMPUTABLE

@@ -40,7 +40,7 @@ def test_model_fits_or_raises_a_clear_error(n, d, e, k, relevancy, data):
 
 @settings(max_examples=30, deadline=None)
 @given(data=st.data(), n=st.integers(3, 40), d=st.integers(1, 5), classes=st.integers(2, 4))
-def test_relieff_weights_are_finite_and_bounded(data, n, d, classes):
+def test_relieff_weights_are_finite(data, n, d, classes):
     X = data.draw(arrays(np.float64, (n, d), elements=finite))
     y = data.draw(arrays(np.int64, n, elements=st.integers(0, classes - 1)))
     if len(np.unique(y)) < 2:
@@ -48,8 +48,8 @@ def test_relieff_weights_are_finite_and_bounded(data, n, d, classes):
             relieff_weights(X, y)
         return
     weights = relieff_weights(X, y, n_neighbors=3)
+    # finite; not bounded by 1: with classes smaller than n_neighbors, skrebate's multiclass weights exceed 1
     assert weights.shape == (d,) and np.all(np.isfinite(weights))
-    assert np.all(np.abs(weights) <= 1.0 + 1e-9)
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
