@@ -26,6 +26,7 @@ import pandas as pd
 from numpy.typing import ArrayLike
 
 from affordance_learning.model import AffordanceModel, EffectPrediction
+from affordance_learning.validation import first_non_finite
 
 #: Where the default tap model is stored.
 DEFAULT_MODEL_PATH = Path(__file__).resolve().parent / "data" / "tap_model.joblib"
@@ -210,12 +211,9 @@ def predict_effect(
             f"features must have shape ({_N_FEATURES},) or (n, {_N_FEATURES}) with n >= 1, got {X.shape}."
         )
     X = np.atleast_2d(X).astype(np.float64)
-    bad = ~np.isfinite(X)
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
-        raise ValueError(
-            f"features must be finite; row {row}, feature {col} is {float(X[row, col])} "
-            f"({int(bad.sum())} non-finite value(s))."
-        )
+    found = first_non_finite(X)
+    if found:
+        count, row, col, value = found
+        raise ValueError(f"features must be finite; row {row}, feature {col} is {value} ({count} non-finite value(s)).")
     model, names = _load_checked(Path(path))
     return model.predict_effect(pd.DataFrame(X, columns=list(names)))

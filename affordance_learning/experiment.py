@@ -47,6 +47,7 @@ from affordance_learning.metrics import adjusted_rand, cluster_purity, make_svm,
 from affordance_learning.model import _check_int, select_features
 from affordance_learning.relieff import MULTICLASS_THRESHOLD, ReliefFScorer
 from affordance_learning.som import SOMClustering
+from affordance_learning.validation import first_non_finite
 
 #: The object types of the paper, in the order figures and case studies list them.
 OBJECT_TYPES = ("sphere", "horizontal_cylinder", "box", "vertical_cylinder")
@@ -132,12 +133,12 @@ def _frame_data(frame: pd.DataFrame) -> _Data:
     X = frame[[f"initial_{n}" for n in names]].to_numpy(dtype=np.float64)
     E = frame[[f"effect_{n}" for n in names]].to_numpy(dtype=np.float64)
     for prefix, values in (("initial_", X), ("effect_", E)):
-        bad = ~np.isfinite(values)
-        if bad.any():
-            row, col = np.argwhere(bad)[0]
+        found = first_non_finite(values)
+        if found:
+            count, row, col, value = found
             raise ValueError(
-                f"{int(bad.sum())} non-finite value(s) in the {prefix} columns, the first in row {row}, "
-                f"column {prefix}{names[col]}: {float(values[row, col])}; expected finite features."
+                f"{count} non-finite value(s) in the {prefix} columns, the first in row {row}, "
+                f"column {prefix}{names[col]}: {value}; expected finite features."
             )
     rolled = frame["rolled"].to_numpy()
     if rolled.dtype != bool:

@@ -46,6 +46,8 @@ from scipy.spatial.distance import pdist, squareform
 from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from affordance_learning.validation import first_non_finite
+
 #: Distance skrebate gives an instance to itself, so that it sorts after every other instance.
 SELF_DISTANCE = float(sys.maxsize)
 #: skrebate's default: features with at most this many distinct values are discrete.
@@ -76,11 +78,11 @@ def _check_features(X: ArrayLike) -> np.ndarray:
     if not (np.issubdtype(X.dtype, np.number) or X.dtype == bool) or np.iscomplexobj(X):
         raise ValueError(f"X must hold real numbers, got dtype {X.dtype}.")
     X = X.astype(np.float64)
-    bad = ~np.isfinite(X)
-    if bad.any():
-        row, col = np.argwhere(bad)[0]
+    found = first_non_finite(X)
+    if found:
+        count, row, col, value = found
         raise ValueError(
-            f"X has {int(bad.sum())} non-finite value(s), the first X[{row}, {col}] = {float(X[row, col])}; "
+            f"X has {count} non-finite value(s), the first X[{row}, {col}] = {value}; "
             "missing data (skrebate's NaN handling) is not replicated, expected finite values."
         )
     return X
