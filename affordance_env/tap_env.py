@@ -6,6 +6,7 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import gymnasium as gym
+import mujoco
 import numpy as np
 from gymnasium import spaces
 
@@ -50,6 +51,22 @@ def _failure_reason(fault: str | None, visible_initially: bool, stroke) -> str |
     if not stroke.contact:
         return "tap: the hand never touched the object"
     return None
+
+
+#: A box or standing cylinder whose vertical axis tilted more than this has toppled over [rad].
+TOPPLE_ANGLE = np.pi / 4
+
+
+def _toppled(object_type: str, quat_initial: np.ndarray, quat_final: np.ndarray) -> bool:
+    """Whether a box or standing cylinder fell over (its body z axis tilted by more than TOPPLE_ANGLE)."""
+    if object_type not in ("box", "vertical_cylinder"):
+        return False  # spheres and lying cylinders turn about horizontal axes when they roll
+    axes = []
+    for quat in (quat_initial, quat_final):
+        R = np.empty(9)
+        mujoco.mju_quat2Mat(R, np.asarray(quat, dtype=np.float64))
+        axes.append(R.reshape(3, 3)[:, 2])
+    return bool(np.arccos(np.clip(axes[0] @ axes[1], -1.0, 1.0)) > TOPPLE_ANGLE)
 
 
 def default_reward(info: dict[str, Any]) -> float:
@@ -107,9 +124,11 @@ class TapAffordanceEnv(gym.Env):
     After ``reset``: ``object`` (``type``, ``size`` [m], ``pose`` (7,) position and quaternion), ``attention``.
     After ``step`` also: ``effect`` (49,) final minus initial features, ``initial_features``,
     ``final_features``, ``object`` with ``initial_pose`` and ``final_pose``, ``displacement`` [m], ``rolled``
-    (displacement above ``roll_threshold``; the paper's success label), ``outcome`` (``"rest"``, ``"off_table"``
-    or ``"timeout"``), ``contact`` (the hand touched the object), ``hand_speed`` [m/s], ``ik`` (``success``,
-    ``position_error`` [m], ``orientation_error`` [rad]), ``visible`` (object seen in the final snapshot),
+    (displacement above ``roll_threshold`` without toppling; the paper's success label), ``toppled`` (a box or
+    standing cylinder fell over: its vertical axis tilted by more than 45 degrees), ``outcome`` (``"rest"``,
+    ``"off_table"`` or ``"timeout"``), ``contact`` (the hand touched the object), ``hand_speed`` [m/s],
+    ``ik`` (``success``, ``position_error`` [m], ``orientation_error`` [rad]), ``visible`` (object seen in the
+    final snapshot),
     ``failure``: None, or why the interaction is not a valid sample: ``"physics: ..."`` (MuJoCo reported an
     instability or the state became non-finite; then obs is blank, ``effect`` is zeros and ``outcome`` is
     ``"fault"``), ``"perception: ..."`` (object not visible initially), ``"ik: ..."`` (stroke not reachable),
@@ -323,6 +342,7 @@ class TapAffordanceEnv(gym.Env):
             visible = False
         failure = _failure_reason(fault, initial["visible"], stroke)
         displacement = 0.0 if fault else float(np.linalg.norm(final_pose[:2] - initial["pose"][:2]))
+        toppled = (not fault) and _toppled(initial["geometry"].object_type, initial["pose"][3:], final_pose[3:])
         effect = (
             np.zeros(len(FEATURE_NAMES), np.float32)
             if fault
@@ -335,7 +355,8 @@ class TapAffordanceEnv(gym.Env):
             "final_features": final_features,
             "effect": effect,
             "displacement": displacement,
-            "rolled": displacement > self.roll_threshold,
+            "rolled": displacement > self.roll_threshold and not toppled,
+            "toppled": toppled,
             "outcome": "fault" if fault else outcome,
             "contact": stroke.contact,
             "hand_speed": stroke.hand_speed,
