@@ -234,3 +234,21 @@ def test_other_behaviors_run_and_flag_what_they_cannot_do(behavior):
         else:
             assert info["failure"].split(":")[0] in ("reach", "ik", "tap", "perception")
     assert valid >= 3  # push and tap_back fail their reach more often than tap (see README)
+
+
+def test_a_toppled_box_is_not_rolled():
+    from affordance_env.tap_env import _toppled
+
+    upright = np.array([1.0, 0.0, 0.0, 0.0])
+    on_its_side = np.array([np.cos(np.pi / 4), np.sin(np.pi / 4), 0.0, 0.0])  # 90 degrees about x
+    spun = np.array([np.cos(0.5), 0.0, 0.0, np.sin(0.5)])  # turned about the vertical only
+    assert _toppled("box", upright, on_its_side) and _toppled("vertical_cylinder", upright, on_its_side)
+    assert not _toppled("box", upright, spun)
+    assert not _toppled("sphere", upright, on_its_side)  # rolling spheres turn about horizontal axes
+    # a high, fast tap on a tall standing cylinder may knock it over; it is then reported, never "rolled"
+    env = TapAffordanceEnv(object_types=("vertical_cylinder",), size_range=(0.09, 0.10), camera_width=32,
+                           camera_height=32)
+    for seed in range(4):
+        env.reset(seed=seed)
+        info = env.step(np.array([1.0, 0.0, 1.0]))[4]
+        assert not (info["toppled"] and info["rolled"])
