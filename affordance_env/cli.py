@@ -38,25 +38,6 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
-def _collect(args: argparse.Namespace) -> int:
-    from affordance_env.dataset import collect, load_dataset
-
-    options = {"behavior": args.behavior, "camera_width": args.camera_width, "camera_height": args.camera_height}
-    if args.object_types:
-        options["object_types"] = args.object_types
-    if args.size_range:
-        options["size_range"] = tuple(args.size_range)
-    start = time.perf_counter()
-    out = collect(args.out, args.episodes, seed=args.seed, workers=args.workers, action=args.action,
-                  env_options=options, chunk_size=args.chunk_size, dask_address=args.dask_address,
-                  save_images=args.save_images)
-    frame = load_dataset(out)
-    elapsed = time.perf_counter() - start
-    failures = frame.attrs["failures"]
-    print(f"{out}: {len(frame)} interactions ({len(failures)} failed and left out) in {elapsed:.1f} s")
-    return 0
-
-
 def _reproduce(args: argparse.Namespace) -> int:
     from affordance_learning.reproduce import reproduce
 
@@ -77,6 +58,8 @@ def _train_default(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from affordance_env.collect_cli import add_collect_parser
+
     parser = argparse.ArgumentParser(prog="affordance", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="tap a few objects with the canonical tap and print what happened")
@@ -86,25 +69,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--object", default=None, help="only this object type (default: all four)")
     demo.set_defaults(func=_demo)
 
-    collect = sub.add_parser("collect", help="collect interactions into a dataset (parallel, resumable)")
-    collect.add_argument("--episodes", type=int, required=True, help="number of interactions")
-    collect.add_argument("--out", type=Path, required=True, help="dataset directory (resumed if it exists)")
-    collect.add_argument("--seed", type=int, default=0, help="dataset seed (default 0)")
-    collect.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
-    collect.add_argument("--behavior", default="tap", help="tap | tap_back | push (default tap)")
-    collect.add_argument("--action", default="canonical", choices=("canonical", "random"),
-                         help="the paper's canonical tap, or uniform random actions (default canonical)")
-    collect.add_argument("--object-types", nargs="+", default=None, help="object types to sample (default all)")
-    collect.add_argument("--size-range", nargs=2, type=float, default=None, metavar=("LOW", "HIGH"),
-                         help="object size range [m] (default 0.04 0.10)")
-    collect.add_argument("--camera-width", type=int, default=128)
-    collect.add_argument("--camera-height", type=int, default=128)
-    collect.add_argument("--chunk-size", type=int, default=50, help="interactions per file (default 50)")
-    collect.add_argument("--save-images", action="store_true",
-                         help="also store range images and object masks (compressed)")
-    collect.add_argument("--dask-address", default=None,
-                         help="run on this Dask distributed scheduler (e.g. tcp://host:8786) instead of --workers")
-    collect.set_defaults(func=_collect)
+    add_collect_parser(sub)
 
     reproduce = sub.add_parser(
         "reproduce", help="the paper's experiment: collect taps, learn, write results.json, figures and a report"
