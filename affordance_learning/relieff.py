@@ -26,6 +26,12 @@ exactly:
   number of classes. skrebate weighs each miss class by its observed share among the neighbours, not by its
   prior (its class-prior map is built but never read); this module does the same.
 
+One deliberate difference: skrebate counts a constant feature (a single value) as discrete, so one constant
+column among continuous ones switches the whole data set to the mixed mode, where any continuous difference
+larger than the feature's standard deviation counts as 1 and the weights saturate. Here a constant feature has
+weight 0 and takes no part in choosing the data type or in the distances: the weights are skrebate's on the data
+without the constant columns (and equal to skrebate's outright when no column is constant).
+
 Not replicated, and refused with a ``ValueError``: missing values (skrebate's missing-data distances), more
 than ``multiclass_threshold`` (10) classes (skrebate's continuous-endpoint ReliefF), a single class, and
 non-integer ``n_neighbors`` (skrebate's "fraction of the data" form).
@@ -107,12 +113,17 @@ class ReliefFScorer:
         self.X = X
         self.n_samples, self.n_features = X.shape
         n_unique = np.array([np.unique(X[:, j]).size for j in range(self.n_features)])
+        #: True for the features with a single value: weight 0, and no part in the data type or distances.
+        self.constant = n_unique == 1
+        if self.constant.all():
+            raise ValueError(f"every feature of X is constant (shape {X.shape}); ReliefF needs one that varies.")
         #: True for the features treated as discrete, (n_features,).
-        self.discrete = n_unique <= discrete_threshold
-        continuous = ~self.discrete
-        if continuous.all():
+        self.discrete = (n_unique <= discrete_threshold) & ~self.constant
+        continuous = ~self.discrete & ~self.constant
+        self._continuous = continuous
+        if not self.discrete.any():
             self.data_type: DataType = "continuous"
-        elif self.discrete.all():
+        elif not continuous.any():
             self.data_type = "discrete"
         else:
             self.data_type = "mixed"
@@ -125,17 +136,18 @@ class ReliefFScorer:
         self._ranks: dict[int, np.ndarray] = {}
 
     def _distance_matrix(self) -> np.ndarray:
-        """Instance distances as skrebate's ``_distarray_no_missing``, self-distance ``sys.maxsize``."""
-        cidx = np.flatnonzero(~self.discrete)
+        """Instance distances as skrebate's ``_distarray_no_missing`` on the non-constant features, self-distance
+        ``sys.maxsize``."""
+        cidx = np.flatnonzero(self._continuous)
         didx = np.flatnonzero(self.discrete)
         if self.data_type == "discrete":
-            dist = squareform(pdist(self.X, metric="hamming"))
+            dist = squareform(pdist(self.X[:, didx], metric="hamming"))
         else:
             xc = (self.X[:, cidx] - self.minimum[cidx]) / self.range[cidx]
             c_dist = squareform(pdist(xc, metric="cityblock"))
             if self.data_type == "mixed":
                 d_dist = squareform(pdist(self.X[:, didx], metric="hamming"))
-                dist = np.add(d_dist * self.n_features, c_dist)
+                dist = np.add(d_dist * (cidx.size + didx.size), c_dist)
             else:
                 dist = c_dist
         np.fill_diagonal(dist, SELF_DISTANCE)
@@ -184,7 +196,7 @@ class ReliefFScorer:
         deviation.
         """
         total = np.zeros(self.n_features)
-        cont = ~self.discrete
+        cont = self._continuous
         for start in range(0, rows.size, _PAIR_CHUNK):
             stop = start + _PAIR_CHUNK
             raw = np.take(self.X, rows[start:stop], axis=0)

@@ -16,6 +16,7 @@ from affordance_learning import (
     DefaultModelError,
     DefaultModelMissingError,
     ReliefF,
+    ReliefFScorer,
     SOMClustering,
     adjusted_rand,
     cluster_purity,
@@ -156,6 +157,27 @@ def test_relieff_equals_skrebate_on_600_rows_of_49_features() -> None:
     y = np.digitize(score, np.quantile(score, [0.25, 0.5, 0.75]))
     expected = skrebate.ReliefF(n_neighbors=10).fit(X, y).feature_importances_
     np.testing.assert_allclose(relieff_weights(X, y), expected, rtol=0, atol=1e-6)
+
+
+def test_constant_columns_get_weight_zero_and_keep_continuous_data_continuous() -> None:
+    # Invisible-normal latitude bins are constant in real data: in skrebate they make the data "mixed", where a
+    # continuous difference above one standard deviation counts as 1 and the top weights saturate.
+    skrebate = pytest.importorskip("skrebate")
+    rng = np.random.default_rng(11)
+    varying = rng.normal(size=(150, 6))
+    y = np.digitize(varying[:, 1] + 0.4 * rng.normal(size=150), [-0.3, 0.6])
+    X = np.column_stack([np.zeros(150), varying[:, :3], np.full(150, 2.5), varying[:, 3:]])
+    scorer = ReliefFScorer(X)
+    assert scorer.data_type == "continuous"
+    weights = scorer.weights(y)
+    assert weights[0] == 0.0 and weights[4] == 0.0
+    expected = skrebate.ReliefF(n_neighbors=10).fit(varying, y).feature_importances_
+    np.testing.assert_allclose(np.delete(weights, [0, 4]), expected, rtol=0, atol=1e-9)
+    # skrebate itself, on the same data, has switched mode: its weights are not the continuous ones
+    switched = skrebate.ReliefF(n_neighbors=10).fit(X, y).feature_importances_
+    assert np.abs(np.delete(switched, [0, 4]) - expected).max() > 0.05
+    with pytest.raises(ValueError, match="every feature of X is constant"):
+        ReliefFScorer(np.ones((10, 3)))
 
 
 def test_relieff_matches_skrebate_where_its_multiclass_weights_exceed_one() -> None:
