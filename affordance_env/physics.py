@@ -13,6 +13,7 @@ import mujoco
 import numpy as np
 
 from affordance_env.objects import PRIMITIVES, ObjectGeometry
+from affordance_env.outcome import ObjectMonitor
 from affordance_env.robot_model import ACTIVE_JOINTS, CONTACT_LINKS
 
 #: Geom group that hides the scene's inactive object primitives from the range camera and the renderer.
@@ -55,7 +56,6 @@ class TapPhysics:
         touch = _id(model, obj.mjOBJ_SENSOR, "palm_touch")
         self.touch_adr = int(model.sensor_adr[touch])
         self.table_geom = _id(model, obj.mjOBJ_GEOM, "table_top")
-        self.table_surface = _id(model, obj.mjOBJ_GEOM, "table_surface")
         self.home_key = _id(model, obj.mjOBJ_KEY, "home")
         contact_bodies = {_id(model, obj.mjOBJ_BODY, n) for n in CONTACT_LINKS}
         self.hand_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] in contact_bodies])
@@ -75,6 +75,9 @@ class TapPhysics:
         self._hidden_rbound = {p: float(model.geom_rbound[g]) for p, g in self.object_geoms.items()}
         self.active_geom = self.object_geoms["sphere"]
         self.geometry: ObjectGeometry | None = None
+        #: Follows the object through an interaction (:mod:`affordance_env.outcome`), sampled after every
+        #: :meth:`step` call while set.
+        self.monitor: ObjectMonitor | None = None
         #: Called as ``on_step(physics)`` after every :meth:`step` call, if set (used to record video frames).
         self.on_step: Callable[[TapPhysics], None] | None = None
 
@@ -188,10 +191,24 @@ class TapPhysics:
         p = self.data.qpos[self.object_qpos : self.object_qpos + 3]
         return bool(p[2] > self.table_top and np.all(p[:2] >= self.table_low) and np.all(p[:2] <= self.table_high))
 
+    def start_monitor(self) -> ObjectMonitor:
+        """Start following the object (:class:`~affordance_env.outcome.ObjectMonitor`) from now on."""
+        self.monitor = ObjectMonitor(self.table_top, self.table_low, self.table_high, self.object_pose()[:3],
+                                     self.data.time)
+        return self.monitor
+
+    def _sample_monitor(self) -> None:
+        a, v = self.object_qpos, self.object_qvel
+        qvel = self.data.qvel
+        self.monitor.sample(self.data.time, self.data.qpos[a : a + 3], self.data.xmat[self.object_body],
+                            qvel[v : v + 3], qvel[v + 3 : v + 6])
+
     # --- stepping --------------------------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
         """Advance the simulation by ``n`` timesteps."""
         mujoco.mj_step(self.model, self.data, n)
+        if self.monitor is not None:  # once per call: every control tick (10 ms) or, in the stroke, every step
+            self._sample_monitor()
         if self.on_step is not None:
             self.on_step(self)
 

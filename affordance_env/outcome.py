@@ -1,0 +1,151 @@
+"""What an interaction did to the object, measured from its motion alone (never from its type).
+
+:class:`ObjectMonitor` follows the object's state at every simulation step of an interaction, whatever the
+arm is doing, and records:
+
+- when and where the object's centre left the table top (it then falls to the floor);
+- the distance its centre covered while *rolling* on the table: moving with its lowest point nearly at rest
+  (``|v_contact| <= ROLL_SLIP_RATIO |v|``, where ``v_contact = v + w x (-h z)`` is the velocity of the point
+  ``h`` below the centre, ``h`` the centre's height above the table) and at constant height
+  (``|v_z| <= ROLL_VERTICAL_RATIO |v_xy|``). A sliding object fails the first test, an object tipping over an
+  edge the second (its centre rises and falls), except briefly at the top of the tip;
+- the highest its centre rose above where it started;
+- since when it has been still (linear and angular speed below :data:`REST_SPEED`, :data:`REST_ANGULAR_SPEED`).
+
+The labels are pure functions of those records and of the initial and final poses:
+
+- ``rolled``: the rolling distance exceeds the roll threshold;
+- ``toppled``: the axis that was vertical at the start ends tilted by more than :data:`TOPPLE_ANGLE`, and the
+  centre rose on the way by more than :data:`TOPPLE_RISE` of its initial height above the table, as it must to
+  tip over an edge (a cube's centre rises by 41 % of its height); a rolling ball or lying cylinder turns its
+  body axes by any angle at a constant centre height, so it does not count as toppled.
+
+A standing cylinder that topples and then rolls away is both ``toppled`` and ``rolled``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+#: The object is still when its linear speed [m/s] and angular speed [rad/s] are below these ...
+REST_SPEED, REST_ANGULAR_SPEED = 0.01, 0.3
+#: ... and at rest once it has been still this long [s].
+REST_DURATION = 0.05
+#: Rolling: contact-point speed at most this share of the centre's horizontal speed ...
+ROLL_SLIP_RATIO = 0.3
+#: ... and vertical speed at most this share of it.
+ROLL_VERTICAL_RATIO = 0.2
+#: Centre speeds below this [m/s] count as no motion (neither rolling nor sliding).
+MIN_MOTION_SPEED = 1e-3
+#: Toppled: the initially vertical body axis tilted by more than this [rad] ...
+TOPPLE_ANGLE = math.pi / 4
+#: ... and the centre rose by more than this share of its initial height above the table.
+TOPPLE_RISE = 0.1
+
+
+class ObjectMonitor:
+    """Follows the object of a :class:`~affordance_env.physics.TapPhysics` through one interaction.
+
+    Args:
+        table_top: Height of the table top [m].
+        table_low, table_high: Corners of the table top in world x, y [m], (2,) each.
+        p_world_start: Object centre when the interaction starts [m], (3,).
+        time: Simulation time when the interaction starts [s].
+    """
+
+    def __init__(self, table_top: float, table_low: np.ndarray, table_high: np.ndarray,
+                 p_world_start: np.ndarray, time: float) -> None:
+        self.table_top = float(table_top)
+        self._x0, self._y0 = float(table_low[0]), float(table_low[1])
+        self._x1, self._y1 = float(table_high[0]), float(table_high[1])
+        self.z_start = float(p_world_start[2])
+        #: Simulation time [s] and centre position [m] when the object left the table; None while on it.
+        self.exit_time: float | None = None
+        self.exit_position: np.ndarray | None = None
+        #: Distance the centre covered while rolling on the table [m].
+        self.rolling_distance = 0.0
+        #: Distance the centre covered on the table, rolling or not [m].
+        self.path_length = 0.0
+        #: Highest rise of the centre above its start while on the table [m].
+        self.max_rise = 0.0
+        #: Simulation time since which the object has been still [s]; None while it moves.
+        self.still_since: float | None = time
+        self._time = float(time)
+
+    @property
+    def left_table(self) -> bool:
+        """Whether the object's centre has left the table top."""
+        return self.exit_time is not None
+
+    def at_rest(self, time: float, since: float = -math.inf) -> bool:
+        """Whether the object has been still for :data:`REST_DURATION` at ``time``, counting from ``since`` [s]."""
+        return self.still_since is not None and time - max(self.still_since, since) >= REST_DURATION - 1e-9
+
+    def sample(self, time: float, p: np.ndarray, R: np.ndarray, v: np.ndarray, w_local: np.ndarray) -> None:
+        """Take the object's state at ``time`` [s].
+
+        Args:
+            time: Simulation time [s].
+            p: Centre position in the world frame [m], (3,).
+            R: Orientation (body to world), (3, 3) or flat (9,).
+            v: Linear velocity of the centre in the world frame [m/s], (3,).
+            w_local: Angular velocity in the body frame [rad/s], (3,) (MuJoCo's free-joint convention).
+        """
+        dt = time - self._time
+        self._time = time
+        vx, vy, vz = float(v[0]), float(v[1]), float(v[2])
+        R = np.reshape(R, (3, 3))
+        wx, wy, wz = (R @ w_local).tolist()
+        speed = math.sqrt(vx * vx + vy * vy + vz * vz)
+        if speed < REST_SPEED and math.sqrt(wx * wx + wy * wy + wz * wz) < REST_ANGULAR_SPEED:
+            if self.still_since is None:
+                self.still_since = time
+        else:
+            self.still_since = None
+        if self.exit_time is not None:
+            return
+        x, y, z = float(p[0]), float(p[1]), float(p[2])
+        if not (self._x0 <= x <= self._x1 and self._y0 <= y <= self._y1 and z > self.table_top):
+            self.exit_time = time
+            self.exit_position = np.array([x, y, z])
+            return
+        self.max_rise = max(self.max_rise, z - self.z_start)
+        speed_xy = math.sqrt(vx * vx + vy * vy)
+        if speed_xy < MIN_MOTION_SPEED or dt <= 0.0:
+            return
+        self.path_length += speed_xy * dt
+        h = z - self.table_top
+        slip = math.sqrt((vx - h * wy) ** 2 + (vy + h * wx) ** 2 + vz * vz)
+        if slip <= ROLL_SLIP_RATIO * speed_xy and abs(vz) <= ROLL_VERTICAL_RATIO * speed_xy:
+            self.rolling_distance += speed_xy * dt
+
+
+def tilt(quat_initial: np.ndarray, quat_final: np.ndarray) -> float:
+    """Angle [rad] between the vertical and where the body axis that was vertical at the start ends up."""
+    R0, R1 = np.empty(9), np.empty(9)
+    mujoco.mju_quat2Mat(R0, np.asarray(quat_initial, dtype=np.float64))
+    mujoco.mju_quat2Mat(R1, np.asarray(quat_final, dtype=np.float64))
+    up_body = R0.reshape(3, 3).T @ np.array([0.0, 0.0, 1.0])
+    return float(np.arccos(np.clip((R1.reshape(3, 3) @ up_body)[2], -1.0, 1.0)))
+
+
+@dataclass(frozen=True)
+class Labels:
+    """The outcome labels of one interaction (see the module docstring)."""
+
+    rolled: bool
+    toppled: bool
+    tilt: float
+
+
+def outcome_labels(monitor: ObjectMonitor, quat_initial: np.ndarray, quat_final: np.ndarray,
+                   roll_threshold: float) -> Labels:
+    """``rolled`` and ``toppled`` from what the monitor measured and the initial and final orientations."""
+    angle = tilt(quat_initial, quat_final)
+    height = monitor.z_start - monitor.table_top
+    toppled = angle > TOPPLE_ANGLE and monitor.max_rise > TOPPLE_RISE * height
+    return Labels(rolled=monitor.rolling_distance > roll_threshold, toppled=bool(toppled), tilt=angle)
