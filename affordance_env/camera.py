@@ -60,6 +60,8 @@ class RangeImage:
         p_world_camera: Camera centre in the world frame [m], (3,).
         R_world_camera: Camera orientation (columns: camera x, y, z axes in the world frame), (3, 3).
         intrinsics: The pinhole intrinsics used.
+        normals: Unit surface normal at each hit point in the world frame, (H, W, 3); NaN where no hit. Only
+            when captured with ``normals=True`` (the range-noise model needs them), else None.
     """
 
     ranges: np.ndarray
@@ -68,6 +70,7 @@ class RangeImage:
     p_world_camera: np.ndarray
     R_world_camera: np.ndarray
     intrinsics: Intrinsics
+    normals: np.ndarray | None = None
 
     def mask_of(self, geom_id: int) -> np.ndarray:
         """Boolean (H, W) mask of the pixels that see geom ``geom_id``."""
@@ -135,14 +138,16 @@ class RangeCamera:
         """``(p_world_camera, R_world_camera)`` from the current kinematics (``mj_kinematics`` must be current)."""
         return data.cam_xpos[self.camera_id].copy(), data.cam_xmat[self.camera_id].reshape(3, 3).copy()
 
-    def capture(self, data: mujoco.MjData) -> RangeImage:
-        """Cast one ray per pixel from the camera's current pose and return the range snapshot."""
+    def capture(self, data: mujoco.MjData, normals: bool = False) -> RangeImage:
+        """Cast one ray per pixel from the camera's current pose and return the range snapshot (with the surface
+        normals of the hit points if ``normals``)."""
         K = self.intrinsics
         p_world_camera, R_world_camera = self.pose(data)
         d_world = self._d_camera_rays @ R_world_camera.T
+        normal = np.empty(3 * len(self._dist)) if normals else None
         mujoco.mj_multiRay(
             self.model, data, p_world_camera, d_world.reshape(-1), self._geomgroup, True, -1,
-            self._geom_ids, self._dist, None, len(self._dist), self.max_range,
+            self._geom_ids, self._dist, normal, len(self._dist), self.max_range,
         )
         hit = self._geom_ids >= 0
         dist = np.where(hit, self._dist, np.inf)
@@ -154,4 +159,6 @@ class RangeCamera:
             p_world_camera=p_world_camera,
             R_world_camera=R_world_camera,
             intrinsics=K,
+            normals=None if normal is None else np.where(
+                hit[:, None], normal.reshape(-1, 3), np.nan).reshape(K.height, K.width, 3),
         )
