@@ -217,6 +217,33 @@ def compute_features(
     return Features(values, visible=True, n_pixels=n_obj)
 
 
+#: Index of ``orientation``, an axis angle: its effect is wrapped (see :func:`effect_features`).
+ORIENTATION_INDEX = FEATURE_NAMES.index("orientation")
+
+
+def wrap_axis_angle(angle: np.ndarray | float) -> np.ndarray:
+    """An angle between two undirected axes [rad], wrapped into (-pi/2, pi/2]: the smallest turn between them."""
+    angle = np.asarray(angle, dtype=np.float64)
+    return angle - np.pi * np.ceil((angle - np.pi / 2) / np.pi)
+
+
+def effect_features(initial: np.ndarray, final: np.ndarray) -> np.ndarray:
+    """The effect of an interaction: ``final - initial`` features, (49,) float32 (or (n, 49) for rows).
+
+    Every feature is a plain difference except ``orientation``, the angle of an undirected image axis in
+    (-pi/2, pi/2]: its difference is wrapped into (-pi/2, pi/2], so that an object turning by a degree across the
+    wrap reads as a degree, not as about pi.
+    """
+    initial = np.asarray(initial, dtype=np.float64)
+    final = np.asarray(final, dtype=np.float64)
+    if initial.shape != final.shape or initial.shape[-1:] != (N_FEATURES,):
+        raise ValueError(f"initial and final must both be (..., {N_FEATURES}) feature arrays, got shapes "
+                         f"{initial.shape} and {final.shape}.")
+    effect = final - initial
+    effect[..., ORIENTATION_INDEX] = wrap_axis_angle(effect[..., ORIENTATION_INDEX])
+    return effect.astype(np.float32)
+
+
 def _normal_histograms(
     p_world_obj: np.ndarray, pixel_index: np.ndarray, grid_shape: tuple[int, int], p_world_camera: np.ndarray
 ) -> np.ndarray:
