@@ -11,8 +11,13 @@ index       meaning                                                          ran
 ==========  ===============================================================  ======================
 0           height of the palm centre above the canonical contact height     -1.5 .. +1.5 cm
 1           lateral offset of the stroke, across the stroke direction        -2 .. +2 cm
-2           hand speed along the stroke                                      0.15 .. 0.45 m/s
+2           hand speed along the stroke, 0.2 m/s x 3 ** action[2]            0.067 .. 0.6 m/s
 ==========  ===============================================================  ======================
+
+The canonical tap is moderate (the paper: "moderately hitting an object from its side"): at 0.2 m/s a ball or a
+lying cylinder rolls some 5 to 20 cm on the table and stays in view; the speed scale is geometric, because the
+distance a struck object rolls grows with the square of its speed: at the gentlest tap (-1) rolling objects
+move 2-4 cm, at the hardest (+1) most of them roll off the 1 m wide table (see ``assets/README.md``).
 """
 
 from __future__ import annotations
@@ -26,8 +31,8 @@ from affordance_env.objects import ObjectGeometry
 ACTION_DIM = 3
 HEIGHT_RANGE = 0.015  # [m]
 LATERAL_RANGE = 0.02  # [m]
-SPEED_CANONICAL = 0.3  # [m/s]
-SPEED_RANGE = 0.15  # [m/s]
+#: Hand speed of the canonical tap [m/s], and the factor by which action[2] = +-1 multiplies or divides it.
+SPEED_CANONICAL, SPEED_FACTOR = 0.2, 3.0
 #: Gap between hand surface and object before the stroke [m].
 CLEARANCE = 0.03
 #: Distance the hand keeps moving after it first touches the object [m].
@@ -165,7 +170,7 @@ def plan_stroke(
         p_start=p_start,
         p_end=p_end,
         direction=d,
-        speed=SPEED_CANONICAL + a[2] * SPEED_RANGE,
+        speed=SPEED_CANONICAL * SPEED_FACTOR ** a[2],
         R_world_hand=behavior.R_world_hand,
         follow_through=FOLLOW_THROUGH,
     )

@@ -6,24 +6,27 @@ from collections.abc import Callable, Sequence
 from typing import Any
 
 import gymnasium as gym
-import mujoco
 import numpy as np
 from gymnasium import spaces
 
 from affordance_env.attention import attend
 from affordance_env.behaviors import ACTION_DIM, BEHAVIORS, check_action, get_behavior, plan_stroke
 from affordance_env.camera import RangeCamera
-from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features
+from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
 from affordance_env.kinematics import Kinematics
 from affordance_env.motion import CONTROL_DT, MotionExecutor
 from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size, object_geometry
+from affordance_env.outcome import REST_DURATION, ObjectMonitor, outcome_labels
 from affordance_env.physics import TapPhysics
+from affordance_env.range_noise import add_kinect_noise, check_range_noise
 from affordance_env.robot_model import ACTIVE_JOINTS
 from affordance_env.scene import build_model
 
 #: Region of the table where objects are placed: centre (x, y) and half-widths [m].
 PLACEMENT_CENTRE = np.array([-0.30, 0.03])
 PLACEMENT_HALF_WIDTH = np.array([0.03, 0.03])
+#: Keys of ``reset(options=...)`` that choose the object instead of drawing it.
+RESET_OPTIONS = ("object_type", "size", "position", "yaw")
 #: Yaw jitter of boxes and lying cylinders [rad].
 YAW_JITTER = 0.25
 #: Longest time the object is given to settle after placement [s].
@@ -31,8 +34,6 @@ SETTLE_TIME = 0.5
 #: The hand may start the stroke at most this far from the planned pre-stroke pose [m], and may have moved
 #: the object at most this much before the stroke [m]; otherwise the interaction is marked failed.
 MAX_START_ERROR, MAX_OBJECT_MOVED_BEFORE = 0.01, 0.003
-#: Object at rest: linear [m/s] and angular [rad/s] speed below these.
-REST_SPEED, REST_ANGULAR_SPEED = 0.01, 0.3
 
 
 def _failure_reason(fault: str | None, visible_initially: bool, stroke) -> str | None:
@@ -53,22 +54,6 @@ def _failure_reason(fault: str | None, visible_initially: bool, stroke) -> str |
     return None
 
 
-#: A box or standing cylinder whose vertical axis tilted more than this has toppled over [rad].
-TOPPLE_ANGLE = np.pi / 4
-
-
-def _toppled(object_type: str, quat_initial: np.ndarray, quat_final: np.ndarray) -> bool:
-    """Whether a box or standing cylinder fell over (its body z axis tilted by more than TOPPLE_ANGLE)."""
-    if object_type not in ("box", "vertical_cylinder"):
-        return False  # spheres and lying cylinders turn about horizontal axes when they roll
-    axes = []
-    for quat in (quat_initial, quat_final):
-        R = np.empty(9)
-        mujoco.mju_quat2Mat(R, np.asarray(quat, dtype=np.float64))
-        axes.append(R.reshape(3, 3)[:, 2])
-    return bool(np.arccos(np.clip(axes[0] @ axes[1], -1.0, 1.0)) > TOPPLE_ANGLE)
-
-
 def default_reward(info: dict[str, Any]) -> float:
     """The object's displacement on the table [m]: how much the interaction changed the world."""
     return float(info["displacement"])
@@ -86,6 +71,14 @@ class TapAffordanceEnv(gym.Env):
     tap) and takes the final snapshot. The hand is driven by Pinocchio inverse kinematics and MuJoCo position
     servos; the stroke stops a short follow-through after the hand first touches the object.
 
+    The world: a 60 x 100 cm wooden lab table whose top is what objects rest on and roll on (rolling resistance of
+    wood on wood, see ``assets/README.md``); past its edges an object falls to the floor. The range camera in the
+    head has the iCub eye camera's field of view (57 x 72 degrees at the default 4:3 image). The head keeps the
+    gaze of the initial snapshot until the final one, so both snapshots see the table from the same pose: a
+    moderate tap rolls a ball 5-20 cm, and it is seen where it stops. 3-D features (``mean_x``, ``hand_dx``, ...)
+    are in the robot's root frame, which is fixed (the robot does not walk), so final minus initial is the
+    object's motion; image features are in the head camera's image, also unmoved between the two snapshots.
+
     ## Action Space
     ``Box(-1, 1, (3,), float32)``; 0 is the paper's canonical tap.
 
@@ -93,7 +86,7 @@ class TapAffordanceEnv(gym.Env):
     |-------|---------|-------|
     | 0 | height of the palm above the canonical contact height | -1.5 .. +1.5 cm |
     | 1 | lateral offset of the stroke, across its direction | -2 .. +2 cm |
-    | 2 | hand speed along the stroke | 0.15 .. 0.45 m/s |
+    | 2 | hand speed along the stroke, 0.2 x 3 ** a m/s | 0.067 .. 0.6 m/s |
 
     Values outside [-1, 1], NaN or a wrong shape raise ``ValueError``.
 
@@ -115,18 +108,27 @@ class TapAffordanceEnv(gym.Env):
     Robot at the ``home`` keyframe; object type uniform over ``object_types``, size uniform in ``size_range``,
     position uniform within +-3 cm of (-0.30, 0.03) m on the table, yaw jittered by up to 0.25 rad (boxes and
     lying cylinders; a lying cylinder's axis stays across the tap direction). All drawn from ``self.np_random``.
+    ``reset(options={...})`` may set any of them instead: ``object_type``, ``size`` [m], ``position`` (x, y) on
+    the table [m], ``yaw`` [rad]; another key raises ``ValueError`` listing these.
 
     ## Episode End
-    The episode terminates after one interaction (``terminated=True``). The object's motion is simulated until it
-    is at rest, has left the table, or ``settle_timeout`` seconds after the robot is back home and still.
+    The episode terminates after one interaction (``terminated=True``). The object is followed at every control
+    tick from the start of the step, whatever the arm is doing (:mod:`affordance_env.outcome`). Once the arm is
+    back home and still, the simulation goes on until the object is at rest (still for 50 ms after the first
+    touch), has left the table (detected the moment its centre crosses the table's edge), or ``settle_timeout``
+    seconds have passed since the first touch; then the final snapshot is taken.
 
     ## Info
     After ``reset``: ``object`` (``type``, ``size`` [m], ``pose`` (7,) position and quaternion), ``attention``.
     After ``step`` also: ``effect`` (49,) final minus initial features, ``initial_features``,
-    ``final_features``, ``object`` with ``initial_pose`` and ``final_pose``, ``displacement`` [m], ``rolled``
-    (displacement above ``roll_threshold`` without toppling; the paper's success label), ``toppled`` (a box or
-    standing cylinder fell over: its vertical axis tilted by more than 45 degrees), ``outcome`` (``"rest"``,
-    ``"off_table"`` or ``"timeout"``), ``contact`` (the hand touched the object), ``hand_speed`` [m/s],
+    ``final_features``, ``object`` with ``initial_pose`` and ``final_pose``, ``displacement`` [m] (horizontal
+    travel of the centre on the table: to where it rests, or to where it left the table),
+    ``rolling_distance`` [m] (the part of the travel covered rolling: contact point at rest, centre at constant
+    height), ``rolled`` (``rolling_distance`` above ``roll_threshold``: the paper's success label), ``tilt``
+    [rad] (how far the initially vertical body axis turned), ``toppled`` (tilt above 45 degrees after the centre
+    rose over an edge), ``outcome`` (``"rest"``, ``"off_table"`` or ``"timeout"``), ``outcome_time`` [s] (when,
+    after the first touch, the object came to rest or left the table), ``contact`` (the hand touched the
+    object), ``hand_speed`` [m/s],
     ``ik`` (``success``, ``position_error`` [m], ``orientation_error`` [rad]), ``visible`` (object seen in the
     final snapshot),
     ``failure``: None, or why the interaction is not a valid sample: ``"physics: ..."`` (MuJoCo reported an
@@ -142,10 +144,12 @@ class TapAffordanceEnv(gym.Env):
     | ``behavior`` | ``"tap"`` | ``"tap"``; ``"tap_back"`` (other side, back of hand); ``"push"`` (from the front) |
     | ``object_types`` | all four | types to sample from |
     | ``size_range`` | (0.04, 0.10) | object size range [m] |
-    | ``camera_width``, ``camera_height`` | 128, 128 | range image size [pixels] |
-    | ``camera_fovy`` | 50 | vertical field of view [deg] |
-    | ``roll_threshold`` | 0.05 | displacement above which an interaction is ``rolled`` [m] |
-    | ``settle_timeout`` | 2.0 | longest simulated wait for the outcome once the robot is back home [s] |
+    | ``camera_width``, ``camera_height`` | 160, 120 | range image size [pixels] (the iCub eye camera's 4:3) |
+    | ``camera_fovy`` | 57.4 | vertical field of view [deg]; the iCub eye camera's (fy = 219 px at 320 x 240) |
+    | ``roll_threshold`` | 0.03 | rolling distance above which an interaction is ``rolled`` [m] |
+    | ``settle_timeout`` | 3.0 | longest simulated wait for the outcome after the first touch [s] |
+    | ``range_noise`` | None | ``"kinect_v1"``: the axial depth noise of a structured-light camera (Nguyen, Izadi
+      and Lovell 2012, :mod:`affordance_env.range_noise`), drawn from ``self.np_random``; None: exact ranges |
     | ``reward_fn`` | displacement | ``callable(info) -> float`` |
     | ``render_mode`` | None | ``"rgb_array"``: a picture from an outside camera (headless EGL/OSMesa) |
 
@@ -160,11 +164,12 @@ class TapAffordanceEnv(gym.Env):
         behavior: str = "tap",
         object_types: Sequence[str] = OBJECT_TYPES,
         size_range: tuple[float, float] = (0.04, 0.10),
-        camera_width: int = 128,
-        camera_height: int = 128,
-        camera_fovy: float = 50.0,
-        roll_threshold: float = 0.05,
-        settle_timeout: float = 2.0,
+        camera_width: int = 160,
+        camera_height: int = 120,
+        camera_fovy: float = 57.4,
+        roll_threshold: float = 0.03,
+        settle_timeout: float = 3.0,
+        range_noise: str | None = None,
         reward_fn: Callable[[dict[str, Any]], float] | None = None,
         render_mode: str | None = None,
         render_width: int = 480,
@@ -187,6 +192,7 @@ class TapAffordanceEnv(gym.Env):
                 f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}."
             )
         self.roll_threshold = float(roll_threshold)
+        self.range_noise = check_range_noise(range_noise)
         self.settle_timeout = float(settle_timeout)
         self.reward_fn = default_reward if reward_fn is None else reward_fn
         self.render_mode = render_mode
@@ -195,7 +201,7 @@ class TapAffordanceEnv(gym.Env):
         self.kinematics = Kinematics()
         self.motion = MotionExecutor(self.physics, self.kinematics)
         self.camera = RangeCamera(self.physics.model, width=camera_width, height=camera_height, fovy_deg=camera_fovy)
-        self.attention_camera = RangeCamera(self.physics.model, width=32, height=32, fovy_deg=camera_fovy)
+        self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy)
         self._renderer = None
         self._render_size = (render_width, render_height)
         #: With ``render_mode="rgb_array"``: pictures taken every 1/render_fps s of simulated time during the
@@ -235,7 +241,9 @@ class TapAffordanceEnv(gym.Env):
         }
 
     def _snapshot(self) -> tuple[dict[str, np.ndarray], Any]:
-        image = self.camera.capture(self.physics.data)
+        image = self.camera.capture(self.physics.data, normals=self.range_noise is not None)
+        if self.range_noise is not None:
+            image = add_kinect_noise(image, self.np_random)
         mask = image.mask_of(self.physics.active_geom)
         p_world_hand = self.physics.hand_position()
         uv_hand = image.project(p_world_hand)
@@ -253,22 +261,46 @@ class TapAffordanceEnv(gym.Env):
         }
         return obs, features
 
-    def _sample_object(self) -> tuple[str, float, np.ndarray, float]:
+    def _sample_object(self, options: dict[str, Any] | None) -> tuple[str, float, np.ndarray, float]:
+        """Type, size, position and yaw of the next object: drawn from ``self.np_random``, then replaced by any
+        given in ``options`` (the draws are made either way, so the rest of the episode's randomness is the same)."""
         rng = self.np_random
         object_type = self.object_types[int(rng.integers(len(self.object_types)))]
         size = float(rng.uniform(*self.size_range))
         xy = PLACEMENT_CENTRE + rng.uniform(-1.0, 1.0, 2) * PLACEMENT_HALF_WIDTH
         yaw = float(rng.uniform(-YAW_JITTER, YAW_JITTER))
+        options = dict(options or {})
+        unknown = sorted(set(options) - set(RESET_OPTIONS))
+        if unknown:
+            raise ValueError(f"Unknown reset option(s) {unknown}. Valid options: {', '.join(RESET_OPTIONS)}.")
+        if "object_type" in options:
+            object_type = check_object_type(options["object_type"])
+        if "size" in options:
+            size = check_size(options["size"])
         if object_type in ("sphere", "vertical_cylinder"):
             yaw = 0.0
+        if "position" in options:
+            xy = np.asarray(options["position"], dtype=np.float64)
+            low, high = self.physics.table_extent()
+            if xy.shape != (2,) or not np.all(np.isfinite(xy)) or np.any(xy < low) or np.any(xy > high):
+                raise ValueError(f"position must be (x, y) on the table top, x in [{low[0]:.2f}, {high[0]:.2f}] and "
+                                 f"y in [{low[1]:.2f}, {high[1]:.2f}] m, got {options['position']!r}.")
+        if "yaw" in options:
+            yaw = float(options["yaw"])
+            if not np.isfinite(yaw):
+                raise ValueError(f"yaw must be a finite angle [rad], got {options['yaw']!r}.")
         return object_type, size, xy, yaw
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
-        """Place a new object, let it settle, attend to it and take the initial snapshot."""
+        """Place a new object, let it settle, attend to it and take the initial snapshot.
+
+        ``options`` may choose the object instead of drawing it: ``object_type`` (one of
+        ``affordance_env.OBJECT_TYPES``), ``size`` [m], ``position`` (x, y) on the table [m] and ``yaw`` [rad].
+        """
         super().reset(seed=seed)
+        object_type, size, xy, yaw = self._sample_object(options)
         self.frames = []
         self._next_frame_time = 0.0
-        object_type, size, xy, yaw = self._sample_object()
         physics = self.physics
         physics.reset_home()
         self._q_home = physics.joint_targets()
@@ -298,22 +330,22 @@ class TapAffordanceEnv(gym.Env):
             if physics.object_speed() < 1e-3 and physics.object_angular_speed() < 1e-2:
                 return
 
-    def _wait_outcome(self) -> str:
-        """Simulate until the object is at rest, has left the table, or ``settle_timeout`` has passed."""
+    def _wait_outcome(self, monitor: ObjectMonitor, since: float) -> tuple[str, float]:
+        """Simulate until the object has left the table, has been at rest since ``since`` [s] or later, or
+        ``settle_timeout`` has passed since ``since``; the monitor has followed it all along.
+
+        Returns the outcome and when it happened, in seconds after ``since``: the moment the object left the
+        table, or the moment it had been still for ``REST_DURATION``, which may lie before the arm was back.
+        """
         physics = self.physics
-        t_end = physics.data.time + self.settle_timeout
-        rest_ticks = 0
+        t_end = since + self.settle_timeout
         while True:
-            if not physics.object_on_table():
-                return "off_table"
-            if physics.object_speed() < REST_SPEED and physics.object_angular_speed() < REST_ANGULAR_SPEED:
-                rest_ticks += 1
-                if rest_ticks >= 5:
-                    return "rest"
-            else:
-                rest_ticks = 0
-            if physics.data.time >= t_end:
-                return "timeout"
+            if monitor.left_table:
+                return "off_table", monitor.exit_time - since
+            if monitor.at_rest(physics.data.time, since):
+                return "rest", max(monitor.still_since, since) + REST_DURATION - since
+            if physics.data.time >= t_end - 1e-9:
+                return "timeout", self.settle_timeout
             physics.step(self.motion.steps_per_tick)
 
     def step(self, action):
@@ -326,9 +358,14 @@ class TapAffordanceEnv(gym.Env):
         self.frames = []
         plan = plan_stroke(self.behavior, initial["geometry"], initial["pose"][:3], initial["yaw"],
                            physics.table_top, action)
-        stroke = self.motion.stroke(plan)
-        self.motion.go_home(self._q_home)
-        outcome = self._wait_outcome()
+        monitor = physics.start_monitor()  # from now on, whatever the arm does
+        try:
+            stroke = self.motion.stroke(plan)
+            self.motion.go_home(self._q_home)
+            outcome, outcome_time = self._wait_outcome(
+                monitor, stroke.contact_time if stroke.contact else physics.data.time)
+        finally:
+            physics.monitor = None
         fault = physics.unstable()
         if fault is None:
             obs, features = self._snapshot()
@@ -341,12 +378,15 @@ class TapAffordanceEnv(gym.Env):
             final_pose = np.full(7, np.nan)
             visible = False
         failure = _failure_reason(fault, initial["visible"], stroke)
-        displacement = 0.0 if fault else float(np.linalg.norm(final_pose[:2] - initial["pose"][:2]))
-        toppled = (not fault) and _toppled(initial["geometry"].object_type, initial["pose"][3:], final_pose[3:])
+        # Travel on the table: to where the object rests, or to where it left the table (not where it fell).
+        p_end = monitor.exit_position if monitor.left_table else final_pose
+        displacement = 0.0 if fault else float(np.linalg.norm(p_end[:2] - initial["pose"][:2]))
+        labels = None if fault else outcome_labels(monitor, initial["pose"][3:], final_pose[3:],
+                                                   self.roll_threshold)
         effect = (
             np.zeros(len(FEATURE_NAMES), np.float32)
             if fault
-            else (final_features - initial["features"].values).astype(np.float32)
+            else effect_features(initial["features"].values, final_features)
         )
         info = {
             "object": {"type": initial["geometry"].object_type, "size": initial["geometry"].size,
@@ -355,9 +395,12 @@ class TapAffordanceEnv(gym.Env):
             "final_features": final_features,
             "effect": effect,
             "displacement": displacement,
-            "rolled": displacement > self.roll_threshold and not toppled,
-            "toppled": toppled,
+            "rolling_distance": 0.0 if fault else monitor.rolling_distance,
+            "rolled": bool(labels and labels.rolled),
+            "toppled": bool(labels and labels.toppled),
+            "tilt": 0.0 if fault else labels.tilt,
             "outcome": "fault" if fault else outcome,
+            "outcome_time": float(outcome_time),
             "contact": stroke.contact,
             "hand_speed": stroke.hand_speed,
             "ik": {"success": stroke.ik_success, "position_error": stroke.ik_position_error,

@@ -48,7 +48,9 @@ def test_action_moves_height_lateral_offset_and_speed():
     moved = plan_stroke(get_behavior("tap"), box, p_object, 0.0, TABLE, np.array([1.0, 1.0, 1.0]))
     assert moved.p_start[2] - base.p_start[2] == pytest.approx(0.015)
     assert abs(moved.p_start[0] - base.p_start[0]) == pytest.approx(0.02)
-    assert moved.speed == pytest.approx(0.45)
+    assert moved.speed == pytest.approx(0.6)  # hardest: 3 x the canonical 0.2 m/s
+    gentle = plan_stroke(get_behavior("tap"), box, p_object, 0.0, TABLE, np.array([0.0, 0.0, -1.0]))
+    assert gentle.speed == pytest.approx(0.2 / 3)
 
 
 def test_push_and_tap_back_move_the_other_ways():
