@@ -43,7 +43,7 @@ from affordance_env.behaviors import ACTION_DIM
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
 
 #: Version of the on-disk format; :func:`load_dataset` reads versions 1 up to this one.
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 FORMAT = "tap-affordance-dataset"
 MANIFEST = "manifest.json"
 METADATA_KEY = b"tap_affordance"
@@ -66,9 +66,10 @@ def arrow_schema(save_images: bool = False) -> pa.Schema:
               ("type", pa.string()), ("size", pa.float64())]
     fields += [(f"action_{j}", pa.float32()) for j in range(ACTION_DIM)]
     fields += [(f"{stage}_{f}", pa.float64()) for stage in ("initial", "final") for f in POSE_FIELDS]
-    fields += [("displacement", pa.float64()), ("rolled", pa.bool_()), ("outcome", pa.string()),
-               ("contact", pa.bool_()), ("hand_speed", pa.float64()), ("visible_initial", pa.bool_()),
-               ("visible_final", pa.bool_()), ("ik_success", pa.bool_())]
+    fields += [("displacement", pa.float64()), ("rolling_distance", pa.float64()), ("rolled", pa.bool_()),
+               ("tilt", pa.float64()), ("toppled", pa.bool_()), ("outcome", pa.string()),
+               ("outcome_time", pa.float64()), ("contact", pa.bool_()), ("hand_speed", pa.float64()),
+               ("visible_initial", pa.bool_()), ("visible_final", pa.bool_()), ("ik_success", pa.bool_())]
     fields += [(f"{stage}_{name}", pa.float64())
                for stage in ("initial", "final", "effect") for name in FEATURE_NAMES]
     if save_images:
@@ -147,10 +148,11 @@ def _record(episode: int, env_seed: int, action: np.ndarray, reset_info: dict, i
     row.update({f"action_{j}": a for j, a in enumerate(action)})
     for stage in ("initial", "final"):
         row.update({f"{stage}_{f}": float(v) for f, v in zip(POSE_FIELDS, obj[f"{stage}_pose"], strict=True)})
-    row.update(displacement=float(info["displacement"]), rolled=bool(info["rolled"]), outcome=info["outcome"],
-               contact=bool(info["contact"]), hand_speed=float(info["hand_speed"]),
-               visible_initial=bool(reset_info["visible"]), visible_final=bool(info["visible"]),
-               ik_success=bool(info["ik"]["success"]))
+    row.update(displacement=float(info["displacement"]), rolling_distance=float(info["rolling_distance"]),
+               rolled=bool(info["rolled"]), tilt=float(info["tilt"]), toppled=bool(info["toppled"]),
+               outcome=info["outcome"], outcome_time=float(info["outcome_time"]), contact=bool(info["contact"]),
+               hand_speed=float(info["hand_speed"]), visible_initial=bool(reset_info["visible"]),
+               visible_final=bool(info["visible"]), ik_success=bool(info["ik"]["success"]))
     for stage, values in (("initial", info["initial_features"]), ("final", info["final_features"]),
                           ("effect", info["effect"])):
         row.update({f"{stage}_{name}": float(v) for name, v in zip(FEATURE_NAMES, values, strict=True)})
@@ -536,7 +538,9 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
 
     Columns (:func:`arrow_schema`): ``episode`` (index i), ``seed`` (env seed of interaction i), ``behavior``,
     ``type``, ``size`` [m], ``action_0..2``, ``initial_x, _y, _z, _qw, _qx, _qy, _qz`` and ``final_...``
-    (object position [m] and quaternion), ``displacement`` [m], ``rolled``, ``outcome``, ``contact``,
+    (object position [m] and quaternion), ``displacement`` [m], ``rolling_distance`` [m], ``rolled``, ``tilt``
+    [rad], ``toppled``, ``outcome``, ``outcome_time`` [s] (see the environment's ``info``; datasets of schema
+    version 2 and older lack ``rolling_distance``, ``tilt``, ``toppled`` and ``outcome_time``), ``contact``,
     ``hand_speed`` [m/s], ``visible_initial``, ``visible_final``, ``ik_success``, then ``initial_<f>``,
     ``final_<f>``, ``effect_<f>`` for each name ``f`` of ``FEATURE_NAMES``; with ``with_images`` also the
     encoded images (decode them with :func:`images`). ``frame.attrs["manifest"]`` holds the manifest and
@@ -568,7 +572,6 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
                            "with `affordance collect`.")
     manifest = read_manifest(path)
     version = manifest["schema_version"]
-    columns = None if with_images or version == 1 else arrow_schema(False).names
     tables, failures, missing = [], {}, []
     ranges = _chunk_ranges(manifest["episodes"], manifest["settings"]["chunk_size"])
     for index, (start, stop) in enumerate(ranges):
@@ -579,6 +582,7 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
         try:
             if version >= 2:
                 failures.update(_check_chunk(chunk, manifest, start, stop)["chunk"]["failures"])
+            columns = None if with_images else [c for c in pq.read_schema(chunk).names if c not in IMAGE_COLUMNS]
             table = pq.read_table(chunk, columns=columns)
         except DatasetError as exc:
             raise DatasetError(f"{exc} Delete {chunk.name} and rerun the same collect command to redo "

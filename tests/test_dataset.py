@@ -40,18 +40,23 @@ def assert_same_dataset(path, reference: pd.DataFrame) -> None:
 
 
 @pytest.fixture(scope="module")
-def reference(tmp_path_factory):
+def reference_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("data") / "reference"
     collect(out, 24, workers=1, **RUN)
-    return load_dataset(out)
+    return out
+
+
+@pytest.fixture(scope="module")
+def reference(reference_dir):
+    return load_dataset(reference_dir)
 
 
 def test_schema_columns_and_metadata(reference, tmp_path):
     assert len(reference) + len(reference.attrs["failures"]) == 24
     pose = [f"{stage}_{f}" for stage in ("initial", "final") for f in ("x", "y", "z", "qw", "qx", "qy", "qz")]
     required = ["action_0", "action_1", "action_2", "type", "size", *pose, "displacement", "rolled",
-                "outcome", "contact", "visible_initial", "visible_final", "ik_success", "behavior", "episode",
-                "seed"]
+                "rolling_distance", "tilt", "toppled", "outcome", "outcome_time", "contact", "visible_initial",
+                "visible_final", "ik_success", "behavior", "episode", "seed"]
     required += [f"{stage}_{name}" for stage in ("initial", "final", "effect") for name in FEATURE_NAMES]
     assert set(required) <= set(reference.columns)
     assert reference["episode"].is_monotonic_increasing and reference["episode"].is_unique
@@ -61,16 +66,16 @@ def test_schema_columns_and_metadata(reference, tmp_path):
     assert reference.rolled.dtype == bool and set(reference.behavior) == {"tap"}
     manifest = reference.attrs["manifest"]
     assert manifest["feature_names"] == list(FEATURE_NAMES) and manifest["feature_groups"] == FEATURE_GROUPS
-    assert manifest["schema_version"] == 2 and manifest["complete"] and manifest["rows"] == len(reference)
+    assert manifest["schema_version"] == 3 and manifest["complete"] and manifest["rows"] == len(reference)
     assert manifest["settings"]["env_options"]["camera_width"] == 32
-    assert manifest["settings"]["env_options"]["settle_timeout"] == 2.0  # defaults are recorded too
+    assert manifest["settings"]["env_options"]["settle_timeout"] == 3.0  # defaults are recorded too
 
 
 def test_chunk_files(tmp_path, reference):
     collect(tmp_path / "d", 8, workers=1, **RUN)
     chunk = tmp_path / "d" / "chunk-00000.parquet"
     meta = json.loads(pq.read_schema(chunk).metadata[b"tap_affordance"])
-    assert meta["schema_version"] == 2 and meta["feature_names"] == list(FEATURE_NAMES)
+    assert meta["schema_version"] == 3 and meta["feature_names"] == list(FEATURE_NAMES)
     assert meta["package_version"] and meta["settings"]["env_options"]["camera_height"] == 32
     assert (meta["chunk"]["start"], meta["chunk"]["stop"]) == (0, 8)
     plain = pd.read_parquet(chunk)
@@ -110,7 +115,7 @@ def test_other_settings_are_refused_naming_them(tmp_path):
     collect(out, 4, seed=1, env_options=SMALL, chunk_size=4, progress=False)
     with pytest.raises(DatasetError, match="other settings.*seed: dataset has 1, asked for 2"):
         collect(out, 4, seed=2, env_options=SMALL, chunk_size=4, progress=False)
-    with pytest.raises(DatasetError, match="camera_width: dataset has 32, asked for 128"):
+    with pytest.raises(DatasetError, match="camera_width: dataset has 32, asked for 160"):
         collect(out, 4, seed=1, env_options={}, chunk_size=4, progress=False)
     with pytest.raises(DatasetError, match="action: dataset has 'canonical', asked for 'random'.*chunk_size"):
         collect(out, 4, seed=1, action="random", env_options=SMALL, chunk_size=2, progress=False)
@@ -251,6 +256,24 @@ def test_schema_version_1_datasets_are_read(reference, tmp_path):
     assert "object_initial_x" in old.columns and "initial_x" in frame.columns
     with pytest.raises(DatasetError, match="schema_version: dataset has 1"):
         collect(out, 8, workers=1, **RUN)
+
+
+def test_schema_version_2_datasets_are_read(reference, reference_dir, tmp_path):
+    # Version 2 had no rolling_distance, tilt, toppled or outcome_time columns.
+    out = tmp_path / "v2"
+    out.mkdir()
+    added = ["rolling_distance", "tilt", "toppled", "outcome_time"]
+    manifest = {**reference.attrs["manifest"], "schema_version": 2}
+    for index in range(3):
+        chunk = pq.read_table(reference_dir / f"chunk-{index:05d}.parquet")
+        meta = json.loads(chunk.schema.metadata[b"tap_affordance"])
+        meta["schema_version"] = 2
+        chunk = chunk.drop_columns(added).replace_schema_metadata({b"tap_affordance": json.dumps(meta)})
+        pq.write_table(chunk, out / f"chunk-{index:05d}.parquet")
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    frame = load_dataset(out)
+    assert len(frame) == len(reference) and not set(added) & set(frame.columns)
+    pd.testing.assert_frame_equal(frame, reference.drop(columns=added), check_exact=True)
 
 
 def test_progress_bar_only_on_a_terminal_and_not_in_ci(monkeypatch):
