@@ -63,7 +63,7 @@ MULTICLASS_THRESHOLD = 10
 #: Number of (instance, neighbour) pairs whose feature differences are held in memory at once.
 _PAIR_CHUNK = 32768
 
-DataType = Literal["continuous", "discrete", "mixed"]
+DataType = Literal["continuous", "discrete", "mixed", "constant"]
 
 
 def _check_n_neighbors(n_neighbors: object) -> int:
@@ -115,14 +115,14 @@ class ReliefFScorer:
         n_unique = np.array([np.unique(X[:, j]).size for j in range(self.n_features)])
         #: True for the features with a single value: weight 0, and no part in the data type or distances.
         self.constant = n_unique == 1
-        if self.constant.all():
-            raise ValueError(f"every feature of X is constant (shape {X.shape}); ReliefF needs one that varies.")
         #: True for the features treated as discrete, (n_features,).
         self.discrete = (n_unique <= discrete_threshold) & ~self.constant
         continuous = ~self.discrete & ~self.constant
         self._continuous = continuous
-        if not self.discrete.any():
-            self.data_type: DataType = "continuous"
+        if self.constant.all():  # nothing varies, nothing separates the classes: every weight is 0
+            self.data_type: DataType = "constant"
+        elif not self.discrete.any():
+            self.data_type = "continuous"
         elif not continuous.any():
             self.data_type = "discrete"
         else:
@@ -140,7 +140,9 @@ class ReliefFScorer:
         ``sys.maxsize``."""
         cidx = np.flatnonzero(self._continuous)
         didx = np.flatnonzero(self.discrete)
-        if self.data_type == "discrete":
+        if self.data_type == "constant":
+            dist = np.zeros((self.n_samples, self.n_samples))
+        elif self.data_type == "discrete":
             dist = squareform(pdist(self.X[:, didx], metric="hamming"))
         else:
             xc = (self.X[:, cidx] - self.minimum[cidx]) / self.range[cidx]
@@ -203,12 +205,12 @@ class ReliefFScorer:
             raw -= np.take(self.X, cols[start:stop], axis=0)
             np.abs(raw, out=raw)
             w = pair_weight[start:stop]
-            if self.data_type != "discrete":
+            if self.data_type in ("continuous", "mixed"):
                 spread = raw[:, cont]
                 if self.data_type == "mixed":
                     spread = np.where(spread > self.std[cont], self.range[cont], spread)
                 total[cont] += w @ spread
-            if self.data_type != "continuous":
+            if self.data_type in ("discrete", "mixed"):
                 # Exact for finite floats: a - b == 0 exactly when a == b.
                 total[self.discrete] += w @ (raw[:, self.discrete] != 0).astype(np.float64)
         total[cont] /= self.range[cont]
