@@ -28,6 +28,8 @@ from affordance_env.features import (
     VERTICAL_TOLERANCE_RAD,
     Features,
     compute_features,
+    effect_features,
+    wrap_axis_angle,
 )
 
 INDEX = {name: i for i, name in enumerate(FEATURE_NAMES)}
@@ -264,6 +266,26 @@ def test_orientation_of_a_vertical_principal_axis_is_plus_half_pi() -> None:
     for angle in (math.pi / 2, -math.pi / 2):
         orientation = rectangle_features(angle).values[INDEX["orientation"]]
         assert orientation == pytest.approx(math.pi / 2, abs=1e-6)
+
+
+def test_orientation_effect_of_a_small_turn_across_the_wrap_is_small() -> None:
+    # A rectangle near vertical in the image turns by 2 degrees across +-pi/2: its orientation feature jumps
+    # from about +pi/2 to about -pi/2, but the effect is the 2-degree turn.
+    before = rectangle_features(math.radians(89.0)).values
+    after = rectangle_features(math.radians(91.0)).values
+    k = INDEX["orientation"]
+    assert before[k] > 1.5 and after[k] < -1.5  # the raw features sit on both sides of the wrap
+    effect = effect_features(before, after)
+    assert effect[k] == pytest.approx(math.radians(2.0), abs=math.radians(1.0))
+    back = effect_features(after, before)
+    assert back[k] == pytest.approx(-math.radians(2.0), abs=math.radians(1.0))
+    others = np.arange(len(before)) != k
+    np.testing.assert_allclose(effect[others], (after - before)[others], rtol=1e-6, atol=1e-6)
+    for turn in np.linspace(-3 * math.pi, 3 * math.pi, 37):
+        assert -math.pi / 2 < wrap_axis_angle(turn) <= math.pi / 2
+        assert math.cos(2 * float(wrap_axis_angle(turn))) == pytest.approx(math.cos(2 * turn), abs=1e-9)
+    with pytest.raises(ValueError, match="feature arrays"):
+        effect_features(before, after[:10])
 
 
 def test_ray_distance_of_a_receding_face() -> None:
