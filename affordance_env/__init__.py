@@ -22,7 +22,7 @@ from affordance_env.robot_model import ACTIVE_JOINTS  # noqa: E402
 
 register_envs()
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 __all__ = [
     "ACTIVE_JOINTS",

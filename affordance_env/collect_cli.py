@@ -9,7 +9,7 @@ from typing import Any
 
 #: Command-line flags that are env options, and the env keyword each one sets.
 _ENV_FLAGS = ("behavior", "object_types", "size_range", "camera_width", "camera_height", "camera_fovy",
-              "roll_threshold", "settle_timeout")
+              "roll_threshold", "settle_timeout", "range_noise")
 
 
 def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -49,9 +49,11 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     env.add_argument("--camera-height", type=int, default=None, help="range image height [pixels]")
     env.add_argument("--camera-fovy", type=float, default=None, help="vertical field of view [deg]")
     env.add_argument("--roll-threshold", type=float, default=None,
-                     help="displacement above which an interaction is 'rolled' [m]")
+                     help="rolling distance above which an interaction is 'rolled' [m]")
     env.add_argument("--settle-timeout", type=float, default=None,
-                     help="longest simulated wait for the outcome [s]")
+                     help="longest simulated wait for the outcome after the first touch [s]")
+    env.add_argument("--range-noise", default=None, choices=("kinect_v1",),
+                     help="depth noise of the range camera (default: none)")
     parser.set_defaults(func=run_collect)
     return parser
 

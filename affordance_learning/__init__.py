@@ -10,7 +10,7 @@
   (``affordance reproduce`` runs them end to end).
 """
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 from affordance_learning.default_model import (  # noqa: E402 (after __version__, which it reads)
     DefaultModelError,

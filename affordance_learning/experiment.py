@@ -119,6 +119,8 @@ class _Data:
     rolled: np.ndarray  # (n,) bool
     types: np.ndarray  # (n,) str
     sizes: np.ndarray  # (n,) float [m]
+    effect_mean: np.ndarray  # (d,) the standardisation of the effects, to turn prototypes back into units
+    effect_scale: np.ndarray  # (d,)
 
 
 def _frame_data(frame: pd.DataFrame) -> _Data:
@@ -148,14 +150,17 @@ def _frame_data(frame: pd.DataFrame) -> _Data:
     sizes = frame["size"].to_numpy(dtype=np.float64)
     if not np.all(np.isfinite(sizes)):
         raise ValueError("'size' must be finite [m] for every row.")
+    scaler = StandardScaler().fit(E)
     return _Data(
         names=names,
         shape=np.array([g == "shape" for g in feature_groups(names)]),
         X=X,
-        Z=StandardScaler().fit_transform(E),
+        Z=scaler.transform(E),
         rolled=rolled,
         types=frame["type"].astype(str).to_numpy(),
         sizes=sizes,
+        effect_mean=scaler.mean_,
+        effect_scale=scaler.scale_,
     )
 
 
@@ -200,22 +205,22 @@ def _run_trial(
     X_train, X_test = data.X[train], data.X[test]
     scorer: ReliefFScorer | None = None
     out: dict[str, Any] = {
-        key: {} for key in ("uniformity", "purity", "ari", "n_categories", "baseline", "weights", "cases")
+        key: {} for key in ("uniformity", "purity", "ari", "n_categories", "baseline", "weights", "cases",
+                            "prototypes")
     }
     out.update({key: {} for key in ("accuracy", "shape_fraction", "n_selected")})
     for k in ks:
         seed = np.random.SeedSequence([random_state, trial, k]).generate_state(1)[0]
-        labels = (
-            SOMClustering(n_clusters=k, n_iterations=som_iterations, random_state=int(seed))
-            .fit(data.Z)
-            .labels_
-        )
+        som = SOMClustering(n_clusters=k, n_iterations=som_iterations, random_state=int(seed)).fit(data.Z)
+        labels = som.labels_
         out["uniformity"][k] = uniformity(labels, data.rolled)
         out["purity"][k] = cluster_purity(labels, data.types)
         out["ari"][k] = adjusted_rand(labels, data.types)
         out["n_categories"][k] = int(np.unique(labels).size)
         if trial == 0 and k in case_study_ks:
             out["cases"][k] = _case_study(labels, k, data, type_order)
+            # the map's prototype effects, back in feature units (the SOM learned them standardised)
+            out["prototypes"][k] = (som.cluster_centers_ * data.effect_scale + data.effect_mean).tolist()
         y_train, y_test = labels[train], labels[test]
         classes, counts = np.unique(y_train, return_counts=True)
         majority = classes[np.argmax(counts)]
@@ -391,6 +396,9 @@ def run_protocol(
         "shape_fraction": per_rk("shape_fraction"),
         "n_selected": per_rk("n_selected"),
         "case_studies": {str(k): trials[0]["cases"][k] for k in case_study_ks},
+        "prototypes": {str(k): trials[0]["prototypes"][k] for k in case_study_ks},
+        "feature_names": list(data.names),
+        "effects": effect_summary(df),
         "purity": per_k("purity"),
         "adjusted_rand": per_k("ari"),
         "n_categories": per_k("n_categories"),
@@ -428,14 +436,86 @@ def run_protocol(
     }
 
 
+def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:
+    """What the effects of a dataset contain, for a reader to check before any verdict.
+
+    Per object type (``by_type``): interactions, the shares rolled, at rest and seen in the final snapshot
+    (``visible_final``), and left the table (``outcome == "off_table"``); the median travel (``displacement``)
+    [m], the median 3-D motion seen, ``|effect of (mean_x, mean_y, mean_z)|`` [m], over the objects seen at
+    the end, the median ``|effect of pixel_count|`` [pixels] and the median change of the normal histograms
+    (sum of ``|effect|`` over the 24 shape features). Overall: the share of rolled objects seen at the end
+    (``rolled_visible``), the share of rolled objects whose effect is just minus their initial features
+    (``rolled_effect_is_minus_initial``: they vanished), and the Spearman correlation of the travel with the
+    3-D motion seen (``travel_vs_seen_motion``). Columns the frame lacks give None.
+    """
+    names = feature_names(frame)
+    groups = feature_groups(names)
+    xyz = [f"effect_{n}" for n in ("mean_x", "mean_y", "mean_z") if n in names]
+    seen_motion = (np.linalg.norm(frame[xyz].to_numpy(dtype=np.float64), axis=1) if len(xyz) == 3
+                   else np.full(len(frame), np.nan))
+    shape_change = np.abs(frame[[f"effect_{n}" for n, g in zip(names, groups, strict=True) if g == "shape"]]
+                          .to_numpy(dtype=np.float64)).sum(axis=1)
+    initial = frame[[f"initial_{n}" for n in names]].to_numpy(dtype=np.float64)
+    effect = frame[[f"effect_{n}" for n in names]].to_numpy(dtype=np.float64)
+    vanished = np.abs(effect + initial).max(axis=1) < 1e-6
+    visible = frame["visible_final"].to_numpy(dtype=bool) if "visible_final" in frame else None
+    outcome = frame["outcome"].astype(str).to_numpy() if "outcome" in frame else None
+    travel = frame["displacement"].to_numpy(dtype=np.float64) if "displacement" in frame else None
+    rolled = frame["rolled"].to_numpy(dtype=bool)
+    pixels = (np.abs(frame["effect_pixel_count"].to_numpy(dtype=np.float64)) if "pixel_count" in names
+              else np.full(len(frame), np.nan))
+
+    def share(mask: np.ndarray | None, rows: np.ndarray) -> float | None:
+        return None if mask is None or not rows.any() else float(np.mean(mask[rows]))
+
+    def median(values: np.ndarray | None, rows: np.ndarray) -> float | None:
+        if values is None or not rows.any():
+            return None
+        finite = values[rows][np.isfinite(values[rows])]
+        return float(np.median(finite)) if finite.size else None
+
+    types = frame["type"].astype(str).to_numpy()
+    by_type = {}
+    for t in [t for t in OBJECT_TYPES if t in set(types)] + sorted(set(types) - set(OBJECT_TYPES)):
+        rows = types == t
+        seen = rows & visible if visible is not None else rows
+        by_type[t] = {
+            "n": int(rows.sum()),
+            "rolled": share(rolled, rows),
+            "rest": share(None if outcome is None else outcome == "rest", rows),
+            "visible_final": share(visible, rows),
+            "off_table": share(None if outcome is None else outcome == "off_table", rows),
+            "displacement": median(travel, rows),
+            "seen_motion": median(seen_motion, seen),
+            "pixel_count_change": median(pixels, rows),
+            "shape_change": median(shape_change, rows),
+        }
+    correlation = None
+    if travel is not None and visible is not None and visible.sum() >= 3:
+        from scipy.stats import spearmanr
+
+        correlation = float(spearmanr(travel[visible], seen_motion[visible]).statistic)
+    return {
+        "by_type": by_type,
+        "rolled_visible": share(visible, rolled),
+        "rolled_rest_visible": None if visible is None or outcome is None else share(
+            visible & (outcome == "rest"), rolled),
+        "rolled_effect_is_minus_initial": share(vanished, rolled),
+        "travel_vs_seen_motion": correlation,
+    }
+
+
 def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0) -> pd.DataFrame:
     """A dataset frame in the project's schema with tapping-like structure, made without the simulator.
 
     Objects of the four types, sizes uniform in [0.04, 0.10] m. Spheres and lying cylinders roll (95 %),
     boxes and standing cylinders do not (97 %). Shape features (normal histograms, fractions) depend on the
-    type, size features on the size, relation features are jitter; a rolling object's effect moves its
-    position, range and pixel count by its travel, a resting one's barely changes. Feature names are
-    ``affordance_env.features.FEATURE_NAMES`` when available, else ``f00`` ... ``f48``.
+    type, size features on the size, relation features are jitter. As on the simulated table, a rolled object
+    travels 5-22 cm and is seen where it stops: its effect moves its position, range, pixel count and image
+    offsets by its travel; 3 % of the rolled objects leave the table instead (``outcome == "off_table"``,
+    ``visible_final`` False, final features all zeros, so their effect is minus their initial features); a
+    resting object slides about 1.5 cm. Feature names are ``affordance_env.features.FEATURE_NAMES`` when
+    available, else ``f00`` ... ``f48``.
 
     Args:
         n_rows: Interactions, >= 8.
@@ -497,23 +577,28 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0) -> pd.DataFr
     relation = rng.normal(0.0, 1.0, (n_rows, 7)) * np.array([5, 5, 7, 0.02, 0.02, 0.02, 0.03])
     initial = np.hstack([shape, size_features, relation])
 
-    # Effects: travel along the tap direction (+y) for rolling objects, a 1 cm slide otherwise.
-    roll = np.where(types == "sphere", rng.uniform(0.15, 0.35, n_rows), rng.uniform(0.3, 0.6, n_rows))
-    travel = np.where(rolled, roll, rng.normal(0.01, 0.002, n_rows))
+    # Effects: travel along the tap direction for rolling objects, a 1.5 cm slide otherwise.
+    roll = np.where(types == "sphere", rng.uniform(0.10, 0.22, n_rows), rng.uniform(0.05, 0.20, n_rows))
+    travel = np.where(rolled, roll, rng.normal(0.015, 0.003, n_rows))
+    off_table = rolled & (rng.random(n_rows) < 0.03)
     effect = rng.normal(0.0, 1.0, initial.shape) * 0.01 * (np.abs(initial).mean(axis=0) + 1e-3)
     effect[:, 24] += 0.1 * travel  # mean_x
     effect[:, 25] += travel  # mean_y
     effect[:, 27] += 0.6 * travel  # mean_range
-    effect[:, 28] -= pixels * np.clip(1.2 * travel, 0.0, 0.9)  # pixel_count
-    effect[:, 42:45] += np.column_stack([2, 60, 60]).ravel() * travel[:, None]  # image offsets [pixels]
+    effect[:, 28] -= pixels * 0.8 * travel  # pixel_count: seen from a little further away
+    effect[:, 42:45] += np.column_stack([10, 300, 300]).ravel() * travel[:, None]  # image offsets [pixels]
     effect[:, 46] += travel  # hand_dy
     effect[:, 48] += travel  # hand_distance
     spin = np.where(types == "horizontal_cylinder", 1.0, 0.0) * rolled
     effect[:, 12:24] += 0.05 * spin[:, None] * rng.normal(0.0, 1.0, (n_rows, 12))
     final = initial + effect
+    final[off_table] = 0.0  # not visible: the documented zeros
+    effect[off_table] = -initial[off_table]
 
     columns: dict[str, Any] = {}
     for prefix, values in (("initial_", initial), ("final_", final), ("effect_", effect)):
         columns.update({f"{prefix}{n}": values[:, j] for j, n in enumerate(names)})
-    columns.update({"type": types, "size": size, "rolled": rolled, "displacement": np.abs(travel)})
+    columns.update({"type": types, "size": size, "rolled": rolled, "displacement": np.abs(travel),
+                    "rolling_distance": np.where(rolled, np.abs(travel), 0.0), "visible_final": ~off_table,
+                    "outcome": np.where(off_table, "off_table", "rest")})
     return pd.DataFrame(columns)

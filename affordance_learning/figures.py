@@ -11,6 +11,9 @@ Drawn with matplotlib's object API on the Agg canvas (no pyplot, no display, no 
   accuracy of always answering the most common category.
 - ``clusters_vs_type.png`` (not in the paper): purity and adjusted Rand index of the clusters against the
   object type versus k.
+- ``prototypes.png`` (not in the paper): what each effect category of the 1 x 2 and 1 x 4 maps is, as its
+  prototype effect in feature units: the motion of the object's mean point [cm], the change of its pixel count,
+  and the change of its normal histograms.
 """
 
 from __future__ import annotations
@@ -161,6 +164,51 @@ def _clusters_vs_type(results: Mapping[str, Any], path: Path) -> Path:
     return _save(fig, path)
 
 
+def _prototypes(results: Mapping[str, Any], path: Path) -> Path:
+    maps = sorted(results["prototypes"].items(), key=lambda item: int(item[0]))
+    names = list(results["feature_names"])
+    fig, axes = _new_figure(14.0, 3.2 * len(maps), ncols=4, nrows=len(maps))
+    axes = axes.reshape(len(maps), 4)
+    index = {n: i for i, n in enumerate(names)}
+    lat = [i for i, n in enumerate(names) if n.startswith("normal_lat_")]
+    lon = [i for i, n in enumerate(names) if n.startswith("normal_lon_")]
+    xyz = [index.get(n) for n in ("mean_x", "mean_y", "mean_z")]
+    for row, (k, prototypes) in enumerate(maps):
+        P = np.asarray(prototypes, dtype=float)
+        clusters = results.get("case_studies", {}).get(k, [])
+        labels = [f"{c} ({cl['rolled']} rolled / {cl['not_rolled']} not)" if (cl := _cluster(clusters, c))
+                  else str(c) for c in range(len(P))]
+        ax_move, ax_pix, ax_lat, ax_lon = axes[row]
+        if None not in xyz:
+            width = 0.8 / 3
+            for j, (i, axis) in enumerate(zip(xyz, "xyz", strict=True)):
+                ax_move.bar(np.arange(len(P)) - 0.4 + width * (j + 0.5), 100 * P[:, i], width,
+                            label=f"mean_{axis}")
+            ax_move.legend(fontsize="x-small")
+        ax_move.set(xlabel="cluster", ylabel="change [cm]", title=f"1 x {k}: motion of the mean point")
+        if "pixel_count" in index:
+            ax_pix.bar(np.arange(len(P)), P[:, index["pixel_count"]], color="tab:gray")
+        ax_pix.set(xlabel="cluster", ylabel="change [pixels]", title="pixel count")
+        for ax, cols, title in ((ax_lat, lat, "normal latitude histogram"),
+                                (ax_lon, lon, "normal longitude histogram")):
+            for c in range(len(P)):
+                ax.plot(np.arange(len(cols)), P[c, cols], marker=".", label=labels[c])
+            ax.axhline(0.0, color="grey", linewidth=0.8)
+            ax.set(xlabel="bin", ylabel="change [fraction]", title=title)
+        ax_lon.legend(fontsize="x-small")
+        for ax in (ax_move, ax_pix):
+            ax.set_xticks(np.arange(len(P)))
+            ax.axhline(0.0, color="grey", linewidth=0.8)
+        for ax in axes[row]:
+            ax.grid(alpha=0.3)
+    fig.suptitle("Prototype effect of each category, in feature units (first trial)")
+    return _save(fig, path)
+
+
+def _cluster(clusters: list[Mapping[str, Any]], c: int) -> Mapping[str, Any] | None:
+    return next((cl for cl in clusters if cl.get("cluster") == c), None)
+
+
 def write_figures(results: Mapping[str, Any], out_dir: str | Path) -> list[Path]:
     """Write the figures of a results dict into ``out_dir`` (created if needed); returns their paths.
 
@@ -183,4 +231,6 @@ def write_figures(results: Mapping[str, Any], out_dir: str | Path) -> list[Path]
     paths.append(_svm_accuracy(results, out / "svm_accuracy.png"))
     if "purity" in results and "adjusted_rand" in results:
         paths.append(_clusters_vs_type(results, out / "clusters_vs_type.png"))
+    if results.get("prototypes") and "feature_names" in results:
+        paths.append(_prototypes(results, out / "prototypes.png"))
     return paths

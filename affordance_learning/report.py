@@ -407,6 +407,52 @@ def _case_tables(results: Mapping[str, Any]) -> list[str]:
     return lines
 
 
+def _pct(value: float | None) -> str:
+    return "-" if value is None else f"{100 * value:.0f} %"
+
+
+def _num(value: float | None, scale: float = 1.0, digits: int = 1) -> str:
+    return "-" if value is None else f"{scale * value:.{digits}f}"
+
+
+def _effects_section(results: Mapping[str, Any], figures: Sequence[str]) -> list[str]:
+    """What the effects contain: the numbers a reviewer asks for before any verdict."""
+    effects = results.get("effects")
+    if not effects:
+        return []
+    lines = [
+        "## What the effects contain",
+        "",
+        "An effect is final minus initial features. It carries what happened only if the final snapshot sees the "
+        "object where it stopped; an object that left the table or the view has the documented not-visible "
+        "features (zeros), so its effect is just minus its initial features.",
+        "",
+        f"- Rolled objects seen in the final snapshot: **{_pct(effects.get('rolled_visible'))}** "
+        f"(at rest and seen: {_pct(effects.get('rolled_rest_visible'))}); rolled objects whose effect is minus "
+        f"their initial features (they vanished): {_pct(effects.get('rolled_effect_is_minus_initial'))}.",
+        f"- Spearman correlation of the true travel with the 3-D motion seen (norm of the effect on mean_x, "
+        f"mean_y, mean_z), over the objects seen at the end: "
+        f"**{_num(effects.get('travel_vs_seen_motion'), digits=2)}**.",
+        "",
+        "| type | n | rolled | at rest | seen at the end | left the table | travel [cm] | motion seen [cm] | "
+        "pixel count change | normal histogram change |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for t, row in effects.get("by_type", {}).items():
+        lines.append(
+            f"| {t.replace('_', ' ')} | {row['n']} | {_pct(row['rolled'])} | {_pct(row['rest'])} | "
+            f"{_pct(row['visible_final'])} | {_pct(row['off_table'])} | {_num(row['displacement'], 100)} | "
+            f"{_num(row['seen_motion'], 100)} | {_num(row['pixel_count_change'], 1, 0)} | "
+            f"{_num(row['shape_change'], 1, 3)} |"
+        )
+    lines += ["", "Medians per type; the normal histogram change is the sum of |effect| over the 24 shape "
+              "features (each histogram sums to 1).", ""]
+    if results.get("prototypes") and "feature_names" in results:  # drawn by write_figures from the same results
+        lines += ["What each effect category is, as its map prototype in feature units:", "",
+                  "![prototypes](prototypes.png)", ""]
+    return lines
+
+
 def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> str:
     """The Markdown text of the report (see :func:`write_report`)."""
     claims = evaluate_claims(results)
@@ -428,7 +474,8 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
     ]
     for c in claims:
         lines.append(f"| {c.topic} | {c.paper} | {c.rule} | {c.ours} | **{c.verdict}** |")
-    lines += ["", "## Effect clusters", ""]
+    lines += [""] + _effects_section(results, figures)
+    lines += ["## Effect clusters", ""]
     lines += _table_k(
         results,
         [
@@ -449,8 +496,9 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
     if "svm_baseline" in results:
         lines += ["Always answering the most common training category:", ""]
         lines += _table_k(results, [("svm_baseline", "baseline accuracy [%]", 100.0, 1)]) + [""]
-    if figures:
-        lines += ["## Figures", ""] + [f"![{Path(f).stem}]({Path(f).name})" for f in figures] + [""]
+    shown = [f for f in figures if Path(f).name != "prototypes.png" or "effects" not in results]  # shown above
+    if shown:
+        lines += ["## Figures", ""] + [f"![{Path(f).stem}]({Path(f).name})" for f in shown] + [""]
     if config:
         lines += ["## Configuration", ""] + [f"- {key}: {value}" for key, value in config.items()] + [""]
     return "\n".join(lines)

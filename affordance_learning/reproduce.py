@@ -37,8 +37,12 @@ def reproduce(
     workers: int = 2,
     dataset: Path | None = None,
     progress: bool | None = None,
+    range_noise: str | None = None,
 ) -> dict:
-    """Run the whole experiment and write its outputs into ``out``; returns the results dict."""
+    """Run the whole experiment and write its outputs into ``out``; returns the results dict.
+
+    ``range_noise`` (for example ``"kinect_v1"``) collects the taps with the range camera's noise model on.
+    """
     from affordance_env.dataset import collect, load_dataset
     from affordance_learning.experiment import run_protocol
     from affordance_learning.figures import write_figures
@@ -53,14 +57,16 @@ def reproduce(
     dataset = Path(dataset) if dataset is not None else out / "dataset"
     start = time.perf_counter()
     print(f"[1/3] collecting {episodes} taps into {dataset} (seed {seed}, {workers} workers; reused if present)")
-    collect(episodes=episodes, seed=seed, workers=workers, out=dataset, progress=progress)
+    env_options = {} if range_noise is None else {"range_noise": range_noise}
+    collect(episodes=episodes, seed=seed, workers=workers, out=dataset, progress=progress, env_options=env_options)
     frame = load_dataset(dataset)
     collected = time.perf_counter()
     print(f"      {len(frame)} interactions ({collected - start:.1f} s)")
     print(f"[2/3] learning protocol: k = 2..10, r in 0.0..0.8, {trials} trials")
     results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers)
     results.setdefault("config", {}).update(
-        {"episodes": int(len(frame)), "dataset": str(dataset), "seed": seed, "trials": trials}
+        {"episodes": int(len(frame)), "dataset": str(dataset), "seed": seed, "trials": trials,
+         "range_noise": range_noise or "none"}
     )
     learned = time.perf_counter()
     print(f"      done ({learned - collected:.1f} s)")

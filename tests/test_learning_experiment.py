@@ -151,6 +151,7 @@ def test_figures_and_report_are_written(results: dict, tmp_path: Path) -> None:
         "case_study_k2.png",
         "case_study_k4.png",
         "svm_accuracy.png",
+        "prototypes.png",
     } <= names
     for path in paths:
         data = path.read_bytes()
