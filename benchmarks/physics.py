@@ -21,13 +21,14 @@ from affordance_env.scene import build_model
 
 BARE_SCENE = """
 <mujoco>
-  <option timestep="0.002" integrator="implicitfast" cone="elliptic" impratio="10"/>
+  <option timestep="0.002" integrator="implicitfast" cone="elliptic" impratio="10" ccd_tolerance="1e-9"
+          ccd_iterations="200"/>
   <worldbody>
-    <geom name="floor" type="plane" size="2 2 0.05" pos="0 0 -0.7"/>
-    <geom name="table_surface" type="plane" size="0.15 0.32 0.01" pos="-0.33 0 -0.07"/>
+    <geom name="floor" type="plane" size="3 3 0.05" pos="0 0 -0.7"/>
+    <geom name="table_top" type="box" size="0.3 0.5 0.015" pos="-0.46 0 -0.085" friction="0.4 0.0005 0.001"/>
     <body name="object" pos="{x} {y} {z}" quat="{quat}">
       <freejoint/>
-      <geom type="{primitive}" size="{size}" condim="6" friction="1 0.005 0.0001" mass="{mass}"/>
+      <geom type="{primitive}" size="{size}" condim="6" friction="0.4 0.0005 0.001" mass="{mass}"/>
     </body>
   </worldbody>
 </mujoco>
