@@ -26,6 +26,7 @@ A standing cylinder that topples and then rolls away is both ``toppled`` and ``r
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import mujoco
@@ -85,21 +86,19 @@ class ObjectMonitor:
         """Whether the object has been still for :data:`REST_DURATION` at ``time``, counting from ``since`` [s]."""
         return self.still_since is not None and time - max(self.still_since, since) >= REST_DURATION - 1e-9
 
-    def sample(self, time: float, p: np.ndarray, R: np.ndarray, v: np.ndarray, w_local: np.ndarray) -> None:
+    def sample(self, time: float, p: Sequence[float], v: Sequence[float], w: Sequence[float]) -> None:
         """Take the object's state at ``time`` [s].
 
         Args:
             time: Simulation time [s].
-            p: Centre position in the world frame [m], (3,).
-            R: Orientation (body to world), (3, 3) or flat (9,).
-            v: Linear velocity of the centre in the world frame [m/s], (3,).
-            w_local: Angular velocity in the body frame [rad/s], (3,) (MuJoCo's free-joint convention).
+            p: Centre position in the world frame [m], 3 numbers.
+            v: Linear velocity of the centre in the world frame [m/s], 3 numbers.
+            w: Angular velocity in the world frame [rad/s], 3 numbers.
         """
         dt = time - self._time
         self._time = time
-        vx, vy, vz = float(v[0]), float(v[1]), float(v[2])
-        R = np.reshape(R, (3, 3))
-        wx, wy, wz = (R @ w_local).tolist()
+        vx, vy, vz = v
+        wx, wy, wz = w
         speed = math.sqrt(vx * vx + vy * vy + vz * vz)
         if speed < REST_SPEED and math.sqrt(wx * wx + wy * wy + wz * wz) < REST_ANGULAR_SPEED:
             if self.still_since is None:
@@ -108,10 +107,10 @@ class ObjectMonitor:
             self.still_since = None
         if self.exit_time is not None:
             return
-        x, y, z = float(p[0]), float(p[1]), float(p[2])
+        x, y, z = p
         if not (self._x0 <= x <= self._x1 and self._y0 <= y <= self._y1 and z > self.table_top):
             self.exit_time = time
-            self.exit_position = np.array([x, y, z])
+            self.exit_position = np.array([x, y, z], dtype=np.float64)
             return
         self.max_rise = max(self.max_rise, z - self.z_start)
         speed_xy = math.sqrt(vx * vx + vy * vy)

@@ -19,6 +19,8 @@ from affordance_env.robot_model import ACTIVE_JOINTS, CONTACT_LINKS
 #: Geom group that hides the scene's inactive object primitives from the range camera and the renderer.
 HIDDEN_GEOM_GROUP = 3
 OBJECT_RGBA = np.array([0.85, 0.2, 0.15, 1.0])
+#: The monitor samples the object at most this often [s]: every control tick.
+MONITOR_PERIOD = 0.01
 #: Collision bits of the active object (assets/scene.xml): type 1, takes surfaces (1) and the hand (2).
 OBJECT_CONTYPE, OBJECT_CONAFFINITY = 1, 3
 
@@ -63,6 +65,7 @@ class TapPhysics:
         self._is_hand_geom[self.hand_geoms] = True
         self.ctrl_low = model.actuator_ctrlrange[self.actuators, 0].copy()
         self.ctrl_high = model.actuator_ctrlrange[self.actuators, 1].copy()
+        self._ctrl = np.empty(len(self.actuators))
         # The table is static: its top height and extent are fixed once.
         mujoco.mj_kinematics(model, self._scratch)
         centre = self._scratch.geom_xpos[self.table_geom]
@@ -78,6 +81,7 @@ class TapPhysics:
         #: Follows the object through an interaction (:mod:`affordance_env.outcome`), sampled after every
         #: :meth:`step` call while set.
         self.monitor: ObjectMonitor | None = None
+        self._next_sample = 0.0
         #: Called as ``on_step(physics)`` after every :meth:`step` call, if set (used to record video frames).
         self.on_step: Callable[[TapPhysics], None] | None = None
 
@@ -102,7 +106,9 @@ class TapPhysics:
 
     def set_joint_targets(self, q: np.ndarray) -> None:
         """Command the position servos to ``q`` [rad] (ACTIVE_JOINTS order), clipped to the joint ranges."""
-        self.data.ctrl[self.actuators] = np.clip(q, self.ctrl_low, self.ctrl_high)
+        # np.minimum/np.maximum into the control vector: np.clip's wrapper costs more than the clipping
+        np.minimum(np.maximum(q, self.ctrl_low, out=self._ctrl), self.ctrl_high, out=self._ctrl)
+        self.data.ctrl[self.actuators] = self._ctrl
 
     def joint_targets(self) -> np.ndarray:
         """Current servo targets [rad]."""
@@ -121,11 +127,11 @@ class TapPhysics:
         ncon = self.data.ncon
         if ncon == 0:
             return False
-        g1 = self.data.contact.geom1[:ncon]
-        g2 = self.data.contact.geom2[:ncon]
-        obj = self.active_geom
-        hand = self._is_hand_geom
-        return bool(np.any(((g1 == obj) & hand[g2]) | ((g2 == obj) & hand[g1])))
+        obj, hand = self.active_geom, self._is_hand_geom
+        for g1, g2 in self.data.contact.geom[:ncon].tolist():  # a few contacts: plain Python is fastest
+            if (g1 == obj and hand[g2]) or (g2 == obj and hand[g1]):
+                return True
+        return False
 
     # --- the object ------------------------------------------------------------------------------------------
     def set_object(self, geometry: ObjectGeometry, xy: np.ndarray, yaw: float) -> None:
@@ -195,20 +201,23 @@ class TapPhysics:
         """Start following the object (:class:`~affordance_env.outcome.ObjectMonitor`) from now on."""
         self.monitor = ObjectMonitor(self.table_top, self.table_low, self.table_high, self.object_pose()[:3],
                                      self.data.time)
+        self._next_sample = self.data.time
         return self.monitor
 
     def _sample_monitor(self) -> None:
-        a, v = self.object_qpos, self.object_qvel
-        qvel = self.data.qvel
-        self.monitor.sample(self.data.time, self.data.qpos[a : a + 3], self.data.xmat[self.object_body],
-                            qvel[v : v + 3], qvel[v + 3 : v + 6])
+        a, v, data = self.object_qpos, self.object_qvel, self.data
+        # qvel[v:v+3] is the centre's world velocity (the body origin is its centre of mass); cvel's rotational
+        # part is the angular velocity in world axes (computed at the start of the last step, 2 ms before).
+        self.monitor.sample(data.time, data.qpos[a : a + 3].tolist(), data.qvel[v : v + 3].tolist(),
+                            data.cvel[self.object_body, :3].tolist())
 
     # --- stepping --------------------------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
         """Advance the simulation by ``n`` timesteps."""
         mujoco.mj_step(self.model, self.data, n)
-        if self.monitor is not None:  # once per call: every control tick (10 ms) or, in the stroke, every step
+        if self.monitor is not None and self.data.time >= self._next_sample - 1e-9:  # every 10 ms at least
             self._sample_monitor()
+            self._next_sample = self.data.time + MONITOR_PERIOD
         if self.on_step is not None:
             self.on_step(self)
 
