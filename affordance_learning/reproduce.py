@@ -28,6 +28,15 @@ def _jsonable(value):
     return value
 
 
+def _shown_path(path: Path, out: Path) -> str:
+    """``path`` relative to the output directory when it lies inside it (the report then reads the same on any
+    machine), else as given."""
+    try:
+        return str(path.resolve().relative_to(out.resolve()))
+    except ValueError:
+        return str(path)
+
+
 def reproduce(
     out: Path,
     *,
@@ -65,7 +74,7 @@ def reproduce(
     print(f"[2/3] learning protocol: k = 2..10, r in 0.0..0.8, {trials} trials")
     results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers)
     results.setdefault("config", {}).update(
-        {"episodes": int(len(frame)), "dataset": str(dataset), "seed": seed, "trials": trials,
+        {"episodes": int(len(frame)), "dataset": _shown_path(dataset, out), "seed": seed, "trials": trials,
          "range_noise": range_noise or "none"}
     )
     learned = time.perf_counter()
