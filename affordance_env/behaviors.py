@@ -15,9 +15,9 @@ index       meaning                                                          ran
 ==========  ===============================================================  ======================
 
 The canonical tap is moderate (the paper: "moderately hitting an object from its side"): at 0.2 m/s a ball or a
-lying cylinder rolls some 5 to 20 cm on the table and stays in view; the speed scale is geometric, because the
+lying cylinder rolls some 5 to 25 cm on the table and stays in view; the speed scale is geometric, because the
 distance a struck object rolls grows with the square of its speed: at the gentlest tap (-1) rolling objects
-move 2-4 cm, at the hardest (+1) most of them roll off the 1 m wide table (see ``assets/README.md``).
+move 2-3 cm, at the hardest (+1) four in five roll off the 1 m wide table (see ``assets/README.md``).
 """
 
 from __future__ import annotations
