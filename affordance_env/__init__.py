@@ -10,15 +10,11 @@
 or, without the import, ``gym.make("affordance_env:TapAffordance-v0")``.
 """
 
-from affordance_env.rendering import select_gl_backend
-
-select_gl_backend()  # before anything imports mujoco: headless RGB rendering needs EGL or OSMesa
-
-from affordance_env.dataset import load_dataset  # noqa: E402
-from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES  # noqa: E402
-from affordance_env.objects import OBJECT_TYPES  # noqa: E402
-from affordance_env.registration import register_envs  # noqa: E402
-from affordance_env.robot_model import ACTIVE_JOINTS  # noqa: E402
+from affordance_env.dataset import load_dataset
+from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
+from affordance_env.objects import OBJECT_TYPES
+from affordance_env.registration import register_envs
+from affordance_env.robot_model import ACTIVE_JOINTS
 
 register_envs()
 

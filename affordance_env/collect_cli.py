@@ -31,6 +31,9 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
                              "(default canonical)")
     parser.add_argument("--save-images", action="store_true",
                         help="also store range images (float16) and object masks (bit-packed), compressed")
+    parser.add_argument("--max-failure-share", type=float, default=0.2, metavar="SHARE",
+                        help="stop once more than this share of the interactions failed (the environment's "
+                             "failure reasons are listed); 1 accepts any (default 0.2)")
     parser.add_argument("--chunk-size", type=int, default=50,
                         help="interactions per file, the most a crash loses per worker (default 50)")
     parser.add_argument("--scheduler", choices=("joblib", "dask"), default=None,
@@ -68,7 +71,7 @@ def env_options_from_args(args: argparse.Namespace) -> dict[str, Any]:
 
 def run_collect(args: argparse.Namespace) -> int:
     """Run ``affordance collect``; bad options or a dataset made with other settings raise ValueError."""
-    from affordance_env.dataset import MANIFEST, collect, read_manifest
+    from affordance_env.dataset import MANIFEST, collect, failure_summary, read_manifest
 
     if args.scheduler == "joblib" and args.dask_address is not None:
         raise ValueError("--dask-address runs on Dask: drop --scheduler joblib (or use --scheduler dask).")
@@ -76,12 +79,14 @@ def run_collect(args: argparse.Namespace) -> int:
     start = time.perf_counter()
     out = collect(args.out, args.episodes, seed=args.seed, workers=args.workers, action=args.action,
                   env_options=env_options_from_args(args), chunk_size=args.chunk_size, scheduler=scheduler,
-                  dask_address=args.dask_address, save_images=args.save_images)
+                  dask_address=args.dask_address, save_images=args.save_images,
+                  max_failure_share=args.max_failure_share)
     elapsed = time.perf_counter() - start
     manifest = read_manifest(out)
     failures = manifest["failures"]
-    kinds = ", ".join(f"{kind} {n}" for kind, n in failures["by_kind"].items())
-    details = f" ({kinds}; reasons in {out / MANIFEST})" if kinds else ""
+    details = ""
+    if failures["count"]:
+        details = f" ({failure_summary(failures['episodes'])}; all reasons in {out / MANIFEST})"
     print(f"{out}: {manifest['rows']} interactions written, {failures['count']} failed and left "
           f"out{details}; {elapsed:.1f} s")
     return 0

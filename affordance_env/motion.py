@@ -169,10 +169,11 @@ class MotionExecutor:
         return StrokeOutcome(ik_ok, pos_err, rot_err, contact, contact_time, hand_speed, travel, start_error,
                              object_moved)
 
-    def go_home(self, q_home: np.ndarray) -> None:
-        """Return to ``q_home`` (after :meth:`stroke`, from above the object) and hold until the robot is still."""
+    def go_home(self, q_home: np.ndarray) -> bool:
+        """Return to ``q_home`` (after :meth:`stroke`, from above the object) and hold until the robot is still;
+        returns whether it came to rest (:meth:`hold_still`)."""
         self.move_joints(q_home, HOME_TIME)
-        self.hold_still()
+        return self.hold_still()
 
     def hold_still(self, max_time: float = HOLD_MAX_TIME) -> bool:
         """Hold the current servo targets until every joint is within HOLD_POSITION_TOLERANCE of its target and

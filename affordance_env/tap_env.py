@@ -14,7 +14,13 @@ from affordance_env.behaviors import ACTION_DIM, BEHAVIORS, check_action, get_be
 from affordance_env.camera import RangeCamera
 from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
 from affordance_env.kinematics import Kinematics
-from affordance_env.motion import CONTROL_DT, MotionExecutor
+from affordance_env.motion import (
+    CONTROL_DT,
+    HOLD_MAX_TIME,
+    HOLD_POSITION_TOLERANCE,
+    HOLD_SPEED_TOLERANCE,
+    MotionExecutor,
+)
 from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size, object_geometry
 from affordance_env.outcome import REST_DURATION, ObjectMonitor, outcome_labels
 from affordance_env.physics import TapPhysics
@@ -36,10 +42,16 @@ SETTLE_TIME = 0.5
 MAX_START_ERROR, MAX_OBJECT_MOVED_BEFORE = 0.01, 0.003
 
 
-def _failure_reason(fault: str | None, visible_initially: bool, stroke) -> str | None:
-    """Why an interaction cannot be used, or None; see the class docstring."""
+def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: tuple[bool, bool]) -> str | None:
+    """Why an interaction cannot be used, or None; see the class docstring. ``still``: whether the robot was
+    still for the initial and for the final snapshot."""
     if fault is not None:
         return f"physics: {fault}"
+    for snapshot, was_still in zip(("initial", "final"), still, strict=True):
+        if not was_still:
+            return (f"snapshot: the robot was still moving at the {snapshot} snapshot (not within "
+                    f"{HOLD_POSITION_TOLERANCE * 1e3:g} mrad and {HOLD_SPEED_TOLERANCE:g} rad/s of rest after "
+                    f"{HOLD_MAX_TIME:g} s)")
     if not visible_initially:
         return "perception: the object was not visible in the initial snapshot"
     if not stroke.ik_success:
@@ -119,7 +131,8 @@ class TapAffordanceEnv(gym.Env):
     seconds have passed since the first touch; then the final snapshot is taken.
 
     ## Info
-    After ``reset``: ``object`` (``type``, ``size`` [m], ``pose`` (7,) position and quaternion), ``attention``.
+    After ``reset``: ``object`` (``type``, ``size`` [m], ``pose`` (7,) position and quaternion), ``attention``,
+    ``visible`` (object seen in the initial snapshot), ``still`` (the robot was still for it).
     After ``step`` also: ``effect`` (49,) final minus initial features, ``initial_features``,
     ``final_features``, ``object`` with ``initial_pose`` and ``final_pose``, ``displacement`` [m] (horizontal
     travel of the centre on the table: to where it rests, or to where it left the table),
@@ -133,7 +146,8 @@ class TapAffordanceEnv(gym.Env):
     final snapshot),
     ``failure``: None, or why the interaction is not a valid sample: ``"physics: ..."`` (MuJoCo reported an
     instability or the state became non-finite; then obs is blank, ``effect`` is zeros and ``outcome`` is
-    ``"fault"``), ``"perception: ..."`` (object not visible initially), ``"ik: ..."`` (stroke not reachable),
+    ``"fault"``), ``"snapshot: ..."`` (the robot's head or arm still moved when a snapshot was taken),
+    ``"perception: ..."`` (object not visible initially), ``"ik: ..."`` (stroke not reachable),
     ``"reach: ..."`` (the arm touched the object before the stroke, or the stroke started more than 1 cm from
     its planned pose), ``"tap: ..."`` (the hand never touched the object). The next ``reset`` recovers from any of them.
 
@@ -308,17 +322,18 @@ class TapAffordanceEnv(gym.Env):
         physics.set_object(geometry, xy, yaw)
         self._settle_object()
         attention = attend(physics, self.attention_camera, self.motion.move_joints)
-        self.motion.hold_still()
+        still = self.motion.hold_still()
         self._q_home = physics.joint_targets()  # the arm's home, with the gaze on the object
         obs, features = self._snapshot()
         pose = physics.object_pose()
         self._initial = {"features": features, "pose": pose, "yaw": yaw, "geometry": geometry,
-                         "visible": features.visible}
+                         "visible": features.visible, "still": still}
         info = {
             "object": {"type": object_type, "size": size, "pose": pose},
             "attention": {"success": attention.success, "visible": attention.visible,
                           "pixel_error": attention.pixel_error},
             "visible": features.visible,
+            "still": still,
         }
         return obs, info
 
@@ -361,7 +376,7 @@ class TapAffordanceEnv(gym.Env):
         monitor = physics.start_monitor()  # from now on, whatever the arm does
         try:
             stroke = self.motion.stroke(plan)
-            self.motion.go_home(self._q_home)
+            still = self.motion.go_home(self._q_home)
             outcome, outcome_time = self._wait_outcome(
                 monitor, stroke.contact_time if stroke.contact else physics.data.time)
         finally:
@@ -377,7 +392,7 @@ class TapAffordanceEnv(gym.Env):
             final_features = NOT_VISIBLE_VALUES
             final_pose = np.full(7, np.nan)
             visible = False
-        failure = _failure_reason(fault, initial["visible"], stroke)
+        failure = _failure_reason(fault, initial["visible"], stroke, (initial["still"], still))
         # Travel on the table: to where the object rests, or to where it left the table (not where it fell).
         p_end = monitor.exit_position if monitor.left_table else final_pose
         displacement = 0.0 if fault else float(np.linalg.norm(p_end[:2] - initial["pose"][:2]))

@@ -52,7 +52,7 @@ def reproduce(
 
     ``range_noise`` (for example ``"kinect_v1"``) collects the taps with the range camera's noise model on.
     """
-    from affordance_env.dataset import collect, load_dataset
+    from affordance_env.dataset import collect, failure_summary, load_dataset
     from affordance_learning.experiment import run_protocol
     from affordance_learning.figures import write_figures
     from affordance_learning.report import write_report
@@ -70,7 +70,10 @@ def reproduce(
     collect(episodes=episodes, seed=seed, workers=workers, out=dataset, progress=progress, env_options=env_options)
     frame = load_dataset(dataset)
     collected = time.perf_counter()
-    print(f"      {len(frame)} interactions ({collected - start:.1f} s)")
+    failures = frame.attrs["failures"]
+    print(f"      {len(frame)} interactions, {len(failures)} failed and left out"
+          f"{f' ({failure_summary({str(k): v for k, v in failures.items()})})' if failures else ''} "
+          f"({collected - start:.1f} s)")
     print(f"[2/3] learning protocol: k = 2..10, r in 0.0..0.8, {trials} trials")
     results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers)
     results.setdefault("config", {}).update(

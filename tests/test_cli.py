@@ -2,7 +2,7 @@
 
 import pytest
 
-from affordance_env.cli import main
+from affordance_learning.cli import main
 
 
 def test_demo_prints_what_happened(capsys):

@@ -18,6 +18,7 @@ import pytest
 from affordance_env import FEATURE_GROUPS, FEATURE_NAMES, load_dataset
 from affordance_env.dataset import (
     DatasetError,
+    FailureShareError,
     collect,
     images,
     interaction_action,
@@ -188,37 +189,90 @@ def assert_same_dataset_prefix(path, reference, episodes):
     assert not list(path.glob(".*.tmp"))
 
 
-def test_failed_interactions_are_reported_never_written(reference, tmp_path, monkeypatch):
-    seeds = {"raise": interaction_seed(5, 1), "nan": interaction_seed(5, 4)}
+def _patch_env(monkeypatch, change):
+    """Make TapAffordanceEnv.step call ``change(episode_seed, info)`` on what it returns (may raise)."""
     reset, step = TapAffordanceEnv.reset, TapAffordanceEnv.step
 
-    def flaky_step(self, action):
+    def patched_step(self, action):
         obs, reward, terminated, truncated, info = step(self, action)
-        if self._test_seed == seeds["raise"]:
-            raise RuntimeError("the simulation blew up")
-        if self._test_seed == seeds["nan"]:
-            info["effect"] = np.full_like(info["effect"], np.nan)
+        change(self._test_seed, info)
         return obs, reward, terminated, truncated, info
 
     def remembering_reset(self, *, seed=None, options=None):
         self._test_seed = seed
         return reset(self, seed=seed, options=options)
 
-    monkeypatch.setattr(TapAffordanceEnv, "step", flaky_step)
+    monkeypatch.setattr(TapAffordanceEnv, "step", patched_step)
     monkeypatch.setattr(TapAffordanceEnv, "reset", remembering_reset)
-    out = tmp_path / "flaky"
-    collect(out, 8, workers=1, **RUN)  # workers=1 runs in this process, with the patched env
+
+
+def test_interactions_the_env_marks_failed_are_reported_never_written(reference, tmp_path, monkeypatch):
+    failing = {interaction_seed(5, 1), interaction_seed(5, 4)}
+
+    def fail(seed, info):
+        if seed in failing:
+            info["failure"] = "tap: the hand never touched the object"
+
+    _patch_env(monkeypatch, fail)
+    out = tmp_path / "failing"
+    collect(out, 8, workers=1, max_failure_share=0.5, **RUN)  # workers=1 runs in this process, patched
     frame = load_dataset(out)
     assert 1 not in set(frame.episode) and 4 not in set(frame.episode)
-    assert frame.attrs["failures"][1] == "exception: RuntimeError: the simulation blew up"
-    assert frame.attrs["failures"][4].startswith("non-finite")
-    assert not frame.isna().any().any()
+    assert frame.attrs["failures"][1] == frame.attrs["failures"][4] == "tap: the hand never touched the object"
     kept = reference[(reference.episode < 8) & ~reference.episode.isin([1, 4])].reset_index(drop=True)
-    pd.testing.assert_frame_equal(frame, kept, check_exact=True)  # interactions after a crash are unharmed
+    pd.testing.assert_frame_equal(frame, kept, check_exact=True)  # the other interactions are unharmed
     failures = read_manifest(out)["failures"]
     assert failures["count"] == 2 + sum(e < 8 for e in reference.attrs["failures"])
-    assert failures["by_kind"]["exception"] == 1 and failures["by_kind"]["non-finite"] == 1
-    assert failures["episodes"]["1"] == "exception: RuntimeError: the simulation blew up"
+    assert failures["by_kind"]["tap"] >= 2
+
+
+def test_a_bug_stops_the_collection_with_its_traceback_and_keeps_what_was_written(reference, tmp_path,
+                                                                                   monkeypatch):
+    def blow_up(seed, info):
+        if seed == interaction_seed(5, 5):
+            raise RuntimeError("the simulation blew up")
+
+    _patch_env(monkeypatch, blow_up)
+    out = tmp_path / "bug"
+    settings = {**RUN, "chunk_size": 2}
+    with pytest.raises(RuntimeError, match="the simulation blew up"):
+        collect(out, 8, workers=1, **settings)
+    manifest = read_manifest(out)
+    assert manifest["chunks_done"] == 2 and not manifest["complete"]  # episodes 0-3, written before the bug
+    partial = load_dataset(out, allow_incomplete=True)
+    assert set(partial.episode) == {0, 1, 2, 3}
+    monkeypatch.undo()  # the bug is fixed: the same command finishes the dataset
+    collect(out, 8, workers=1, **settings)
+    pd.testing.assert_frame_equal(load_dataset(out), reference[reference.episode < 8].reset_index(drop=True),
+                                  check_exact=True)
+
+
+def test_non_finite_numbers_in_an_interaction_not_marked_failed_are_a_bug(tmp_path, monkeypatch):
+    def poison(seed, info):
+        if seed == interaction_seed(5, 2):
+            info["effect"] = np.full_like(info["effect"], np.nan)
+
+    _patch_env(monkeypatch, poison)
+    with pytest.raises(RuntimeError, match="interaction 2 .* non-finite value"):
+        collect(tmp_path / "nan", 4, workers=1, **RUN)
+
+
+def test_collection_stops_above_the_failure_share_and_lists_the_reasons(tmp_path, monkeypatch):
+    def fail_most(seed, info):
+        if seed != interaction_seed(5, 0):
+            info["failure"] = "reach: the arm moved the object by 4.0 mm before the stroke"
+
+    _patch_env(monkeypatch, fail_most)
+    out = tmp_path / "unreachable"
+    settings = {**RUN, "chunk_size": 2}
+    with pytest.raises(FailureShareError, match=r"1 of the 2 interactions .* \(50 %\).* reach 1 \(e.g. episode 1: "
+                                                 r"reach: the arm moved"):
+        collect(out, 8, workers=1, **settings)
+    assert (out / "chunk-00000.parquet").exists()  # what was collected is kept
+    collect(out, 8, workers=1, max_failure_share=1.0, **settings)  # accepting them, the collection goes on
+    assert len(load_dataset(out)) == 1
+    with pytest.raises(ValueError, match="max_failure_share"):
+        collect(out, 8, workers=1, max_failure_share=1.5, **settings)
 
 
 def test_a_second_collection_into_the_same_directory_is_refused(tmp_path):

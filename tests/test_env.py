@@ -336,3 +336,23 @@ def test_range_noise_is_seeded_and_realistic():
     assert 0.5e-3 < np.std(error) < 5e-3  # about 1.2 mm at 0.3-0.6 m (Nguyen et al. 2012)
     with pytest.raises(ValueError, match="kinect_v1"):
         TapAffordanceEnv(range_noise="lidar")
+
+
+def test_a_snapshot_of_a_moving_robot_is_a_failure_not_a_sample():
+    env = TapAffordanceEnv(camera_width=32, camera_height=24)
+    _, info0 = env.reset(seed=0)
+    assert info0["still"]
+    physics = env.physics
+    neck = physics.robot_qvel[affordance_env.ACTIVE_JOINTS.index("neck_yaw")]
+
+    def shake_the_head(p):  # a disturbance the neck servo keeps fighting: the head never comes to rest
+        p.data.qfrc_applied[neck] = 2.0 * np.sin(40.0 * p.data.time)
+
+    physics.on_step = shake_the_head
+    info = env.step(np.zeros(3))[4]
+    assert info["failure"] is not None and info["failure"].startswith("snapshot: the robot was still moving at "
+                                                                       "the final snapshot"), info["failure"]
+    physics.on_step = None
+    physics.data.qfrc_applied[:] = 0.0
+    env.reset(seed=0)
+    assert env.step(np.zeros(3))[4]["failure"] is None  # the same interaction, still: a valid sample

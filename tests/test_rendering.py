@@ -1,22 +1,34 @@
-"""RGB pictures, headless: EGL or OSMesa chosen automatically, a clear error when neither works."""
+"""RGB pictures, headless: the OpenGL backend chosen when a picture is first asked for, never at import."""
 
 import os
+import subprocess
+import sys
 
-import mujoco
 import numpy as np
 import pytest
 
-from affordance_env.rendering import SceneRenderer, select_gl_backend
+from affordance_env.rendering import SceneRenderer, choose_gl_backend
 from affordance_env.tap_env import TapAffordanceEnv
 
-needs_gl = pytest.mark.skipif(
-    os.environ.get("MUJOCO_GL") not in ("egl", "osmesa", "glfw"), reason="no OpenGL backend on this machine"
-)
+needs_gl = pytest.mark.skipif(choose_gl_backend() is None, reason="no OpenGL backend on this machine")
 
 
-def test_backend_is_chosen_before_mujoco_renders():
-    # affordance_env was imported (by conftest), so the choice is made: kept if the user set it.
-    assert select_gl_backend() == os.environ.get("MUJOCO_GL")
+def test_import_leaves_the_process_environment_alone():
+    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
+    code = ("import os, gymnasium as gym, affordance_env; e = gym.make('TapAffordance-v0', camera_width=32, "
+            "camera_height=24); e.reset(seed=0); "
+            "print(os.environ.get('MUJOCO_GL'), os.environ.get('PYOPENGL_PLATFORM'))")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["None", "None"]
+
+
+def test_the_backend_the_user_names_is_used(monkeypatch):
+    monkeypatch.setenv("MUJOCO_GL", "osmesa")
+    assert choose_gl_backend() == "osmesa"
+    monkeypatch.delenv("MUJOCO_GL")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert choose_gl_backend() in ("egl", "osmesa", None)
 
 
 @needs_gl
@@ -28,6 +40,8 @@ def test_rgb_array_pictures_and_frames_of_a_tap():
     picture = env.render()
     assert picture.shape == (120, 160, 3) and picture.dtype == np.uint8
     assert picture.std() > 10  # not a blank image
+    sky, floor = picture[:10].mean(), picture[-10:].mean()
+    assert floor > sky  # upright: the lit floor and table are at the bottom, the dark background on top
     env.step(np.zeros(3))
     assert len(env.frames) > 10
     assert not np.array_equal(env.frames[0], env.frames[-1])  # the arm moved
@@ -40,10 +54,10 @@ def test_render_without_render_mode_returns_none():
     assert env.render() is None
 
 
-def test_missing_opengl_gives_a_clear_error(monkeypatch, model):
-    def broken(*args, **kwargs):
-        raise RuntimeError("gladLoadGL error")
-
-    monkeypatch.setattr(mujoco, "Renderer", broken)
+def test_missing_opengl_gives_a_clear_error(model):
     with pytest.raises(RuntimeError, match="MUJOCO_GL=egl or MUJOCO_GL=osmesa"):
-        SceneRenderer(model)
+        SceneRenderer(model, backend="osmesa-that-is-not-there")
+    with pytest.raises(ValueError, match="Available cameras"):
+        SceneRenderer(model, camera="eyes")
+    with pytest.raises(ValueError, match="offscreen buffer"):
+        SceneRenderer(model, width=4000)

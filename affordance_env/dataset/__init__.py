@@ -1,0 +1,51 @@
+"""Datasets of interactions: collected in parallel, deterministically and resumably; read back as a DataFrame.
+
+- :mod:`.format`: what a dataset is on disk (schema, manifest, chunks) and how its files are checked.
+- :mod:`.collect`: :func:`collect` runs interactions into a dataset, resumably.
+- :mod:`.load`: :func:`load_dataset` reads one back; :func:`images` decodes its stored images.
+"""
+
+from affordance_env.dataset.collect import (
+    ACTIONS,
+    SCHEDULERS,
+    FailureShareError,
+    collect,
+    failure_summary,
+    interaction_action,
+    interaction_seed,
+    show_progress,
+)
+from affordance_env.dataset.format import (
+    FORMAT,
+    IMAGE_COLUMNS,
+    MANIFEST,
+    POSE_FIELDS,
+    SCHEMA_VERSION,
+    DatasetError,
+    arrow_schema,
+    chunk_name,
+    read_manifest,
+)
+from affordance_env.dataset.load import images, load_dataset
+
+__all__ = [
+    "ACTIONS",
+    "FORMAT",
+    "IMAGE_COLUMNS",
+    "MANIFEST",
+    "POSE_FIELDS",
+    "SCHEDULERS",
+    "SCHEMA_VERSION",
+    "DatasetError",
+    "FailureShareError",
+    "arrow_schema",
+    "chunk_name",
+    "collect",
+    "failure_summary",
+    "images",
+    "interaction_action",
+    "interaction_seed",
+    "load_dataset",
+    "read_manifest",
+    "show_progress",
+]

@@ -1,0 +1,357 @@
+"""Collecting a dataset: interactions run in parallel, deterministically and resumably, into chunk files.
+
+Interaction ``i`` depends only on ``(seed, i)``: its environment seed comes from ``SeedSequence([seed, i])``
+and its random action (``action="random"``) from ``SeedSequence([seed, i, 1])``, so the data are the same
+whatever the workers or the scheduler. A chunk is written to a temporary name and renamed when complete: a
+crash or ``kill -9`` leaves only whole chunks, and the same command collects just the missing ones.
+
+An interaction that the environment marks as failed (``info["failure"]``: an unreachable stroke, a missed tap,
+a physics fault) is not written; its episode and reason go to the chunk's metadata and the manifest. Anything
+else that goes wrong (an exception from ``reset`` or ``step``, a record with non-finite numbers) is a bug: it
+stops the collection with its traceback, and the chunks already written stay. When more than
+``max_failure_share`` of the interactions collected so far have failed, the collection stops with
+:class:`FailureShareError`, which lists the reasons: rerun with a larger share to accept them.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import inspect
+import json
+import os
+import sys
+import threading
+import warnings
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from affordance_env.behaviors import ACTION_DIM
+from affordance_env.dataset.format import (
+    IMAGE_COLUMNS,
+    MANIFEST,
+    METADATA_KEY,
+    DatasetError,
+    arrow_schema,
+    check_chunk,
+    chunk_metadata,
+    chunk_name,
+    chunk_ranges,
+    dataset_header,
+    interaction_row,
+    read_manifest,
+    settings_differences,
+    write_atomically,
+    write_manifest,
+)
+
+ACTIONS = ("canonical", "random")
+SCHEDULERS = ("joblib", "dask")
+#: Env arguments that a dataset cannot record, or that do not change the data.
+_NOT_COLLECTED = ("self", "reward_fn", "render_mode", "render_width", "render_height")
+
+
+def interaction_seed(seed: int, episode: int) -> int:
+    """Environment seed of interaction ``episode`` of a dataset collected with ``seed``."""
+    return int(np.random.SeedSequence([seed, episode]).generate_state(1)[0])
+
+
+def interaction_action(seed: int, episode: int, action: str) -> np.ndarray:
+    """Action of interaction ``episode``: zeros (canonical tap) or uniform in [-1, 1]^3 by (seed, i)."""
+    if action == "canonical":
+        return np.zeros(ACTION_DIM, dtype=np.float32)
+    if action != "random":
+        raise ValueError(f"action must be one of {ACTIONS}, got {action!r}.")
+    rng = np.random.default_rng(np.random.SeedSequence([seed, episode, 1]))
+    return rng.uniform(-1.0, 1.0, ACTION_DIM).astype(np.float32)
+
+
+# --- a worker: interactions -> one chunk file --------------------------------------------------------------
+#: Per worker thread, {options: env}: building an env takes about a second, so a worker keeps its own.
+_worker = threading.local()
+
+
+def _worker_env(options_json: str):
+    envs = _worker.__dict__.setdefault("envs", {})
+    if options_json not in envs:
+        from affordance_env.tap_env import TapAffordanceEnv
+
+        envs[options_json] = TapAffordanceEnv(**json.loads(options_json))
+    return envs[options_json]
+
+
+def _drop_worker_env(options_json: str) -> None:
+    """Forget an env whose state may be broken (it raised); the next interaction builds a fresh one."""
+    env = _worker.__dict__.get("envs", {}).pop(options_json, None)
+    if env is not None:
+        with contextlib.suppress(Exception):
+            env.close()
+
+
+def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) -> tuple[int, int, dict]:
+    """Run interactions ``start .. stop-1``, write them as chunk ``index``; returns (index, n, failures)."""
+    from affordance_env import __version__
+
+    if __version__ != header["package_version"]:
+        raise RuntimeError(f"this worker has tap-affordance {__version__}, the dataset is collected with "
+                           f"{header['package_version']}: install the same version on every worker.")
+    settings = header["settings"]
+    options_json = json.dumps(settings["env_options"], sort_keys=True)
+    schema = arrow_schema(settings["save_images"])
+    columns: dict[str, list] = {name: [] for name in schema.names}
+    failures: dict[str, str] = {}
+    for episode in range(start, stop):
+        env = _worker_env(options_json)  # an env that cannot be built stops the run: not a failed interaction
+        env_seed = interaction_seed(settings["seed"], episode)
+        action = interaction_action(settings["seed"], episode, settings["action"])
+        # An exception here is a bug, not a failed interaction (the env reports those in info["failure"]): it
+        # stops the collection with its traceback; the chunks already written stay.
+        reset = env.reset(seed=env_seed)
+        step = env.step(action)
+        row = interaction_row(episode, env_seed, action, reset, step, settings["save_images"])
+        if isinstance(row, str):
+            failures[str(episode)] = row
+            continue
+        for name in schema.names:
+            columns[name].append(row[name])
+    meta = {**header, "chunk": {"index": index, "start": start, "stop": stop, "failures": failures}}
+    table = pa.Table.from_pydict(columns, schema=schema.with_metadata({METADATA_KEY: json.dumps(meta)}))
+    # zstd for the images (small); snappy for the numbers: zstd saves little there and reads twice as slowly
+    codecs = {name: "zstd" if name in IMAGE_COLUMNS else "snappy" for name in schema.names}
+    write_atomically(Path(out) / chunk_name(index),
+                      lambda tmp: pq.write_table(table, tmp, compression=codecs))
+    return index, stop - start, failures
+
+
+# --- the coordinator -------------------------------------------------------------------------------------
+def _full_options(env_options: dict[str, Any]) -> dict[str, Any]:
+    """The env options with every default filled in, as JSON values, so that equal settings compare equal."""
+    from affordance_env.tap_env import TapAffordanceEnv
+
+    parameters = inspect.signature(TapAffordanceEnv.__init__).parameters
+    allowed = [name for name in parameters if name not in _NOT_COLLECTED]
+    unknown = sorted(set(env_options) - set(allowed))
+    if unknown:
+        raise ValueError(f"unknown or unsupported env options {unknown} for collection; allowed: {allowed}.")
+    full = {name: parameters[name].default for name in allowed}
+    full.update(env_options)
+    return json.loads(json.dumps(full, default=list))
+
+
+@contextlib.contextmanager
+def _exclusive(out: Path) -> Iterator[None]:
+    """Hold ``out/.lock`` so that two collections never write one dataset (released even on kill -9)."""
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lock
+        yield
+        return
+    with open(out / ".lock", "w") as lock:
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise DatasetError(f"another collection is writing to {out} (it holds {out / '.lock'}); wait "
+                               "for it to finish or use another --out.") from None
+        yield
+
+
+def show_progress(progress: bool | None) -> bool:
+    """Whether to draw the progress bar: as asked, or by default on a terminal when ``CI`` is not set."""
+    if progress is not None:
+        return bool(progress)
+    return sys.stderr.isatty() and not os.environ.get("CI")
+
+
+def collect(
+    out: str | os.PathLike,
+    episodes: int,
+    seed: int = 0,
+    workers: int = 1,
+    action: str = "canonical",
+    env_options: dict[str, Any] | None = None,
+    chunk_size: int = 50,
+    progress: bool | None = None,
+    scheduler: str = "joblib",
+    dask_address: str | None = None,
+    save_images: bool = False,
+    max_failure_share: float = 0.2,
+) -> Path:
+    """Collect ``episodes`` interactions into the dataset directory ``out``, resuming it if it exists.
+
+    Args:
+        out: Dataset directory; created if missing. A dataset there made with the same settings is resumed, or
+            extended if ``episodes`` is larger; one made with other settings is refused.
+        episodes: Number of interactions.
+        seed: Seed of the dataset (>= 0); interaction ``i`` depends only on ``(seed, i)``.
+        workers: Processes on this machine (joblib), or in the local Dask cluster of ``scheduler="dask"``.
+            The data do not depend on it.
+        action: ``"canonical"`` (the paper's tap, all zeros) or ``"random"`` (uniform in the action box).
+        env_options: Keyword arguments of ``TapAffordance-v0`` (behavior, object_types, size_range,
+            camera_width, camera_height, camera_fovy, roll_threshold, settle_timeout); the others keep the
+            env's defaults, which are recorded too.
+        chunk_size: Interactions per file: the most a crash can lose, per worker.
+        progress: Draw a progress bar; by default on a terminal when ``CI`` is not set.
+        scheduler: ``"joblib"`` (processes on this machine) or ``"dask"`` (Dask distributed: the cluster at
+            ``dask_address``, or a local cluster of ``workers`` processes).
+        dask_address: A Dask scheduler (``"tcp://host:8786"``); implies ``scheduler="dask"``. Its workers need
+            the same tap-affordance version and must see ``out`` (a shared file system).
+        save_images: Also store the initial and final range images (float16) and object masks (bit-packed),
+            zstd-compressed; read them with ``load_dataset(out, with_images=True)`` and :func:`images`.
+        max_failure_share: Stop with :class:`FailureShareError` once more than this share of the interactions
+            collected so far were marked failed by the environment, in [0, 1] (1 accepts any).
+
+    Returns:
+        The dataset directory.
+    """
+    for name, value, low in (("episodes", episodes, 1), ("workers", workers, 1),
+                             ("chunk_size", chunk_size, 1), ("seed", seed, 0)):
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+            raise ValueError(f"{name} must be an integer >= {low}, got {value!r}.")
+    if action not in ACTIONS:
+        raise ValueError(f"action must be one of {ACTIONS}, got {action!r}.")
+    if isinstance(max_failure_share, bool) or not (isinstance(max_failure_share, int | float | np.floating)
+                                                   and 0.0 <= max_failure_share <= 1.0):
+        raise ValueError(f"max_failure_share must be a share in [0, 1], got {max_failure_share!r}.")
+    if scheduler not in SCHEDULERS:
+        raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}.")
+    if dask_address is not None:
+        scheduler = "dask"
+    options = _full_options(dict(env_options or {}))
+    options_json = json.dumps(options, sort_keys=True)
+    _worker_env(options_json)  # bad options fail here, clearly, before any work
+    if not (scheduler == "joblib" and workers == 1):
+        _drop_worker_env(options_json)  # the workers build their own
+    header = dataset_header(seed, action, chunk_size, options, save_images)
+    out, episodes = Path(out), int(episodes)
+
+    if (out / MANIFEST).exists():
+        _check_resumable(out, header, episodes)
+    elif out.exists() and (not out.is_dir() or any(p.name != ".lock" for p in out.iterdir())):
+        raise DatasetError(f"{out} exists and is not a TapAffordance dataset (no {MANIFEST}); choose an "
+                           "empty or new directory.")
+    out.mkdir(parents=True, exist_ok=True)
+    with _exclusive(out):
+        for stale in out.glob(".*.tmp"):  # left by a run that was killed while writing
+            stale.unlink(missing_ok=True)
+        ranges = chunk_ranges(episodes, chunk_size)
+        done = {}
+        for index, (start, stop) in enumerate(ranges):
+            meta = _existing_chunk(out / chunk_name(index), header, start, stop)
+            if meta is not None:
+                done[index] = (stop - start, meta["chunk"]["failures"])
+        write_manifest(out, header, episodes, done)
+        _check_failure_share(done, max_failure_share, out)
+        tasks = [(str(out), i, start, stop, header)
+                 for i, (start, stop) in enumerate(ranges) if i not in done]
+        n_failed = sum(len(f) for _, f in done.values())
+        from tqdm.auto import tqdm
+
+        with tqdm(total=episodes, initial=sum(n for n, _ in done.values()), unit="interaction", desc=out.name,
+                  disable=not show_progress(progress), smoothing=0.05, dynamic_ncols=True) as bar:
+            bar.set_postfix(failed=n_failed)
+            for index, n, failures in _run(tasks, scheduler, workers, dask_address):
+                if not (out / chunk_name(index)).exists():
+                    raise DatasetError(f"a worker wrote {chunk_name(index)} where this process cannot see "
+                                       f"it: the Dask workers must share {out} with this machine.")
+                done[index] = (n, failures)
+                write_manifest(out, header, episodes, done)
+                n_failed += len(failures)
+                bar.set_postfix(failed=n_failed, refresh=False)
+                bar.update(n)
+                _check_failure_share(done, max_failure_share, out)
+    return out
+
+
+def failure_summary(failures: dict[str, str], examples: int = 1) -> str:
+    """Failed interactions by kind, most common first, with an example reason of each kind:
+    ``"reach 10 (e.g. episode 3: reach: the arm moved ...), ik 2 (...)"``; ``"none"`` if there are none."""
+    by_kind: dict[str, list[str]] = {}
+    for episode in sorted(failures, key=int):
+        by_kind.setdefault(failures[episode].split(":", 1)[0], []).append(episode)
+    parts = []
+    for kind, episodes in sorted(by_kind.items(), key=lambda item: -len(item[1])):
+        shown = "; ".join(f"episode {e}: {failures[e][:160]}" for e in episodes[:examples])
+        parts.append(f"{kind} {len(episodes)} (e.g. {shown})")
+    return ", ".join(parts) or "none"
+
+
+class FailureShareError(DatasetError):
+    """More interactions failed than the collection was told to accept."""
+
+
+def _check_failure_share(done: dict[int, tuple[int, dict]], max_share: float, out: Path) -> None:
+    collected = sum(n for n, _ in done.values())
+    failures = {k: v for _, chunk in done.values() for k, v in chunk.items()}
+    if collected and len(failures) / collected > max_share:
+        raise FailureShareError(
+            f"{len(failures)} of the {collected} interactions collected so far failed "
+            f"({100 * len(failures) / collected:.0f} %), more than max_failure_share = {max_share:g}: "
+            f"{failure_summary(failures)}. The {len(done)} chunk(s) written are kept in {out}; rerun with a "
+            f"larger max_failure_share (--max-failure-share) to accept such failures and go on, or remove "
+            "their cause.")
+
+
+def _check_resumable(out: Path, header: dict, episodes: int) -> None:
+    stored = read_manifest(out)
+    diffs = settings_differences(stored, header)
+    if diffs:
+        raise DatasetError(f"{out} holds a dataset made with other settings ({'; '.join(diffs)}). Use "
+                           "another --out, or the same settings to resume or extend it.")
+    if episodes < stored["episodes"]:
+        raise DatasetError(f"{out} holds a dataset of {stored['episodes']} interactions, asked for "
+                           f"{episodes}: a dataset can be resumed or extended, not shortened; load it and "
+                           f"keep the first {episodes} episodes instead.")
+
+
+def _existing_chunk(path: Path, header: dict, start: int, stop: int) -> dict | None:
+    """The metadata of a finished chunk that matches; None if it is missing or must be collected again."""
+    if not path.exists():
+        return None
+    try:
+        return check_chunk(path, header, start, stop)
+    except DatasetError as exc:
+        with contextlib.suppress(DatasetError, AttributeError, KeyError, TypeError):
+            chunk = chunk_metadata(path)[0]["chunk"]
+            if chunk["start"] == start and chunk["stop"] < stop:  # the short last chunk of a grown dataset
+                return None
+        warnings.warn(f"collecting {path.name} again: {exc}", stacklevel=3)
+        return None
+
+
+def _run(tasks: list[tuple], scheduler: str, workers: int, address: str | None) -> Iterator[tuple]:
+    """Run chunk tasks, yielding ``(index, n, failures)`` as each chunk is written."""
+    if not tasks:
+        return
+    if scheduler == "dask":
+        yield from _run_dask(tasks, workers, address)
+    elif workers == 1:
+        for task in tasks:
+            yield _collect_chunk(*task)
+    else:
+        from joblib import Parallel, delayed
+
+        yield from Parallel(n_jobs=workers, return_as="generator_unordered", batch_size=1)(
+            delayed(_collect_chunk)(*task) for task in tasks
+        )
+
+
+def _run_dask(tasks: list[tuple], workers: int, address: str | None) -> Iterator[tuple]:
+    try:
+        from distributed import Client, LocalCluster, as_completed
+    except ImportError as exc:
+        raise ImportError("scheduler='dask' needs Dask distributed: pip install 'tap-affordance[dask]'"
+                          ) from exc
+    with contextlib.ExitStack() as stack:
+        if address is None:
+            address = stack.enter_context(
+                LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
+            )
+        client = stack.enter_context(Client(address))
+        futures = [client.submit(_collect_chunk, *task, pure=False, retries=1) for task in tasks]
+        for future in as_completed(futures):
+            yield future.result()
+            future.release()

@@ -1,0 +1,223 @@
+"""The on-disk format of a dataset: its schema, its manifest, its chunks and how they are checked.
+
+A dataset is a directory::
+
+    manifest.json          what the dataset is: settings, package version, feature names and groups, schema
+                           version, progress, and the interactions left out (count, kinds, episode -> reason)
+    chunk-00000.parquet    interactions 0 .. chunk_size-1, one row each (columns: :func:`arrow_schema`)
+    chunk-00001.parquet    ...
+    .lock                  held by the collection writing the dataset (empty)
+
+Each chunk also carries the dataset's description, its episode range and its failures in its Parquet key-value
+metadata (key ``tap_affordance``), so that a chunk can be checked on its own. Files are written to a temporary
+name and renamed when complete (:func:`write_atomically`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import uuid
+from collections import Counter
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from affordance_env.behaviors import ACTION_DIM
+from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
+
+#: Version of the on-disk format; :func:`~affordance_env.dataset.load_dataset` reads versions 1 up to this one.
+SCHEMA_VERSION = 3
+FORMAT = "tap-affordance-dataset"
+MANIFEST = "manifest.json"
+METADATA_KEY = b"tap_affordance"
+POSE_FIELDS = ("x", "y", "z", "qw", "qx", "qy", "qz")
+IMAGE_COLUMNS = ("initial_range", "initial_mask", "final_range", "final_mask")
+
+
+class DatasetError(ValueError):
+    """A dataset that cannot be read or extended, with the reason."""
+
+
+def arrow_schema(save_images: bool = False) -> pa.Schema:
+    """The columns of every chunk, in order: bookkeeping, action, ground truth, 3 x 49 features, images."""
+    fields = [("episode", pa.int64()), ("seed", pa.int64()), ("behavior", pa.string()),
+              ("type", pa.string()), ("size", pa.float64())]
+    fields += [(f"action_{j}", pa.float32()) for j in range(ACTION_DIM)]
+    fields += [(f"{stage}_{f}", pa.float64()) for stage in ("initial", "final") for f in POSE_FIELDS]
+    fields += [("displacement", pa.float64()), ("rolling_distance", pa.float64()), ("rolled", pa.bool_()),
+               ("tilt", pa.float64()), ("toppled", pa.bool_()), ("outcome", pa.string()),
+               ("outcome_time", pa.float64()), ("contact", pa.bool_()), ("hand_speed", pa.float64()),
+               ("visible_initial", pa.bool_()), ("visible_final", pa.bool_()), ("ik_success", pa.bool_())]
+    fields += [(f"{stage}_{name}", pa.float64())
+               for stage in ("initial", "final", "effect") for name in FEATURE_NAMES]
+    if save_images:
+        fields += [(column, pa.binary()) for column in IMAGE_COLUMNS]
+    return pa.schema(fields)
+
+
+def _record(episode: int, env_seed: int, action: np.ndarray, reset_info: dict, info: dict) -> dict[str, Any]:
+    obj = info["object"]
+    row: dict[str, Any] = {"episode": episode, "seed": env_seed, "behavior": info["behavior"],
+                           "type": obj["type"], "size": float(obj["size"])}
+    row.update({f"action_{j}": a for j, a in enumerate(action)})
+    for stage in ("initial", "final"):
+        row.update({f"{stage}_{f}": float(v) for f, v in zip(POSE_FIELDS, obj[f"{stage}_pose"], strict=True)})
+    row.update(displacement=float(info["displacement"]), rolling_distance=float(info["rolling_distance"]),
+               rolled=bool(info["rolled"]), tilt=float(info["tilt"]), toppled=bool(info["toppled"]),
+               outcome=info["outcome"], outcome_time=float(info["outcome_time"]), contact=bool(info["contact"]),
+               hand_speed=float(info["hand_speed"]), visible_initial=bool(reset_info["visible"]),
+               visible_final=bool(info["visible"]), ik_success=bool(info["ik"]["success"]))
+    for stage, values in (("initial", info["initial_features"]), ("final", info["final_features"]),
+                          ("effect", info["effect"])):
+        row.update({f"{stage}_{name}": float(v) for name, v in zip(FEATURE_NAMES, values, strict=True)})
+    return row
+
+
+def interaction_row(episode: int, env_seed: int, action: np.ndarray, reset: tuple, step: tuple, save_images: bool
+         ) -> dict[str, Any] | str:
+    """The row of an interaction, from what ``env.reset`` and ``env.step`` returned, or the env's reason
+    (``info["failure"]``) why it has none. A row with non-finite numbers raises RuntimeError: a bug, not a failed
+    interaction."""
+    (obs_initial, reset_info), (obs_final, *_, info) = reset, step
+    if info["failure"] is not None:
+        return info["failure"]
+    row = _record(episode, env_seed, action, reset_info, info)
+    bad = [k for k, v in row.items() if isinstance(v, float | np.floating) and not np.isfinite(v)]
+    if bad:  # the env promises finite numbers for every interaction it does not mark failed: this is a bug
+        raise RuntimeError(f"interaction {episode} (env seed {env_seed}) was not marked failed but has "
+                           f"{len(bad)} non-finite value(s), e.g. {bad[:3]}; nothing of it was written.")
+    if save_images:
+        for stage, obs in (("initial", obs_initial), ("final", obs_final)):
+            row[f"{stage}_range"] = obs["range"].astype(np.float16).tobytes()
+            row[f"{stage}_mask"] = np.packbits(obs["mask"].astype(bool)).tobytes()
+    return row
+
+
+def write_atomically(path: Path, write: Callable[[Path], Any]) -> None:
+    """``write(tmp)`` to a unique temporary name beside ``path``, flush it to disk, rename it to ``path``."""
+    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
+    try:
+        write(tmp)
+        with open(tmp, "rb") as f:
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+    with contextlib.suppress(OSError):  # make the rename durable too (not every file system can)
+        fd = os.open(path.parent, os.O_RDONLY)
+        try:
+            os.fsync(fd)
+        finally:
+            os.close(fd)
+
+
+def chunk_name(index: int) -> str:
+    return f"chunk-{index:05d}.parquet"
+
+
+def chunk_ranges(episodes: int, chunk_size: int) -> list[tuple[int, int]]:
+    return [(s, min(s + chunk_size, episodes)) for s in range(0, episodes, chunk_size)]
+
+
+def dataset_header(seed: int, action: str, chunk_size: int, env_options: dict, save_images: bool) -> dict[str, Any]:
+    """What a dataset is: written to the manifest and to every chunk."""
+    from affordance_env import __version__
+
+    settings = {"seed": int(seed), "action": action, "chunk_size": int(chunk_size),
+                "save_images": bool(save_images), "env_options": env_options}
+    return {"format": FORMAT, "schema_version": SCHEMA_VERSION, "package_version": __version__,
+            "settings": settings, "feature_names": list(FEATURE_NAMES),
+            "feature_groups": dict(FEATURE_GROUPS)}
+
+
+def _flat_settings(description: dict) -> dict[str, Any]:
+    settings = description.get("settings")
+    settings = dict(settings) if isinstance(settings, dict) else {}
+    env_options = settings.pop("env_options", None)
+    return {"schema_version": description.get("schema_version"),
+            "package_version": description.get("package_version"),
+            **settings, **(env_options if isinstance(env_options, dict) else {})}
+
+
+def settings_differences(stored: dict, asked: dict) -> list[str]:
+    """The settings in which a stored dataset differs from the one asked for, for a person to read."""
+    old, new = _flat_settings(stored), _flat_settings(asked)
+    return [f"{key}: dataset has {old.get(key)!r}, asked for {value!r}"
+            for key, value in new.items() if old.get(key) != value]
+
+
+def write_manifest(out: Path, header: dict, episodes: int, done: dict[int, tuple[int, dict]]) -> None:
+    failures = {k: v for _, chunk_failures in done.values() for k, v in chunk_failures.items()}
+    kinds = Counter(reason.split(":", 1)[0] for reason in failures.values())
+    n_chunks = len(chunk_ranges(episodes, header["settings"]["chunk_size"]))
+    manifest = {**header, "episodes": episodes, "chunks": n_chunks, "chunks_done": len(done),
+                "complete": len(done) == n_chunks, "rows": sum(n - len(f) for n, f in done.values()),
+                "failures": {"count": len(failures), "by_kind": dict(sorted(kinds.items())),
+                             "episodes": {k: failures[k] for k in sorted(failures, key=int)}}}
+    write_atomically(out / MANIFEST, lambda tmp: tmp.write_text(json.dumps(manifest, indent=1)))
+
+
+def read_manifest(path: str | os.PathLike) -> dict[str, Any]:
+    """The manifest of the dataset directory ``path``, checked for format and schema version."""
+    path = Path(path)
+    try:
+        manifest = json.loads((path / MANIFEST).read_text())
+    except FileNotFoundError:
+        raise
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise DatasetError(f"{path / MANIFEST} is not a readable TapAffordance manifest ({exc}).") from exc
+    if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
+        raise DatasetError(f"{path} is not a TapAffordance dataset (its {MANIFEST} has no format "
+                           f"{FORMAT!r}).")
+    version = manifest.get("schema_version")
+    if not isinstance(version, int) or isinstance(version, bool) or not 1 <= version <= SCHEMA_VERSION:
+        raise DatasetError(f"{path} has dataset schema version {version!r}; this tap-affordance reads "
+                           f"versions 1 to {SCHEMA_VERSION}: upgrade the package "
+                           "(pip install -U tap-affordance).")
+    settings = manifest.get("settings")
+    chunk_size = settings.get("chunk_size") if isinstance(settings, dict) else None
+    if not isinstance(manifest.get("episodes"), int) or not isinstance(chunk_size, int) or chunk_size < 1:
+        raise DatasetError(f"{path / MANIFEST} is damaged: episodes {manifest.get('episodes')!r}, "
+                           f"chunk_size {chunk_size!r}.")
+    return manifest
+
+
+def chunk_metadata(path: Path) -> tuple[dict, int]:
+    """The ``tap_affordance`` metadata and the row count of a chunk file."""
+    try:
+        parquet = pq.read_metadata(path)
+    except Exception as exc:  # pyarrow raises several types for damaged files
+        raise DatasetError(f"{path} is corrupt or not a Parquet file ({exc}).") from exc
+    raw = (parquet.metadata or {}).get(METADATA_KEY)
+    if raw is None:
+        raise DatasetError(f"{path} is a Parquet file but not a TapAffordance dataset chunk (no "
+                           f"{METADATA_KEY.decode()!r} entry in its metadata).")
+    try:
+        meta = json.loads(raw)
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise DatasetError(f"{path} is corrupt: its {METADATA_KEY.decode()!r} metadata is not JSON.") from exc
+    if not isinstance(meta, dict):
+        raise DatasetError(f"{path} is corrupt: its {METADATA_KEY.decode()!r} metadata is not an object.")
+    return meta, parquet.num_rows
+
+
+def check_chunk(path: Path, header: dict, start: int, stop: int) -> dict:
+    """A chunk's metadata, once checked to be chunk ``start .. stop-1`` of the dataset ``header``."""
+    meta, rows = chunk_metadata(path)
+    chunk = meta.get("chunk")
+    span = (chunk.get("start"), chunk.get("stop")) if isinstance(chunk, dict) else None
+    if span != (start, stop) or not isinstance(chunk.get("failures"), dict):
+        raise DatasetError(f"{path} holds episodes {span}, expected ({start}, {stop}).")
+    diffs = settings_differences(meta, header)
+    if diffs:
+        raise DatasetError(f"{path} was made with other settings than its dataset ({'; '.join(diffs)}).")
+    if rows + len(chunk["failures"]) != stop - start:
+        raise DatasetError(f"{path} is inconsistent: {rows} rows and {len(chunk['failures'])} failures for "
+                           f"{stop - start} interactions.")
+    return meta

@@ -1,0 +1,35 @@
+"""The packages' layering: the environment never depends on the learning package."""
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import affordance_env
+
+
+def _imported_modules(path: Path) -> set[str]:
+    names = set()
+    for node in ast.walk(ast.parse(path.read_text())):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            names.add(node.module)
+    return names
+
+
+def test_affordance_env_never_imports_affordance_learning():
+    package = Path(affordance_env.__file__).parent
+    offenders = {str(path.relative_to(package)): sorted(m for m in _imported_modules(path)
+                                                        if m.split(".")[0] == "affordance_learning")
+                 for path in package.rglob("*.py")}
+    assert not {k: v for k, v in offenders.items() if v}
+
+
+def test_using_the_environment_loads_nothing_of_the_learning_package():
+    code = ("import sys, numpy as np, affordance_env, affordance_env.dataset, affordance_env.collect_cli; "
+            "from affordance_env.tap_env import TapAffordanceEnv; e = TapAffordanceEnv(camera_width=32, "
+            "camera_height=24); e.reset(seed=0); e.step(np.zeros(3)); "
+            "print(sorted(m for m in sys.modules if m.startswith('affordance_learning')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"
