@@ -9,6 +9,7 @@ from affordance_env.camera import Intrinsics, RangeCamera
 from affordance_env.kinematics import Kinematics
 from affordance_env.motion import MotionExecutor
 from affordance_env.objects import object_geometry
+from affordance_env.tap_env import TapAffordanceEnv
 
 WALL_SCENE = """
 <mujoco>
@@ -109,3 +110,44 @@ def test_attention_reports_an_object_out_of_view(physics):
     result = attend(physics, camera, motion.move_joints)
     assert not result.visible and not result.success
     np.testing.assert_array_equal(physics.joint_targets(), q_before)  # did not look elsewhere
+
+
+def _occluding_view(env, distance: float):
+    """The env after reset with the palm moved onto the ray from the camera to the object, ``distance`` [m]
+    before the object; returns (env camera image, image of a camera that sees no robot)."""
+    physics = env.physics
+    camera = env.camera
+    p_cam, _ = camera.pose(physics.data)
+    p_obj = physics.object_pose()[:3]
+    target = p_obj + distance * (p_cam - p_obj) / np.linalg.norm(p_cam - p_obj)
+    q = env.kinematics.solve_ik(target, physics.joint_positions(), position_tolerance=2e-3).q
+    physics.data.qpos[physics.robot_qpos] = q
+    mujoco.mj_forward(physics.model, physics.data)
+    blind = RangeCamera(physics.model, width=camera.intrinsics.width, height=camera.intrinsics.height,
+                        fovy_deg=57.4, geom_groups=(0,))
+    return camera.capture(physics.data), blind.capture(physics.data)
+
+
+def test_the_hand_occludes_the_object_as_on_a_real_camera():
+    env = TapAffordanceEnv(camera_width=80, camera_height=60)
+    env.reset(seed=0, options={"object_type": "box", "size": 0.08})
+    seen, without_robot = _occluding_view(env, 0.08)
+    geom = env.physics.active_geom
+    hidden = without_robot.mask_of(geom) & ~seen.mask_of(geom)
+    assert hidden.sum() > 0.3 * without_robot.mask_of(geom).sum()  # the hand hides much of the box ...
+    assert seen.mask_of(geom).sum() > 0  # ... but not all of it: the mask is the visible part
+    hand = set(env.physics.hand_geoms.tolist())
+    assert set(np.unique(seen.geom_ids[hidden]).tolist()) <= hand  # what hides it is the hand, wrist, forearm
+    assert np.all(seen.ranges[hidden] < without_robot.ranges[hidden])  # nearer than the box behind it
+
+
+def test_an_arm_that_hides_nothing_changes_nothing():
+    env = TapAffordanceEnv(camera_width=80, camera_height=60)
+    obs, _ = env.reset(seed=0, options={"object_type": "sphere", "size": 0.06})
+    physics = env.physics
+    seen = env.camera.capture(physics.data)
+    blind = RangeCamera(physics.model, width=80, height=60, fovy_deg=57.4, geom_groups=(0,)).capture(physics.data)
+    arm = np.isin(seen.geom_ids, physics.hand_geoms) | (seen.geom_ids != blind.geom_ids)
+    assert arm.any()  # the arm is in view at home ...
+    np.testing.assert_array_equal(seen.mask_of(physics.active_geom), blind.mask_of(physics.active_geom))
+    np.testing.assert_array_equal(seen.ranges[~arm], blind.ranges[~arm])  # ... and changes only its own pixels
