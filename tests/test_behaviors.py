@@ -46,8 +46,9 @@ def test_action_moves_height_lateral_offset_and_speed():
     p_object = np.array([-0.30, 0.03, TABLE + 0.04])
     base = plan_stroke(get_behavior("tap"), box, p_object, 0.0, TABLE, np.zeros(3))
     moved = plan_stroke(get_behavior("tap"), box, p_object, 0.0, TABLE, np.array([1.0, 1.0, 1.0]))
-    assert moved.p_start[2] - base.p_start[2] == pytest.approx(0.015)
-    assert abs(moved.p_start[0] - base.p_start[0]) == pytest.approx(0.02)
+    # the tap moves along -y; its "across" direction is +x (direction turned by +90 degrees)
+    np.testing.assert_allclose(moved.p_start - base.p_start, [0.02, 0.0, 0.015], atol=1e-12)
+    np.testing.assert_allclose(moved.p_end - base.p_end, [0.02, 0.0, 0.015], atol=1e-12)  # a parallel stroke
     assert moved.speed == pytest.approx(0.6)  # hardest: 3 x the canonical 0.2 m/s
     gentle = plan_stroke(get_behavior("tap"), box, p_object, 0.0, TABLE, np.array([0.0, 0.0, -1.0]))
     assert gentle.speed == pytest.approx(0.2 / 3)

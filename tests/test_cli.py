@@ -33,9 +33,12 @@ def test_reproduce_writes_results_figures_and_report(tmp_path, capsys):
     for name in ("uniformity.png", "selected_features.png", "case_study_k2.png", "case_study_k4.png",
                  "svm_accuracy.png", "REPORT.md"):
         assert (out / name).stat().st_size > 1000
-    # a second run reuses the dataset instead of collecting again
+    assert "40 interactions, 0 failed" in capsys.readouterr().out
+    # a second run reuses the dataset instead of collecting again: its chunk files are not rewritten
+    chunks = {p: p.stat().st_mtime_ns for p in (out / "dataset").glob("chunk-*.parquet")}
     assert main(["reproduce", "--episodes", "40", "--trials", "1", "--workers", "1", "--out", str(out)]) == 0
     assert "40 interactions" in capsys.readouterr().out
+    assert chunks and {p: p.stat().st_mtime_ns for p in chunks} == chunks
 
 
 def test_collect_command(tmp_path, capsys):

@@ -103,9 +103,11 @@ def test_extending_equals_collecting_at_once(reference, tmp_path):
     out = tmp_path / "grown"
     collect(out, 20, workers=1, **RUN)  # its last chunk, 16..19, is redone as 16..23
     assert len(load_dataset(out)) + len(load_dataset(out).attrs["failures"]) == 20
+    whole = {name: (out / name).stat().st_mtime_ns for name in ("chunk-00000.parquet", "chunk-00001.parquet")}
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # redoing the short last chunk is expected: no warning
         collect(out, 24, workers=1, **RUN)
+    assert {name: (out / name).stat().st_mtime_ns for name in whole} == whole  # only the last chunk was redone
     assert_same_dataset(out, reference)
     with pytest.raises(DatasetError, match="not shortened"):
         collect(out, 16, workers=1, **RUN)

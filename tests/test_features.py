@@ -268,6 +268,20 @@ def test_orientation_of_a_vertical_principal_axis_is_plus_half_pi() -> None:
         assert orientation == pytest.approx(math.pi / 2, abs=1e-6)
 
 
+def test_orientation_of_mirror_symmetric_tall_shapes_is_plus_half_pi() -> None:
+    # A shape symmetric about a vertical image axis has a vertical principal axis; rounding makes its pixel
+    # covariance slightly negative or positive, so the angle comes out as -pi/2 or +pi/2: always +pi/2 reported.
+    points, ranges, empty = plane_snapshot(24, 24)
+    rng = np.random.default_rng(0)
+    for _ in range(60):
+        mask = empty.copy()
+        half = rng.random((20, 5)) < 0.6
+        half[:, -1] = True  # connected across the axis, and taller than wide
+        mask[2:22, 5:10] = half
+        mask[2:22, 14:9:-1] = half  # the mirror image about column 9.5
+        assert call(points, ranges, mask).values[INDEX["orientation"]] == pytest.approx(math.pi / 2, abs=1e-9)
+
+
 def test_orientation_effect_of_a_small_turn_across_the_wrap_is_small() -> None:
     # A rectangle near vertical in the image turns by 2 degrees across +-pi/2: its orientation feature jumps
     # from about +pi/2 to about -pi/2, but the effect is the 2-degree turn.

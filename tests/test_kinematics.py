@@ -53,9 +53,13 @@ def test_ik_reaches_the_tap_workspace(kinematics):
 
 
 def test_unreachable_target_is_reported_as_failure(kinematics):
-    result = kinematics.solve_ik(np.array([-2.0, 0.0, 0.0]), np.zeros(kinematics.nq))
+    target = np.array([-2.0, 0.0, 0.0])
+    result = kinematics.solve_ik(target, np.zeros(kinematics.nq), max_iterations=20)
     assert not result.success
     assert result.position_error > 1.0
+    # the error reported is the one of the configuration returned, not of an earlier iterate
+    reached = kinematics.hand_pose(result.q).translation
+    assert result.position_error == pytest.approx(np.linalg.norm(target - reached), rel=1e-9)
 
 
 @pytest.mark.parametrize("bad", [np.array([np.nan, 0, 0]), np.zeros(2)])

@@ -79,6 +79,10 @@ def test_protocol_finds_the_papers_structure_in_synthetic_taps(results: dict) ->
     assert results["shape_fraction"]["0.4"]["3"]["mean"] > 0.8
     assert results["n_selected"]["0.4"]["2"]["mean"] < results["n_selected"]["0.0"]["2"]["mean"]
     assert results["svm_accuracy"]["0.4"]["2"]["mean"] > results["svm_baseline"]["2"]["mean"]
+    # the share counts shape features only: never more of them than the 24 there are
+    for r, per_k in results["shape_fraction"].items():
+        for k, share in per_k.items():
+            assert share["mean"] * results["n_selected"][r][k]["mean"] <= 24.5, (r, k)
 
 
 def test_results_do_not_depend_on_n_jobs(frame: pd.DataFrame, results: dict) -> None:
@@ -222,6 +226,29 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
         "1 x 2 map: object types",
         "r = 0.4 best",
         "r = 0, 0.2, 0.4 alike",
+    ):
+        assert verdicts[topic] == DISAGREES, topic
+    # the other eight claims, each driven the other way
+    worse = copy.deepcopy(good)
+    rs = sorted(good["shape_fraction"], key=float)
+    ks = sorted(good["shape_fraction"][rs[0]], key=int)
+    worse["shape_fraction"] = {r: {k: {"mean": 0.45 - 0.1 * j, "std": 0.0} for k in ks} for j, r in enumerate(rs)}
+    worse["n_selected"] = {r: {k: {"mean": (5.0 + 3 * j) * (1 + int(k) % 2), "std": 0.0} for k in ks}
+                           for j, r in enumerate(rs)}
+    rising = {2: 0.6, 3: 0.65, 4: 0.55, 5: 0.7, 6: 0.72, 7: 0.75, 8: 0.78, 9: 0.8, 10: 0.82}
+    worse["svm_accuracy"] = {r: {str(k): {"mean": a, "std": 0.0} for k, a in rising.items()} for r in rs}
+    worse["case_studies"]["2"][0]["sizes"], worse["case_studies"]["2"][1]["sizes"] = [0.04, 0.05], [0.09, 0.1]
+    worse["case_studies"]["4"][2]["rolled"], worse["case_studies"]["4"][2]["not_rolled"] = 200, 5
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(worse)}
+    for topic in (
+        "Shape features dominate",
+        "Shape share and r",
+        "Fewer features as r rises",
+        "Number constant in k",
+        "1 x 2 map: sizes",
+        "1 x 4 map: success/fail",
+        "SVM accuracy falls with k",
+        "Bump at k = 4",
     ):
         assert verdicts[topic] == DISAGREES, topic
     partial = {"uniformity": good["uniformity"]}

@@ -138,9 +138,16 @@ def test_object_geometry_sizes_and_mass():
     sphere = object_geometry("sphere", 0.06)
     assert sphere.geom_size[0] == pytest.approx(0.03)
     assert sphere.mass == pytest.approx(300 * 4 / 3 * np.pi * 0.03**3)
+    assert sphere.inertia == pytest.approx(np.full(3, 0.4 * sphere.mass * 0.03**2))
+    box = object_geometry("box", 0.06)
+    assert box.mass == pytest.approx(300 * 0.06**3)
+    assert box.inertia == pytest.approx(np.full(3, box.mass * 0.06**2 / 6))
     lying = object_geometry("horizontal_cylinder", 0.06)
     standing = object_geometry("vertical_cylinder", 0.06)
     assert lying.primitive == standing.primitive == "cylinder"
+    assert lying.mass == standing.mass == pytest.approx(300 * np.pi * 0.03**2 * 0.06)
+    across = lying.mass * (3 * 0.03**2 + 0.06**2) / 12
+    assert lying.inertia == pytest.approx([across, across, 0.5 * lying.mass * 0.03**2])  # axis is the body z
     assert not np.allclose(lying.quat_rest, standing.quat_rest)
 
 
