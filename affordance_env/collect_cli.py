@@ -90,3 +90,35 @@ def run_collect(args: argparse.Namespace) -> int:
     print(f"{out}: {manifest['rows']} interactions written, {failures['count']} failed and left "
           f"out{details}; {elapsed:.1f} s")
     return 0
+
+
+def add_export_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
+    """Add the ``export`` subcommand: a collected dataset into another format (Minari)."""
+    parser = subparsers.add_parser(
+        "export", help="write a collected dataset as a Minari dataset (pip install 'tap-affordance[minari]')",
+        description="Write a collected dataset as a Minari dataset, one episode per interaction, stored where "
+                    "Minari keeps its datasets (MINARI_DATASETS_PATH, by default ~/.minari/datasets). The "
+                    "Parquet dataset stays the source of truth.",
+    )
+    parser.add_argument("dataset", type=Path, help="the dataset directory (made by `affordance collect`)")
+    parser.add_argument("--minari", required=True, metavar="DATASET_ID",
+                        help="Minari dataset id, e.g. tap-affordance/canonical-taps-v0")
+    parser.add_argument("--data-format", choices=("arrow", "hdf5"), default="arrow",
+                        help="Minari storage format (default arrow; hdf5 needs h5py)")
+    parser.add_argument("--author", default="tap-affordance", help="recorded in the Minari metadata")
+    parser.add_argument("--author-email", default=None, help="recorded in the Minari metadata")
+    parser.set_defaults(func=run_export)
+    return parser
+
+
+def run_export(args: argparse.Namespace) -> int:
+    """Run ``affordance export``."""
+    from affordance_env.dataset.minari_export import export_minari
+
+    start = time.perf_counter()
+    exported = export_minari(args.dataset, args.minari, data_format=args.data_format, author=args.author,
+                             author_email=args.author_email)
+    print(f"{args.dataset} -> Minari dataset {args.minari!r}: {exported.total_episodes} episodes in "
+          f"{time.perf_counter() - start:.1f} s; load it with minari.load_dataset({args.minari!r})")
+    return 0
+

@@ -163,13 +163,15 @@ class TapAffordanceEnv(gym.Env):
     | ``range_noise`` | None | ``"kinect_v1"``: the axial depth noise of a structured-light camera (Nguyen, Izadi
       and Lovell 2012, :mod:`affordance_env.range_noise`), drawn from ``self.np_random``; None: exact ranges |
     | ``reward_fn`` | displacement | ``callable(info) -> float`` |
-    | ``render_mode`` | None | ``"rgb_array"``: a picture from an outside camera (headless EGL/OSMesa) |
+    | ``render_mode`` | None | ``"rgb_array"``: a picture from an outside camera (headless EGL/OSMesa);
+      ``"rgb_array_list"``: every frame of the interaction, for a video (Gymnasium's ``RecordVideo`` keeps one
+      frame per step, so for one-step episodes use this mode and write the frames yourself) |
 
     ## Version History
     * v0: initial release.
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+    metadata = {"render_modes": ["rgb_array", "rgb_array_list"], "render_fps": 30}
 
     def __init__(
         self,
@@ -216,11 +218,11 @@ class TapAffordanceEnv(gym.Env):
         self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy)
         self._renderer = None
         self._render_size = (render_width, render_height)
-        #: With ``render_mode="rgb_array"``: pictures taken every 1/render_fps s of simulated time during the
-        #: last ``reset`` and ``step`` (for videos of an interaction).
+        #: With a render mode: pictures taken every 1/render_fps s of simulated time since the last ``reset``
+        #: (the whole interaction: placing, attention, the behaviour, the wait for the outcome).
         self.frames: list[np.ndarray] = []
         self._next_frame_time = 0.0
-        if render_mode == "rgb_array":
+        if render_mode is not None:
             self.physics.on_step = self._record_frame
 
         H, W = camera_height, camera_width
@@ -368,7 +370,6 @@ class TapAffordanceEnv(gym.Env):
         action = check_action(action)
         initial, self._initial = self._initial, None
         physics = self.physics
-        self.frames = []
         plan = plan_stroke(self.behavior, initial["geometry"], initial["pose"][:3], initial["yaw"],
                            physics.table_top, action)
         monitor = physics.start_monitor()  # from now on, whatever the arm does
@@ -379,6 +380,8 @@ class TapAffordanceEnv(gym.Env):
                 monitor, stroke.contact_time if stroke.contact else physics.data.time)
         finally:
             physics.monitor = None
+        if self.render_mode is not None:
+            self.frames.append(self._picture())  # the scene as the final snapshot sees it
         fault = physics.unstable()
         if fault is None:
             obs, features = self._snapshot()
@@ -426,19 +429,33 @@ class TapAffordanceEnv(gym.Env):
         return obs, reward, True, False, info
 
     def _record_frame(self, physics: TapPhysics) -> None:
-        if physics.data.time >= self._next_frame_time:
-            self.frames.append(self.render())
-            self._next_frame_time = physics.data.time + 1.0 / self.metadata["render_fps"]
+        if physics.data.time >= self._next_frame_time - 1e-9:
+            self.frames.append(self._picture())
+            period = 1.0 / self.metadata["render_fps"]
+            while self._next_frame_time <= physics.data.time + 1e-9:  # keep the clock: one frame per period
+                self._next_frame_time += period
 
-    def render(self):
-        """An RGB picture (H, W, 3) uint8 of the scene from the ``overview`` camera, if ``render_mode='rgb_array'``."""
-        if self.render_mode != "rgb_array":
-            return None
+    def _picture(self) -> np.ndarray:
         if self._renderer is None:
             from affordance_env.rendering import SceneRenderer
 
             self._renderer = SceneRenderer(self.physics.model, *self._render_size)
         return self._renderer.render(self.physics.data)
+
+    def render(self):
+        """Pictures of the scene from the ``overview`` camera, (H, W, 3) uint8, headless.
+
+        ``render_mode="rgb_array"``: the picture of the current state. ``"rgb_array_list"``: every picture taken
+        since the last ``reset`` or ``render`` call (at ``render_fps`` of simulated time: a whole interaction is
+        some 90 of them), as Gymnasium's ``rgb_array_list`` convention has it; the list is then emptied. None
+        without a render mode.
+        """
+        if self.render_mode == "rgb_array":
+            return self._picture()
+        if self.render_mode == "rgb_array_list":
+            frames, self.frames = self.frames, []
+            return frames
+        return None
 
     def close(self) -> None:
         if self._renderer is not None:

@@ -58,7 +58,7 @@ def _train_default(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from affordance_env.collect_cli import add_collect_parser
+    from affordance_env.collect_cli import add_collect_parser, add_export_parser
 
     parser = argparse.ArgumentParser(prog="affordance", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -70,6 +70,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo.set_defaults(func=_demo)
 
     add_collect_parser(sub)
+    add_export_parser(sub)
 
     reproduce = sub.add_parser(
         "reproduce", help="the paper's experiment: collect taps, learn, write results.json, figures and a report"
@@ -98,7 +99,7 @@ def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
         return args.func(args)
-    except (ValueError, FileNotFoundError) as exc:
+    except (ValueError, FileNotFoundError, ImportError) as exc:
         print(f"affordance: error: {exc}", file=sys.stderr)
         return 2
 

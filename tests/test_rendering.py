@@ -61,3 +61,21 @@ def test_missing_opengl_gives_a_clear_error(model):
         SceneRenderer(model, camera="eyes")
     with pytest.raises(ValueError, match="offscreen buffer"):
         SceneRenderer(model, width=4000)
+
+
+@needs_gl
+@pytest.mark.slow
+def test_rgb_array_list_returns_every_frame_of_the_interaction():
+    env = TapAffordanceEnv(render_mode="rgb_array_list", render_width=96, render_height=72,
+                           camera_width=32, camera_height=24)
+    env.reset(seed=4, options={"object_type": "sphere"})
+    env.step(np.zeros(3))
+    simulated = env.physics.data.time
+    frames = env.render()
+    # one frame per 1/30 s of simulated time, from the reset on, and the final scene
+    assert abs(len(frames) - simulated * env.metadata["render_fps"]) <= 2
+    assert all(f.shape == (72, 96, 3) and f.dtype == np.uint8 for f in frames)
+    assert not np.array_equal(frames[0], frames[len(frames) // 2])  # the arm moved, the ball rolled
+    assert np.mean(np.abs(np.diff(np.stack(frames).astype(np.int16), axis=0)).sum(axis=(1, 2, 3)) > 0) > 0.5
+    assert env.render() == []  # emptied: the next call returns only what came after
+    env.close()

@@ -1,0 +1,70 @@
+"""Minari export: every episode equals its Parquet row, the env comes back with its settings, clear errors."""
+
+import sys
+
+import numpy as np
+import pytest
+
+from affordance_env import FEATURE_NAMES, load_dataset
+from affordance_env.dataset import collect, images
+from affordance_env.dataset.minari_export import export_minari
+from affordance_env.tap_env import TapAffordanceEnv
+from affordance_learning.cli import main
+
+
+@pytest.fixture(scope="module")
+def taps(tmp_path_factory):
+    out = tmp_path_factory.mktemp("minari-src") / "taps"
+    collect(out, 6, seed=3, action="random", save_images=True, progress=False,
+            env_options={"camera_width": 40, "camera_height": 30, "size_range": (0.05, 0.08)})
+    return out
+
+
+@pytest.fixture
+def minari_home(tmp_path, monkeypatch):
+    pytest.importorskip("minari")
+    monkeypatch.setenv("MINARI_DATASETS_PATH", str(tmp_path / "minari"))
+    return tmp_path / "minari"
+
+
+def test_every_episode_equals_its_row(taps, minari_home):
+    import minari
+
+    exported = export_minari(taps, "tap-affordance/test-taps-v0")
+    assert (minari_home / "tap-affordance" / "test-taps-v0").is_dir()  # Minari's own location convention
+    dataset = minari.load_dataset("tap-affordance/test-taps-v0")
+    frame = load_dataset(taps, with_images=True)
+    assert dataset.total_episodes == exported.total_episodes == len(frame)
+    initial = frame[[f"initial_{n}" for n in FEATURE_NAMES]].to_numpy(np.float32)
+    final = frame[[f"final_{n}" for n in FEATURE_NAMES]].to_numpy(np.float32)
+    ranges = {s: images(frame, f"{s}_range") for s in ("initial", "final")}
+    masks = {s: images(frame, f"{s}_mask") for s in ("initial", "final")}
+    for i, episode in enumerate(dataset.iterate_episodes()):
+        np.testing.assert_array_equal(episode.observations["features"], np.stack([initial[i], final[i]]))
+        np.testing.assert_array_equal(episode.observations["range"], np.stack([ranges["initial"][i],
+                                                                               ranges["final"][i]]))
+        np.testing.assert_array_equal(episode.observations["mask"], np.stack([masks["initial"][i],
+                                                                              masks["final"][i]]).astype(np.int8))
+        np.testing.assert_array_equal(episode.actions[0], frame.loc[i, ["action_0", "action_1", "action_2"]]
+                                      .to_numpy(np.float32))
+        assert episode.rewards[0] == pytest.approx(frame.loc[i, "displacement"])
+        assert episode.terminations.tolist() == [True] and episode.truncations.tolist() == [False]
+    env = dataset.recover_environment()
+    assert isinstance(env.unwrapped, TapAffordanceEnv)
+    assert env.unwrapped.camera.intrinsics.width == 40 and env.unwrapped.size_range == (0.05, 0.08)
+    env.close()
+    with pytest.raises(ValueError, match="exists already"):
+        export_minari(taps, "tap-affordance/test-taps-v0")
+
+
+def test_export_command(taps, minari_home, capsys):
+    assert main(["export", str(taps), "--minari", "tap-affordance/cli-taps-v0"]) == 0
+    assert "6 episodes" in capsys.readouterr().out
+
+
+def test_without_minari_a_clear_error(taps, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "minari", None)  # as if it were not installed
+    with pytest.raises(ImportError, match=r"pip install 'tap-affordance\[minari\]'"):
+        export_minari(taps, "tap-affordance/none-v0")
+    assert main(["export", str(taps), "--minari", "tap-affordance/none-v0"]) == 2
+    assert "tap-affordance[minari]" in capsys.readouterr().err
