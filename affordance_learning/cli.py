@@ -42,7 +42,7 @@ def _reproduce(args: argparse.Namespace) -> int:
     from affordance_learning.reproduce import reproduce
 
     reproduce(args.out, episodes=args.episodes, trials=args.trials, seed=args.seed, workers=args.workers,
-              dataset=args.dataset, range_noise=args.range_noise)
+              dataset=args.dataset, range_noise=args.range_noise, progress=args.progress)
     return 0
 
 
@@ -81,6 +81,8 @@ def build_parser() -> argparse.ArgumentParser:
     reproduce.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
     reproduce.add_argument("--dataset", type=Path, default=None, help="dataset directory (default OUT/dataset)")
     reproduce.add_argument("--out", type=Path, default=Path("reproduction"), help="output directory")
+    reproduce.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                           help="progress bars (default: on a terminal, unless CI is set)")
     reproduce.add_argument("--range-noise", default=None, choices=("kinect_v1",),
                            help="collect with the range camera's depth noise model (default: exact ranges)")
     reproduce.set_defaults(func=_reproduce)

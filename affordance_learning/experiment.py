@@ -312,6 +312,7 @@ def run_protocol(
     svm_C: float = 1.0,
     svm_gamma: float | str = "scale",
     case_study_ks: Iterable[int] = CASE_STUDY_KS,
+    progress: bool = False,
 ) -> dict[str, Any]:
     """Run the paper's protocol (module docstring) on a dataset frame; returns a JSON-ready results dict.
 
@@ -329,6 +330,7 @@ def run_protocol(
         svm_C: SVM regularisation.
         svm_gamma: SVM RBF coefficient.
         case_study_ks: Map sizes whose clusters of the first trial are described in ``case_studies``.
+        progress: Draw a progress bar over the trials.
 
     Returns:
         ``{"uniformity": {"<k>": {"mean", "std"}}`` [%], ``"svm_accuracy": {"<r>": {"<k>": {"mean", "std"}}}``
@@ -362,7 +364,7 @@ def run_protocol(
     type_order = [t for t in OBJECT_TYPES if t in type_counts.index] + sorted(
         t for t in type_counts.index if t not in OBJECT_TYPES
     )
-    trials = Parallel(n_jobs=n_jobs)(
+    jobs = (
         delayed(_run_trial)(
             data,
             t,
@@ -380,6 +382,11 @@ def run_protocol(
         )
         for t in range(n_trials)
     )
+    from tqdm.auto import tqdm
+
+    # in trial order whatever the workers: the results do not depend on n_jobs
+    trials = list(tqdm(Parallel(n_jobs=n_jobs, return_as="generator")(jobs), total=n_trials, unit="trial",
+                       desc="learning trials", disable=not progress, dynamic_ncols=True))
 
     def per_k(key: str) -> dict[str, dict[str, float | None]]:
         return {str(k): _stats(trial[key][k] for trial in trials) for k in ks}

@@ -209,28 +209,32 @@ def _cluster(clusters: list[Mapping[str, Any]], c: int) -> Mapping[str, Any] | N
     return next((cl for cl in clusters if cl.get("cluster") == c), None)
 
 
-def write_figures(results: Mapping[str, Any], out_dir: str | Path) -> list[Path]:
+def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: bool = False) -> list[Path]:
     """Write the figures of a results dict into ``out_dir`` (created if needed); returns their paths.
 
     Args:
         results: The dict returned by :func:`affordance_learning.experiment.run_protocol` (or read back from
             its JSON).
         out_dir: Directory for the PNG files.
+        progress: Draw a progress bar over the figures.
     """
     missing = [key for key in _REQUIRED if key not in results]
     if missing:
         raise ValueError(f"results lack {missing}; expected the dict returned by run_protocol.")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    paths = [
-        _uniformity(results, out / "uniformity.png"),
-        _selected_features(results, out / "selected_features.png"),
+    drawings = [
+        (_uniformity, results, out / "uniformity.png"),
+        (_selected_features, results, out / "selected_features.png"),
     ]
     for k, clusters in sorted(results["case_studies"].items(), key=lambda item: int(item[0])):
-        paths.append(_case_study(clusters, k, out / f"case_study_k{k}.png"))
-    paths.append(_svm_accuracy(results, out / "svm_accuracy.png"))
+        drawings.append((lambda c, p, k=k: _case_study(c, k, p), clusters, out / f"case_study_k{k}.png"))
+    drawings.append((_svm_accuracy, results, out / "svm_accuracy.png"))
     if "purity" in results and "adjusted_rand" in results:
-        paths.append(_clusters_vs_type(results, out / "clusters_vs_type.png"))
+        drawings.append((_clusters_vs_type, results, out / "clusters_vs_type.png"))
     if results.get("prototypes") and "feature_names" in results:
-        paths.append(_prototypes(results, out / "prototypes.png"))
-    return paths
+        drawings.append((_prototypes, results, out / "prototypes.png"))
+    from tqdm.auto import tqdm
+
+    return [draw(what, path) for draw, what, path in tqdm(drawings, unit="figure", desc="figures",
+                                                            disable=not progress, dynamic_ncols=True)]

@@ -52,7 +52,7 @@ def reproduce(
 
     ``range_noise`` (for example ``"kinect_v1"``) collects the taps with the range camera's noise model on.
     """
-    from affordance_env.dataset import collect, failure_summary, load_dataset
+    from affordance_env.dataset import collect, failure_summary, load_dataset, show_progress
     from affordance_learning.experiment import run_protocol
     from affordance_learning.figures import write_figures
     from affordance_learning.report import write_report
@@ -75,7 +75,8 @@ def reproduce(
           f"{f' ({failure_summary({str(k): v for k, v in failures.items()})})' if failures else ''} "
           f"({collected - start:.1f} s)")
     print(f"[2/3] learning protocol: k = 2..10, r in 0.0..0.8, {trials} trials")
-    results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers)
+    bars = show_progress(progress)
+    results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers, progress=bars)
     results.setdefault("config", {}).update(
         {"episodes": int(len(frame)), "dataset": _shown_path(dataset, out), "seed": seed, "trials": trials,
          "range_noise": range_noise or "none"}
@@ -84,9 +85,33 @@ def reproduce(
     print(f"      done ({learned - collected:.1f} s)")
     print(f"[3/3] writing results.json, figures and REPORT.md into {out}")
     (out / "results.json").write_text(json.dumps(_jsonable(results), indent=2))
-    figures = write_figures(results, out)
+    figures = write_figures(results, out, progress=bars)
     report = write_report(results, out)
-    for path in [out / "results.json", *figures, report]:
-        print(f"      {path}")
+    print(f"      results.json, {len(figures)} figures and REPORT.md ({time.perf_counter() - learned:.1f} s)")
     print(f"total {time.perf_counter() - start:.1f} s")
+    print()
+    print(summary(results, report))
     return results
+
+
+def summary(results: dict, report: Path) -> str:
+    """The headline numbers of a reproduction, and where its report is, in a few lines."""
+    from affordance_learning.report import AGREES, evaluate_claims
+
+    effects = results.get("effects", {})
+    uniformity = {int(k): v["mean"] for k, v in results["uniformity"].items() if v["mean"] is not None}
+    accuracy = results["svm_accuracy"].get("0.4") or next(iter(results["svm_accuracy"].values()))
+    acc = {int(k): v["mean"] for k, v in accuracy.items() if v["mean"] is not None}
+    claims = evaluate_claims(results)
+    ks = sorted(uniformity)
+    lines = [f"Report: {report} (figures and results.json beside it)"]
+    if effects.get("rolled_visible") is not None:
+        lines.append(f"  rolled objects seen where they stopped: {100 * effects['rolled_visible']:.0f} %; true travel "
+                     f"vs motion seen, Spearman {effects['travel_vs_seen_motion']:.2f}")
+    lines.append(f"  uniformity: {uniformity[ks[0]]:.1f} % (k = {ks[0]}) to {uniformity[ks[-1]]:.1f} % "
+                 f"(k = {ks[-1]}), mean {np.mean(list(uniformity.values())):.1f} % (paper: above 80 %)")
+    lines.append(f"  SVM accuracy at r = 0.4: {100 * acc[min(acc)]:.1f} % (k = {min(acc)}) to "
+                 f"{100 * acc[max(acc)]:.1f} % (k = {max(acc)})")
+    lines.append(f"  the paper's claims: {sum(c.verdict == AGREES for c in claims)} of {len(claims)} agree "
+                 "(each verdict and its rule in the report)")
+    return "\n".join(lines)

@@ -25,7 +25,8 @@ def test_reproduce_writes_results_figures_and_report(tmp_path, capsys):
     import json
 
     out = tmp_path / "repro"
-    assert main(["reproduce", "--episodes", "40", "--trials", "2", "--workers", "1", "--out", str(out)]) == 0
+    assert main(["reproduce", "--episodes", "40", "--trials", "2", "--workers", "1", "--out", str(out),
+                 "--progress"]) == 0
     results = json.loads((out / "results.json").read_text())
     assert set(results["uniformity"]) == {str(k) for k in range(2, 11)}
     assert set(results["svm_accuracy"]) == {"0.0", "0.2", "0.4", "0.6", "0.8"}
@@ -33,7 +34,12 @@ def test_reproduce_writes_results_figures_and_report(tmp_path, capsys):
     for name in ("uniformity.png", "selected_features.png", "case_study_k2.png", "case_study_k4.png",
                  "svm_accuracy.png", "REPORT.md"):
         assert (out / name).stat().st_size > 1000
-    assert "40 interactions, 0 failed" in capsys.readouterr().out
+    printed = capsys.readouterr()
+    assert "40 interactions, 0 failed" in printed.out
+    # progress bars for each stage, and the headline numbers at the end
+    assert all(stage in printed.err for stage in ("dataset", "learning trials", "figures"))
+    assert f"Report: {out / 'REPORT.md'}" in printed.out and "uniformity:" in printed.out
+    assert "the paper's claims:" in printed.out and "rolled objects seen where they stopped" in printed.out
     # a second run reuses the dataset instead of collecting again: its chunk files are not rewritten
     chunks = {p: p.stat().st_mtime_ns for p in (out / "dataset").glob("chunk-*.parquet")}
     assert main(["reproduce", "--episodes", "40", "--trials", "1", "--workers", "1", "--out", str(out)]) == 0
