@@ -38,7 +38,7 @@ class AttentionResult:
 
 
 def _centroid(camera: RangeCamera, physics: TapPhysics) -> tuple[np.ndarray, np.ndarray] | None:
-    image = camera.capture(physics.data)
+    image = camera.capture(physics.data, occluded=physics.active_geom)
     mask = image.mask_of(physics.active_geom)
     if not mask.any():
         return None

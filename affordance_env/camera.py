@@ -123,10 +123,11 @@ class RangeCamera:
             object as on a real camera; not the rest of the robot (group 1), which the camera never sees and
             whose meshes would make each image cost six times as much.
 
-    Group 0 is ray cast for every pixel; the geoms of the other groups (the arm's detailed meshes) only for the
-    pixels inside the image rectangles that bound their bounding boxes, in a second pass whose nearer hits
-    replace the first pass's: the same image as one pass over all groups, at a fraction of the cost when the arm
-    covers a corner of the view.
+    Group 0 is ray cast for every pixel; the geoms of the other groups (the arm's detailed meshes, whose rays
+    cost microseconds each) only in a second pass, for the pixels inside the image rectangles that bound their
+    bounding boxes, and whose nearer hits replace the first pass's: the same image as one pass over all groups.
+    :meth:`capture` can limit that pass further to the pixels that see given geoms (``occluded``): the arm then
+    appears only where it hides them, and the rest of the image is the world's.
     """
 
     def __init__(
@@ -166,19 +167,17 @@ class RangeCamera:
         """``(p_world_camera, R_world_camera)`` from the current kinematics (``mj_kinematics`` must be current)."""
         return data.cam_xpos[self.camera_id].copy(), data.cam_xmat[self.camera_id].reshape(3, 3).copy()
 
-    def _rays_near(self, geoms: np.ndarray, data: mujoco.MjData, p_world_camera: np.ndarray,
-                   R_world_camera: np.ndarray) -> np.ndarray:
-        """Flat indices of the pixels inside the image rectangles that bound the oriented bounding boxes of
-        ``geoms`` (a box's projection lies within that of its 8 corners)."""
+    def _rectangles(self, geoms: np.ndarray, data: mujoco.MjData, p_world_camera: np.ndarray,
+                    R_world_camera: np.ndarray) -> list[tuple[int, int, int, int]]:
+        """Pixel rectangles (column from, to, row from, to; ends excluded) that bound the images of the oriented
+        bounding boxes of ``geoms`` (a box's projection lies within that of its 8 corners)."""
         K = self.intrinsics
-        if geoms.size == 0:
-            return np.empty(0, dtype=np.intp)
         aabb = self.model.geom_aabb[geoms]  # centre and half-sizes in each geom's frame
         R = data.geom_xmat[geoms].reshape(-1, 3, 3)
         p_world = data.geom_xpos[geoms][:, None, :] + np.einsum(
             "gij,gcj->gci", R, aabb[:, None, :3] + aabb[:, None, 3:] * _CORNERS)
         p_camera = (p_world - p_world_camera) @ R_world_camera  # (geoms, 8, 3)
-        inside = np.zeros((K.height, K.width), dtype=bool)
+        rectangles = []
         for corners in p_camera:
             points = _in_front(corners)  # the box clipped to the part in front of the camera
             if points.shape[0] == 0:
@@ -186,15 +185,41 @@ class RangeCamera:
             z = -points[:, 2]
             u = K.cx + K.fx * points[:, 0] / z
             v = K.cy - K.fy * points[:, 1] / z
-            cols = slice(int(np.clip(np.floor(u.min()), 0, K.width)), int(np.clip(np.ceil(u.max()) + 1, 0, K.width)))
-            rows = slice(int(np.clip(np.floor(v.min()), 0, K.height)),
-                         int(np.clip(np.ceil(v.max()) + 1, 0, K.height)))
-            inside[rows, cols] = True
+            u0, u1 = max(0, int(np.floor(u.min()))), min(K.width, int(np.ceil(u.max())) + 1)
+            v0, v1 = max(0, int(np.floor(v.min()))), min(K.height, int(np.ceil(v.max())) + 1)
+            if u0 < u1 and v0 < v1:
+                rectangles.append((u0, u1, v0, v1))
+        return rectangles
+
+    def _rays_near(self, geoms: np.ndarray, data: mujoco.MjData, p_world_camera: np.ndarray,
+                   R_world_camera: np.ndarray, candidates: np.ndarray | None = None) -> np.ndarray:
+        """Flat pixel indices inside the rectangles of :meth:`_rectangles`: all of them, or those of
+        ``candidates`` (flat indices)."""
+        K = self.intrinsics
+        if geoms.size == 0 or (candidates is not None and candidates.size == 0):
+            return np.empty(0, dtype=np.intp)
+        rectangles = self._rectangles(geoms, data, p_world_camera, R_world_camera)
+        if candidates is not None:
+            v, u = np.divmod(candidates, K.width)
+            keep = np.zeros(candidates.size, dtype=bool)
+            for u0, u1, v0, v1 in rectangles:
+                keep |= (u >= u0) & (u < u1) & (v >= v0) & (v < v1)
+            return candidates[keep]
+        inside = np.zeros((K.height, K.width), dtype=bool)
+        for u0, u1, v0, v1 in rectangles:
+            inside[v0:v1, u0:u1] = True
         return np.flatnonzero(inside)
 
-    def capture(self, data: mujoco.MjData, normals: bool = False) -> RangeImage:
-        """Cast one ray per pixel from the camera's current pose and return the range snapshot (with the surface
-        normals of the hit points if ``normals``)."""
+    def capture(self, data: mujoco.MjData, normals: bool = False,
+                occluded: int | np.ndarray | None = None) -> RangeImage:
+        """Cast one ray per pixel from the camera's current pose and return the range snapshot.
+
+        Args:
+            data: The simulation state (kinematics current).
+            normals: Also return the surface normals of the hit points.
+            occluded: Geom id(s) (the object of interest): the non-world groups are cast only over the pixels
+                that see these in the world pass, where they may hide them. None: over their whole rectangles.
+        """
         K = self.intrinsics
         p_world_camera, R_world_camera = self.pose(data)
         d_world = self._d_camera_rays @ R_world_camera.T
@@ -205,7 +230,8 @@ class RangeCamera:
                 self.model, data, p_world_camera, d_world.reshape(-1), self._world_group, True, -1,
                 self._geom_ids, self._dist, normal, len(self._dist), self.max_range,
             )
-        rays = self._rays_near(self._bounded_geoms, data, p_world_camera, R_world_camera)
+        candidates = None if occluded is None else np.flatnonzero(np.isin(self._geom_ids, occluded))
+        rays = self._rays_near(self._bounded_geoms, data, p_world_camera, R_world_camera, candidates)
         if rays.size:
             ids, dist = np.empty(rays.size, np.int32), np.empty(rays.size)
             near_normal = np.empty(3 * rays.size) if normals else None

@@ -255,7 +255,8 @@ class TapAffordanceEnv(gym.Env):
         }
 
     def _snapshot(self) -> tuple[dict[str, np.ndarray], Any]:
-        image = self.camera.capture(self.physics.data, normals=self.range_noise is not None)
+        image = self.camera.capture(self.physics.data, normals=self.range_noise is not None,
+                                    occluded=self.physics.active_geom)
         if self.range_noise is not None:
             image = add_kinect_noise(image, self.np_random)
         mask = image.mask_of(self.physics.active_geom)

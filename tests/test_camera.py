@@ -125,7 +125,7 @@ def _occluding_view(env, distance: float):
     mujoco.mj_forward(physics.model, physics.data)
     blind = RangeCamera(physics.model, width=camera.intrinsics.width, height=camera.intrinsics.height,
                         fovy_deg=57.4, geom_groups=(0,))
-    return camera.capture(physics.data), blind.capture(physics.data)
+    return camera.capture(physics.data, occluded=physics.active_geom), blind.capture(physics.data)
 
 
 def test_the_hand_occludes_the_object_as_on_a_real_camera():
@@ -139,15 +139,19 @@ def test_the_hand_occludes_the_object_as_on_a_real_camera():
     hand = set(env.physics.hand_geoms.tolist())
     assert set(np.unique(seen.geom_ids[hidden]).tolist()) <= hand  # what hides it is the hand, wrist, forearm
     assert np.all(seen.ranges[hidden] < without_robot.ranges[hidden])  # nearer than the box behind it
+    # the same as casting the arm over the whole image, where the object is concerned
+    everywhere = env.camera.capture(env.physics.data)
+    np.testing.assert_array_equal(everywhere.geom_ids[without_robot.mask_of(geom)],
+                                  seen.geom_ids[without_robot.mask_of(geom)])
 
 
 def test_an_arm_that_hides_nothing_changes_nothing():
     env = TapAffordanceEnv(camera_width=80, camera_height=60)
     obs, _ = env.reset(seed=0, options={"object_type": "sphere", "size": 0.06})
     physics = env.physics
-    seen = env.camera.capture(physics.data)
+    everywhere = env.camera.capture(physics.data)
     blind = RangeCamera(physics.model, width=80, height=60, fovy_deg=57.4, geom_groups=(0,)).capture(physics.data)
-    arm = np.isin(seen.geom_ids, physics.hand_geoms) | (seen.geom_ids != blind.geom_ids)
-    assert arm.any()  # the arm is in view at home ...
-    np.testing.assert_array_equal(seen.mask_of(physics.active_geom), blind.mask_of(physics.active_geom))
-    np.testing.assert_array_equal(seen.ranges[~arm], blind.ranges[~arm])  # ... and changes only its own pixels
+    assert (everywhere.geom_ids != blind.geom_ids).any()  # the arm is in view at home, beside the object ...
+    # ... and the observation, which casts it only where it could hide the object, is the world's exactly
+    np.testing.assert_array_equal(obs["range"], np.where(np.isfinite(blind.ranges), blind.ranges, 0.0))
+    np.testing.assert_array_equal(obs["mask"], blind.mask_of(physics.active_geom))
