@@ -3,6 +3,7 @@
 - :mod:`.format`: what a dataset is on disk (schema, manifest, chunks) and how its files are checked.
 - :mod:`.collect`: :func:`collect` runs interactions into a dataset, resumably.
 - :mod:`.load`: :func:`load_dataset` reads one back; :func:`images` decodes its stored images.
+- :mod:`.minari_export`: :func:`export_minari` writes one as a Minari dataset.
 """
 
 from affordance_env.dataset.collect import (
@@ -27,6 +28,7 @@ from affordance_env.dataset.format import (
     read_manifest,
 )
 from affordance_env.dataset.load import images, load_dataset
+from affordance_env.dataset.minari_export import export_minari
 
 __all__ = [
     "ACTIONS",
@@ -41,6 +43,7 @@ __all__ = [
     "arrow_schema",
     "chunk_name",
     "collect",
+    "export_minari",
     "failure_summary",
     "images",
     "interaction_action",
