@@ -78,8 +78,8 @@ class TapPhysics:
         self._hidden_rbound = {p: float(model.geom_rbound[g]) for p, g in self.object_geoms.items()}
         self.active_geom = self.object_geoms["sphere"]
         self.geometry: ObjectGeometry | None = None
-        #: Follows the object through an interaction (:mod:`affordance_env.outcome`), sampled after every
-        #: :meth:`step` call while set.
+        #: Follows the object through an interaction (:mod:`affordance_env.outcome`): while set, sampled after
+        #: the :meth:`step` calls that end a MONITOR_PERIOD (every control tick).
         self.monitor: ObjectMonitor | None = None
         self._next_sample = 0.0
         #: Called as ``on_step(physics)`` after every :meth:`step` call, if set (used to record video frames).
