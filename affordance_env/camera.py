@@ -167,6 +167,22 @@ class RangeCamera:
         """``(p_world_camera, R_world_camera)`` from the current kinematics (``mj_kinematics`` must be current)."""
         return data.cam_xpos[self.camera_id].copy(), data.cam_xmat[self.camera_id].reshape(3, 3).copy()
 
+    def _may_hide(self, geoms: np.ndarray, targets: np.ndarray, data: mujoco.MjData,
+                  p_world_camera: np.ndarray) -> np.ndarray:
+        """Which of ``geoms`` may hide some of ``targets`` from the camera: those whose bounding sphere meets the
+        cone of rays through a target's bounding sphere (a cheap, conservative test)."""
+        def cone(ids: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            offset = data.geom_xpos[ids] - p_world_camera
+            distance = np.linalg.norm(offset, axis=1)
+            radius = self.model.geom_rbound[ids]
+            half_angle = np.where(distance > radius, np.arcsin(np.minimum(radius / distance, 1.0)), np.pi)
+            return offset / distance[:, None], half_angle
+
+        d_geom, a_geom = cone(geoms)
+        d_target, a_target = cone(targets)
+        between = np.arccos(np.clip(d_geom @ d_target.T, -1.0, 1.0))  # (geoms, targets)
+        return (between <= a_geom[:, None] + a_target[None, :]).any(axis=1)
+
     def _rectangles(self, geoms: np.ndarray, data: mujoco.MjData, p_world_camera: np.ndarray,
                     R_world_camera: np.ndarray) -> list[tuple[int, int, int, int]]:
         """Pixel rectangles (column from, to, row from, to; ends excluded) that bound the images of the oriented
@@ -230,8 +246,11 @@ class RangeCamera:
                 self.model, data, p_world_camera, d_world.reshape(-1), self._world_group, True, -1,
                 self._geom_ids, self._dist, normal, len(self._dist), self.max_range,
             )
-        candidates = None if occluded is None else np.flatnonzero(np.isin(self._geom_ids, occluded))
-        rays = self._rays_near(self._bounded_geoms, data, p_world_camera, R_world_camera, candidates)
+        geoms, candidates = self._bounded_geoms, None
+        if occluded is not None:
+            geoms = geoms[self._may_hide(geoms, np.atleast_1d(occluded), data, p_world_camera)]
+            candidates = np.flatnonzero(np.isin(self._geom_ids, occluded)) if geoms.size else np.empty(0, np.intp)
+        rays = self._rays_near(geoms, data, p_world_camera, R_world_camera, candidates)
         if rays.size:
             ids, dist = np.empty(rays.size, np.int32), np.empty(rays.size)
             near_normal = np.empty(3 * rays.size) if normals else None
