@@ -122,6 +122,11 @@ class RangeCamera:
             0: table, floor, object) and the robot's arm from the upper arm down (group 2), which occludes the
             object as on a real camera; not the rest of the robot (group 1), which the camera never sees and
             whose meshes would make each image cost six times as much.
+        support: Name of a static, axis-aligned box of group 0 whose upward face most rays end on (the table top),
+            or None. The rays that meet that face are intersected with its plane in closed form, a few
+            nanoseconds each instead of MuJoCo's generic ray query (some 100 ns per ray and geom); MuJoCo still
+            casts every ray that misses the face, and every ray that something else of group 0 (the object) may
+            end first, inside the image rectangle that bounds that geom. The image is the same.
 
     Group 0 is ray cast for every pixel; the geoms of the other groups (the arm's detailed meshes, whose rays
     cost microseconds each) only in a second pass, for the pixels inside the image rectangles that bound their
@@ -139,6 +144,7 @@ class RangeCamera:
         fovy_deg: float | None = None,
         max_range: float = 5.0,
         geom_groups: tuple[int, ...] = (0, 2),
+        support: str | None = None,
     ) -> None:
         camera_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
         if camera_id < 0:
@@ -158,10 +164,75 @@ class RangeCamera:
         #: Geoms of the bounded pass (read once: set_object changes only the object's geoms, in group 0 or 3).
         self._bounded_geoms = np.flatnonzero(self._bounded_group[np.clip(model.geom_group, 0, 5)]
                                              & (model.geom_group >= 0) & (model.geom_group <= 5))
+        self._support = None if support is None or not self._world_group.any() else self._support_face(support)
         self._d_camera_rays = self.intrinsics.ray_directions().reshape(-1, 3)
         n = width * height
         self._geom_ids = np.empty(n, dtype=np.int32)
         self._dist = np.empty(n, dtype=np.float64)
+
+    def _support_face(self, name: str) -> tuple[int, float, np.ndarray, np.ndarray]:
+        """(geom id, height, lower and upper x-y corners) of the upward face of the box ``name``."""
+        model = self.model
+        geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
+        if geom < 0:
+            raise ValueError(f"support: the model has no geom named {name!r}.")
+        data = mujoco.MjData(model)
+        mujoco.mj_kinematics(model, data)
+        R = data.geom_xmat[geom].reshape(3, 3)
+        if (model.geom_type[geom] != mujoco.mjtGeom.mjGEOM_BOX or model.geom_group[geom] != 0
+                or model.body_weldid[model.geom_bodyid[geom]] != 0 or not np.allclose(R, np.eye(3), atol=1e-12)):
+            raise ValueError(f"support: geom {name!r} must be a box of group 0, fixed to the world and aligned with "
+                             "its axes.")
+        centre, half = data.geom_xpos[geom], model.geom_size[geom]
+        top = float(centre[2] + half[2])
+        planes = np.flatnonzero((model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE) & (model.geom_group == 0))
+        for plane in planes:  # a plane of the world may never end a ray before the face does
+            if data.geom_xpos[plane, 2] >= top or not np.allclose(data.geom_xmat[plane, 8], 1.0):
+                raise ValueError(f"support: the plane {model.geom(plane).name!r} is not below the face of {name!r}.")
+        return int(geom), top, centre[:2] - half[:2], centre[:2] + half[:2]
+
+    def _cast(self, data: mujoco.MjData, p_world_camera: np.ndarray, d_world: np.ndarray, rays: np.ndarray,
+              group: np.ndarray, normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """MuJoCo's nearest hit (geom ids, distances; normals written into ``normal``) of the rays ``rays``."""
+        ids, dist = np.empty(rays.size, np.int32), np.empty(rays.size)
+        mujoco.mj_multiRay(self.model, data, p_world_camera, np.ascontiguousarray(d_world[rays]).reshape(-1), group,
+                           True, -1, ids, dist, normal, rays.size, self.max_range)
+        return ids, dist
+
+    def _world_pass(self, data: mujoco.MjData, p_world_camera: np.ndarray, R_world_camera: np.ndarray,
+                    d_world: np.ndarray, normal: np.ndarray | None) -> None:
+        """Nearest hit of every ray among the geoms of group 0, into ``self._geom_ids``, ``self._dist``."""
+        if self._support is None:
+            mujoco.mj_multiRay(
+                self.model, data, p_world_camera, d_world.reshape(-1), self._world_group, True, -1,
+                self._geom_ids, self._dist, normal, len(self._dist), self.max_range,
+            )
+            return
+        geom, top, low, high = self._support
+        on_face = np.zeros(len(self._dist), dtype=bool)
+        if p_world_camera[2] > top:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = (top - p_world_camera[2]) / d_world[:, 2]
+            x = p_world_camera[0] + t * d_world[:, 0]
+            y = p_world_camera[1] + t * d_world[:, 1]
+            on_face = (t > 0) & (t <= self.max_range) & (x >= low[0]) & (x <= high[0]) & (y >= low[1]) & (y <= high[1])
+            self._geom_ids[on_face] = geom
+            self._dist[on_face] = t[on_face]
+            if normal is not None:
+                normal.reshape(-1, 3)[on_face] = (0.0, 0.0, 1.0)
+        # Geoms of group 0 that may end a ray before the face: all but the box and the planes below it.
+        model = self.model
+        others = np.flatnonzero((model.geom_group == 0) & (model.geom_type != mujoco.mjtGeom.mjGEOM_PLANE))
+        others = others[others != geom]
+        cast = ~on_face
+        cast[self._rays_near(others, data, p_world_camera, R_world_camera, np.flatnonzero(on_face))] = True
+        rays = np.flatnonzero(cast)
+        if rays.size:
+            ray_normal = np.empty(3 * rays.size) if normal is not None else None
+            ids, dist = self._cast(data, p_world_camera, d_world, rays, self._world_group, ray_normal)
+            self._geom_ids[rays], self._dist[rays] = ids, dist
+            if normal is not None:
+                normal.reshape(-1, 3)[rays] = ray_normal.reshape(-1, 3)
 
     def pose(self, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
         """``(p_world_camera, R_world_camera)`` from the current kinematics (``mj_kinematics`` must be current)."""
@@ -242,22 +313,15 @@ class RangeCamera:
         normal = np.empty(3 * len(self._dist)) if normals else None
         self._geom_ids[:] = -1
         if self._world_group.any():
-            mujoco.mj_multiRay(
-                self.model, data, p_world_camera, d_world.reshape(-1), self._world_group, True, -1,
-                self._geom_ids, self._dist, normal, len(self._dist), self.max_range,
-            )
+            self._world_pass(data, p_world_camera, R_world_camera, d_world, normal)
         geoms, candidates = self._bounded_geoms, None
         if occluded is not None:
             geoms = geoms[self._may_hide(geoms, np.atleast_1d(occluded), data, p_world_camera)]
             candidates = np.flatnonzero(np.isin(self._geom_ids, occluded)) if geoms.size else np.empty(0, np.intp)
         rays = self._rays_near(geoms, data, p_world_camera, R_world_camera, candidates)
         if rays.size:
-            ids, dist = np.empty(rays.size, np.int32), np.empty(rays.size)
             near_normal = np.empty(3 * rays.size) if normals else None
-            mujoco.mj_multiRay(
-                self.model, data, p_world_camera, np.ascontiguousarray(d_world[rays]).reshape(-1),
-                self._bounded_group, True, -1, ids, dist, near_normal, rays.size, self.max_range,
-            )
+            ids, dist = self._cast(data, p_world_camera, d_world, rays, self._bounded_group, near_normal)
             nearer = (ids >= 0) & ((self._geom_ids[rays] < 0) | (dist < self._dist[rays]))
             self._geom_ids[rays[nearer]] = ids[nearer]
             self._dist[rays[nearer]] = dist[nearer]

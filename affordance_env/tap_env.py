@@ -214,8 +214,10 @@ class TapAffordanceEnv(gym.Env):
         self.physics = TapPhysics(build_model())
         self.kinematics = Kinematics()
         self.motion = MotionExecutor(self.physics, self.kinematics)
-        self.camera = RangeCamera(self.physics.model, width=camera_width, height=camera_height, fovy_deg=camera_fovy)
-        self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy)
+        self.camera = RangeCamera(self.physics.model, width=camera_width, height=camera_height, fovy_deg=camera_fovy,
+                                  support="table_top")
+        self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy,
+                                            support="table_top")
         self._renderer = None
         self._render_size = (render_width, render_height)
         #: With a render mode: pictures taken every 1/render_fps s of simulated time since the last ``reset``

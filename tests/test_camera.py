@@ -155,3 +155,63 @@ def test_an_arm_that_hides_nothing_changes_nothing():
     # ... and the observation, which casts it only where it could hide the object, is the world's exactly
     np.testing.assert_array_equal(obs["range"], np.where(np.isfinite(blind.ranges), blind.ranges, 0.0))
     np.testing.assert_array_equal(obs["mask"], blind.mask_of(physics.active_geom))
+
+
+def _images_along_interactions(env, interactions, every=37):
+    """The states (qpos, qvel) after reset and every ``every`` physics step calls of the interactions, each
+    (reset options, action)."""
+    physics = env.physics
+    step, calls = physics.step, [0]
+    states = []
+
+    def counting_step(n=1):
+        step(n)
+        calls[0] += 1
+        if calls[0] % every == 0:
+            states.append((physics.data.qpos.copy(), physics.data.qvel.copy()))
+
+    physics.step = counting_step
+    try:
+        for seed, (options, action) in enumerate(interactions):
+            env.reset(seed=seed, options=options)
+            states.append((physics.data.qpos.copy(), physics.data.qvel.copy()))
+            env.step(action)
+    finally:
+        physics.step = step
+    return states
+
+
+def test_the_table_face_in_closed_form_gives_mujocos_image():
+    # The env's camera intersects the table's top face in closed form; a camera that leaves every ray to MuJoCo
+    # must see exactly the same image, with the object on the table, rolling off it, under the hand, and fallen.
+    env = TapAffordanceEnv(camera_width=80, camera_height=60)
+    mujoco_only = RangeCamera(env.physics.model, width=80, height=60, fovy_deg=57.4)
+    interactions = [({"object_type": "box"}, np.zeros(3)), ({"object_type": "sphere"}, np.array([1.0, -1.0, 0.5])),
+                    ({"object_type": "sphere", "size": 0.08, "position": (-0.3, 0.05)}, np.array([0.0, 0.0, 1.0]))]
+    states = _images_along_interactions(env, interactions)
+    data = env.physics.data
+    assert not env.physics.object_on_table()  # the ball left the table ...
+    env.physics.step(250)  # ... and falls to the floor
+    states.append((data.qpos.copy(), data.qvel.copy()))
+    faces = off_table = 0
+    for qpos, qvel in states:
+        data.qpos[:], data.qvel[:] = qpos, qvel
+        mujoco.mj_forward(env.physics.model, data)
+        for normals in (False, True):
+            fast = env.camera.capture(data, normals=normals, occluded=env.physics.active_geom)
+            slow = mujoco_only.capture(data, normals=normals, occluded=env.physics.active_geom)
+            np.testing.assert_array_equal(fast.geom_ids, slow.geom_ids)
+            np.testing.assert_allclose(fast.ranges, slow.ranges, rtol=1e-6)
+            if normals:
+                np.testing.assert_allclose(fast.normals, slow.normals, atol=1e-9)
+        faces += (fast.geom_ids == env.physics.table_geom).mean() > 0.5
+        off_table += not env.physics.object_on_table()
+    assert faces == len(states) and off_table > 0  # the face was in view throughout, and an object fell
+
+
+def test_a_support_that_is_not_an_axis_aligned_box_is_refused(wall):
+    model, _ = wall
+    with pytest.raises(ValueError, match="'ball' must be a box"):
+        RangeCamera(model, "cam", width=8, height=8, support="ball")
+    with pytest.raises(ValueError, match="no geom named 'table'"):
+        RangeCamera(model, "cam", width=8, height=8, support="table")
