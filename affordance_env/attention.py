@@ -74,8 +74,8 @@ def attend(
     *,
     max_iterations: int = 6,
     tolerance: float = 0.5,
-    move_time: float = 0.1,
-    hold_time: float = 0.06,
+    move_time: float | None = None,
+    hold_time: float = 0.02,
 ) -> AttentionResult:
     """Centre the object of interest in ``camera``'s image by moving the neck.
 
@@ -85,12 +85,12 @@ def attend(
         move_joints: ``move_joints(q_target, duration)`` of :class:`~affordance_env.motion.MotionExecutor`.
         max_iterations: Look-move cycles at most.
         tolerance: Accepted centroid error [pixels of ``camera``].
-        move_time: Duration of each neck move [s].
+        move_time: Duration of each neck move [s]; None: as fast as the neck's speed limit allows.
         hold_time: Time the servos are given to settle before the next look [s].
     """
     K = camera.intrinsics
     centre = np.array([K.cx, K.cy])
-    scratch = mujoco.MjData(physics.model)
+    scratch = physics.scratch
     seen = _centroid(camera, physics)
     if seen is None:
         return AttentionResult(False, False, float("inf"), 0)

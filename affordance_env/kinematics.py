@@ -120,31 +120,34 @@ class Kinematics:
                 raise ValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
         q = np.clip(self._check_q(q_init).copy(), self.lower, self.upper)
         dofs = self.reach_dofs
+        lower, upper = self.lower[dofs], self.upper[dofs]
+        model, data, frame = self.model, self.data, self.hand_frame_id
+        n_error = 3 if R_world_target is None else 6
+        regulariser = damping * np.eye(n_error)
+        error = np.empty(n_error)
         pos_err = rot_err = np.inf
         iteration = 0
         for iteration in range(1, max_iterations + 1):  # noqa: B007 (the count is returned)
-            pin.framesForwardKinematics(self.model, self.data, q)
-            T_world_hand = self.data.oMf[self.hand_frame_id]
-            e_pos = p_target - T_world_hand.translation
-            pos_err = float(np.linalg.norm(e_pos))
-            J = pin.computeFrameJacobian(
-                self.model, self.data, q, self.hand_frame_id, pin.LOCAL_WORLD_ALIGNED
-            )[:, dofs]
+            # computeFrameJacobian runs the forward kinematics and places the hand frame (data.oMf[frame]).
+            J = pin.computeFrameJacobian(model, data, q, frame, pin.LOCAL_WORLD_ALIGNED)
+            T_world_hand = data.oMf[frame]
+            error[:3] = p_target - T_world_hand.translation
+            pos_err = float(np.linalg.norm(error[:3]))
+            jac = J[:n_error, dofs]
             if R_world_target is None:
                 rot_err = 0.0
-                error, jac = e_pos, J[:3]
             else:
                 e_rot = pin.log3(R_world_target @ T_world_hand.rotation.T)
                 rot_err = float(np.linalg.norm(e_rot))
-                error = np.concatenate([e_pos, orientation_weight * e_rot])
-                jac = np.vstack([J[:3], orientation_weight * J[3:]])
+                error[3:] = orientation_weight * e_rot
+                jac[3:] *= orientation_weight
             if pos_err <= position_tolerance and rot_err <= orientation_tolerance * 0.5:
                 break
-            step = jac.T @ np.linalg.solve(jac @ jac.T + damping * np.eye(len(error)), error)
-            q[dofs] = np.clip(q[dofs] + step, self.lower[dofs], self.upper[dofs])
+            step = jac.T @ np.linalg.solve(jac @ jac.T + regulariser, error)
+            q[dofs] = np.minimum(np.maximum(q[dofs] + step, lower), upper)
         else:
-            pin.framesForwardKinematics(self.model, self.data, q)
-            T_world_hand = self.data.oMf[self.hand_frame_id]
+            pin.framesForwardKinematics(model, data, q)
+            T_world_hand = data.oMf[frame]
             pos_err = float(np.linalg.norm(p_target - T_world_hand.translation))
             if R_world_target is not None:
                 rot_err = float(np.linalg.norm(pin.log3(R_world_target @ T_world_hand.rotation.T)))

@@ -7,6 +7,7 @@ the servo lag and the arm's momentum.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,10 +18,18 @@ from affordance_env.physics import TapPhysics
 
 #: Period of the servo set-point updates [s].
 CONTROL_DT = 0.01
-#: Time to move from home to above the object, and from there down to the pre-stroke pose [s].
-REACH_TIME, DESCEND_TIME = 0.35, 0.15
-#: Time to back off after the stroke, to lift the hand above the object, and to return home [s].
-BACKOFF_TIME, LIFT_TIME, HOME_TIME = 0.12, 0.15, 0.3
+#: Peak joint speed of a move [rad/s]: 100 deg/s, the velocity limit of the iCub's arm, torso and head joints
+#: in its motor interface (the harmonic-drive joints are specified for more; the controllers cap them there).
+JOINT_SPEED_LIMIT = np.radians(100.0)
+#: Shortest move [s]: three control ticks, so that even a tiny correction is a smooth profile.
+MIN_MOVE_TIME = 0.03
+#: Minimum-jerk profile 10 t^3 - 15 t^4 + 6 t^5: its peak speed is PEAK_SPEED_FACTOR times the mean speed.
+PEAK_SPEED_FACTOR = 1.875
+#: Share of the shorter of two consecutive segments of a move through via points during which both run.
+VIA_BLEND = 0.5
+#: Duration of the way home from above the object [s]; None: as fast as JOINT_SPEED_LIMIT allows, blended with
+#: the way up from the stroke.
+HOME_TIME: float | None = None
 #: The hand must be this close to the pre-stroke pose before the stroke starts [m], waiting at most
 #: SETTLE_MAX_TIME [s] for the servos.
 SETTLE_TOLERANCE, SETTLE_MAX_TIME = 0.003, 0.4
@@ -29,6 +38,8 @@ SETTLE_TOLERANCE, SETTLE_MAX_TIME = 0.003, 0.4
 #: about 1 mrad of its target; an arm blocked short of its target (resting on an object that rolled under it)
 #: is still all the same.
 HOLD_SPEED_TOLERANCE, HOLD_MAX_TIME = 0.01, 1.0
+#: Consecutive control ticks at which the robot must be that slow to count as still.
+HOLD_STILL_TICKS = 2
 #: Spacing of the IK solutions along the stroke line [m].
 IK_SPACING = 0.01
 #: IK tolerances for the stroke waypoints: position [m] and orientation [rad].
@@ -50,6 +61,8 @@ class StrokeOutcome:
         hand_travel: Distance the palm travelled along the stroke direction [m].
         start_error: Distance of the palm from the pre-stroke pose when the stroke started [m].
         object_moved: How far the object moved before the stroke started (touched during the reach) [m].
+        q_withdraw: Joint targets of the pose above the pre-stroke pose: the way home passes there, so that it
+            never crosses the object.
     """
 
     ik_success: bool
@@ -61,6 +74,7 @@ class StrokeOutcome:
     hand_travel: float
     start_error: float
     object_moved: float
+    q_withdraw: np.ndarray
 
 
 class MotionExecutor:
@@ -75,12 +89,54 @@ class MotionExecutor:
         self.physics.set_joint_targets(q)
         self.physics.step(self.steps_per_tick)
 
-    def move_joints(self, q_target: np.ndarray, duration: float) -> None:
-        """Ramp the servo targets linearly from their current value to ``q_target`` over ``duration`` [s]."""
+    def move_joints(self, q_target: np.ndarray, duration: float | None = None) -> None:
+        """Move the servo targets from their current value to ``q_target`` along a minimum-jerk profile.
+
+        The profile starts and ends at rest, and the targets lead it by each servo's damping lag (velocity
+        feedforward), so the joints follow it instead of lagging behind. ``duration`` [s] defaults to the shortest
+        one in which no joint exceeds JOINT_SPEED_LIMIT (and at least MIN_MOVE_TIME).
+        """
+        self.move_through([q_target], duration)
+
+    def move_through(self, waypoints: list[np.ndarray], duration: float | None = None,
+                     blend: float = VIA_BLEND) -> None:
+        """Move through ``waypoints`` (joint targets) to the last one, without stopping at the ones before.
+
+        One minimum-jerk segment per waypoint; each starts ``blend`` of the shorter segment's duration before the
+        previous one ends, so the joints pass near the via points at speed rather than stopping there. The
+        segments are stretched so that no joint exceeds JOINT_SPEED_LIMIT; ``duration`` [s] sets the total
+        instead (each segment its share of it).
+        """
         q_from = self.physics.joint_targets()
-        n = max(1, round(duration / CONTROL_DT))
-        for k in range(1, n + 1):
-            self._tick(q_from + (q_target - q_from) * (k / n))
+        deltas = np.diff(np.vstack([q_from, *waypoints]), axis=0)
+        lengths = np.maximum(MIN_MOVE_TIME, PEAK_SPEED_FACTOR * np.max(np.abs(deltas), axis=1) / JOINT_SPEED_LIMIT)
+        starts = np.zeros(len(deltas))
+        for k in range(1, len(deltas)):
+            starts[k] = starts[k - 1] + lengths[k - 1] - blend * min(lengths[k - 1], lengths[k])
+        end = float(np.max(starts + lengths))
+
+        def profile(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            """Joint targets and velocities at times ``t`` [s] (a column) of the unstretched profile."""
+            tau = np.clip((t - starts) / lengths, 0.0, 1.0)  # (ticks, segments)
+            position = tau ** 3 * (10.0 + tau * (6.0 * tau - 15.0))
+            rate = 30.0 * tau ** 2 * (1.0 + tau * (tau - 2.0)) / lengths
+            acceleration = 60.0 * tau * (1.0 + tau * (2.0 * tau - 3.0)) / lengths ** 2
+            return q_from + position @ deltas, rate @ deltas, acceleration @ deltas
+
+        n = max(1, round(end / CONTROL_DT))
+        t = (np.arange(1, n + 1) * (end / n))[:, None]
+        q, qd, qdd = profile(t)
+        stretch = max(1.0, float(np.max(np.abs(qd))) / JOINT_SPEED_LIMIT)  # blended segments may add up
+        if duration is not None:
+            stretch = duration / end
+        if stretch != 1.0:
+            n = max(1, round(stretch * end / CONTROL_DT))
+            q, qd, qdd = profile((np.arange(1, n + 1) * (end / n))[:, None])
+            qd /= stretch
+            qdd /= stretch ** 2
+        physics = self.physics
+        for q_tick, qd_tick, qdd_tick in zip(q, qd, qdd, strict=True):
+            self._tick(q_tick + physics.servo_lead * qd_tick + physics.inertial_lead(qdd_tick))
 
     def settle(self, p_world_target: np.ndarray, tolerance: float = SETTLE_TOLERANCE,
                max_time: float = SETTLE_MAX_TIME) -> float:
@@ -101,44 +157,21 @@ class MotionExecutor:
             p, q_init, plan.R_world_hand, position_tolerance=1e-3, orientation_tolerance=IK_ORIENTATION_TOLERANCE
         )
 
-    def plan_joint_path(self, plan: StrokePlan) -> tuple[list[IKResult], np.ndarray]:
-        """IK of the approach poses and of the stroke line sampled every control tick.
-
-        Returns the IK results (above, start, then every stroke point) and the stroke's joint path (n, nq).
-        """
-        q = self.physics.joint_targets()
-        above = self._ik(plan.p_above, q, plan)
-        start = self._ik(plan.p_start, above.q, plan)
-        length = float(np.dot(plan.p_end - plan.p_start, plan.direction))
-        # IK on waypoints every IK_SPACING along the line; joint-space interpolation between them per tick
-        # (the deviation from the straight line is far below the IK tolerance over such short spans).
-        n_ik = max(2, int(np.ceil(length / IK_SPACING)) + 1)
-        s_ik = np.linspace(0.0, length, n_ik)
-        q_ik = np.empty((n_ik, self.kinematics.nq))
-        results = [above, start]
-        q_prev = start.q
-        for k, s in enumerate(s_ik):
-            res = self._ik(plan.p_start + s * plan.direction, q_prev, plan)
-            results.append(res)
-            q_ik[k] = q_prev = res.q
-        n = max(2, int(np.ceil(length / (plan.speed * CONTROL_DT))) + 1)
-        s_tick = np.linspace(0.0, length, n)
-        path = np.column_stack([np.interp(s_tick, s_ik, q_ik[:, j]) for j in range(q_ik.shape[1])])
-        return results, path
+    def plan_approach(self, plan: StrokePlan) -> tuple[IKResult, IKResult]:
+        """IK of the pose above the pre-stroke pose and of the pre-stroke pose itself."""
+        # The pre-stroke pose first, the pose above it from there: the two differ by a short vertical move, so
+        # the descent (and the way up after the stroke) is a small joint motion, not a change of arm posture.
+        start = self._ik(plan.p_start, self.physics.joint_targets(), plan)
+        above = self._ik(plan.p_above, start.q, plan)
+        return above, start
 
     def stroke(self, plan: StrokePlan) -> StrokeOutcome:
-        """Reach, stroke until contact plus follow-through (or full travel), back off and lift; not the return home."""
+        """Reach, and stroke until contact plus follow-through (or full travel); then :meth:`go_home`."""
         physics = self.physics
-        results, path = self.plan_joint_path(plan)
-        # The pose above the object is a via point that only has to clear it; the stroke itself must be exact.
-        stroke_results = results[1:]
-        pos_err = max(r.position_error for r in stroke_results)
-        rot_err = max(r.orientation_error for r in stroke_results)
-        ik_ok = pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE
+        above, start = self.plan_approach(plan)
+        line = StrokeLine(self, plan, start.q)
         p_object_before = physics.object_pose()[:3]
-        self.move_joints(results[0].q, REACH_TIME)
-        self.settle(plan.p_above, tolerance=0.01)
-        self.move_joints(results[1].q, DESCEND_TIME)
+        self.move_through([above.q, start.q])  # down onto the pre-stroke pose from above it
         start_error = self.settle(plan.p_start)
         object_moved = float(np.linalg.norm(physics.object_pose()[:3] - p_object_before))
         p_hand_start = physics.hand_position()
@@ -146,8 +179,8 @@ class MotionExecutor:
         p_contact = p_hand_start
         dt = physics.model.opt.timestep
         stopped = False
-        for q_tick in path:
-            physics.set_joint_targets(q_tick)
+        for i in range(len(line)):
+            physics.set_joint_targets(line.target(i))
             for _ in range(self.steps_per_tick):
                 p_before = physics.hand_position()
                 physics.step()
@@ -165,26 +198,84 @@ class MotionExecutor:
             if stopped:
                 break
         travel = float(np.dot(physics.hand_position() - p_hand_start, plan.direction))
-        # Back off to the pre-stroke pose and lift above the object, so that the way home never crosses it.
-        self.move_joints(results[1].q, BACKOFF_TIME)
-        self.move_joints(results[0].q, LIFT_TIME)
+        # The pose above the object is a via point that only has to clear it; the stroke itself must be exact.
+        stroke_results = [start, *line.results]
+        pos_err = max(r.position_error for r in stroke_results)
+        rot_err = max(r.orientation_error for r in stroke_results)
+        ik_ok = pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE
         return StrokeOutcome(ik_ok, pos_err, rot_err, contact, contact_time, hand_speed, travel, start_error,
-                             object_moved)
+                             object_moved, above.q)
 
-    def go_home(self, q_home: np.ndarray) -> bool:
-        """Return to ``q_home`` (after :meth:`stroke`, from above the object) and hold until the robot is still;
-        returns whether it came to rest (:meth:`hold_still`)."""
-        self.move_joints(q_home, HOME_TIME)
+    def go_home(self, q_home: np.ndarray, via: np.ndarray | None = None) -> bool:
+        """Return to ``q_home`` through ``via`` (after :meth:`stroke`: up and back above the pre-stroke pose) and
+        hold until the robot is still; returns whether it came to rest (:meth:`hold_still`)."""
+        if via is None:
+            self.move_joints(q_home, HOME_TIME)
+        elif HOME_TIME is None:
+            self.move_through([via, q_home])
+        else:  # a set pace for the way home: up to ``via`` at full speed, then home in HOME_TIME
+            self.move_joints(via)
+            self.move_joints(q_home, HOME_TIME)
         return self.hold_still()
 
-    def hold_still(self, max_time: float = HOLD_MAX_TIME) -> bool:
-        """Hold the current servo targets until every joint is slower than HOLD_SPEED_TOLERANCE, so that a snapshot
-        sees the scene from a still head and with a still hand; at most ``max_time`` [s]. Returns whether the
-        robot came to rest."""
+    def hold_still(self, max_time: float = HOLD_MAX_TIME,
+                   also: Callable[[TapPhysics], bool] | None = None) -> bool:
+        """Hold the current servo targets until the robot is still, so that a snapshot sees the scene from a still
+        head and with a still hand: every joint slower than HOLD_SPEED_TOLERANCE at HOLD_STILL_TICKS consecutive
+        control ticks (one slow sample could be the turning point of an oscillation); at most ``max_time`` [s].
+        ``also(physics)``, if given, must hold too (for instance: the object is at rest). Returns whether the robot
+        came to rest."""
         physics = self.physics
         q = physics.joint_targets()
-        for _ in range(max(1, round(max_time / CONTROL_DT))):
-            if np.max(np.abs(physics.joint_velocities())) <= HOLD_SPEED_TOLERANCE:
+        still_ticks = 0
+        for tick in range(max(1, round(max_time / CONTROL_DT)) + 1):
+            slow = np.max(np.abs(physics.joint_velocities())) <= HOLD_SPEED_TOLERANCE
+            still_ticks = still_ticks + 1 if slow else 0
+            if still_ticks >= HOLD_STILL_TICKS and (also is None or also(physics)):
                 return True
+            if tick * CONTROL_DT >= max_time - 1e-9:
+                break
             self._tick(q)
-        return False
+        return still_ticks >= HOLD_STILL_TICKS
+
+
+class StrokeLine:
+    """The stroke's joint path: the straight stroke line at the plan's speed, one target per control tick.
+
+    IK waypoints every IK_SPACING along the line, each warm started from the one before, are solved only when the
+    hand gets there (the stroke usually stops a follow-through after contact, well before the line's end);
+    between them the targets are interpolated in joint space (the deviation from the straight line is far below
+    the IK tolerance over such short spans).
+    """
+
+    def __init__(self, executor: MotionExecutor, plan: StrokePlan, q_start: np.ndarray) -> None:
+        self._executor, self._plan = executor, plan
+        length = float(np.dot(plan.p_end - plan.p_start, plan.direction))
+        self._s_ik = np.linspace(0.0, length, max(2, int(np.ceil(length / IK_SPACING)) + 1))
+        self._s_tick = np.linspace(0.0, length, max(2, int(np.ceil(length / (plan.speed * CONTROL_DT))) + 1))
+        self._q_ik: list[np.ndarray] = []
+        self._q_start = q_start
+        #: IK results of the waypoints solved so far, in order along the line.
+        self.results: list[IKResult] = []
+
+    def __len__(self) -> int:
+        return len(self._s_tick)
+
+    def _waypoint(self, k: int) -> np.ndarray:
+        while len(self._q_ik) <= k:
+            plan = self._plan
+            q_init = self._q_ik[-1] if self._q_ik else self._q_start
+            result = self._executor._ik(plan.p_start + self._s_ik[len(self._q_ik)] * plan.direction, q_init, plan)
+            self.results.append(result)
+            self._q_ik.append(result.q)
+        return self._q_ik[k]
+
+    def target(self, i: int) -> np.ndarray:
+        """Joint targets of tick ``i``."""
+        s = self._s_tick[i]
+        k = min(int(np.searchsorted(self._s_ik, s)), len(self._s_ik) - 1)
+        if k == 0:
+            return self._waypoint(0)
+        w = (s - self._s_ik[k - 1]) / (self._s_ik[k] - self._s_ik[k - 1])
+        q0 = self._waypoint(k - 1)
+        return q0 + w * (self._waypoint(k) - q0)

@@ -43,7 +43,8 @@ class TapPhysics:
     def __init__(self, model: mujoco.MjModel) -> None:
         self.model = model
         self.data = mujoco.MjData(model)
-        self._scratch = mujoco.MjData(model)
+        #: Data for side computations (kinematics of other configurations); never the simulated state.
+        self.scratch = mujoco.MjData(model)
         obj = mujoco.mjtObj
         self.object_body = _id(model, obj.mjOBJ_BODY, "object")
         self.object_geoms = {p: _id(model, obj.mjOBJ_GEOM, f"object_{p}") for p in PRIMITIVES}
@@ -55,20 +56,23 @@ class TapPhysics:
         self.actuators = np.array([_id(model, obj.mjOBJ_ACTUATOR, n) for n in ACTIVE_JOINTS])
         self.palm_site = _id(model, obj.mjOBJ_SITE, "palm")
         self.head_site = _id(model, obj.mjOBJ_SITE, "head")
-        touch = _id(model, obj.mjOBJ_SENSOR, "palm_touch")
-        self.touch_adr = int(model.sensor_adr[touch])
         self.table_geom = _id(model, obj.mjOBJ_GEOM, "table_top")
         self.home_key = _id(model, obj.mjOBJ_KEY, "home")
         contact_bodies = {_id(model, obj.mjOBJ_BODY, n) for n in CONTACT_LINKS}
         self.hand_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] in contact_bodies])
         self._is_hand_geom = np.zeros(model.ngeom, dtype=bool)
         self._is_hand_geom[self.hand_geoms] = True
+        #: kv / kp of each position servo [s]: a target led by this times the reference velocity cancels the
+        #: servo's damping lag, so the joint follows a moving reference (velocity feedforward).
+        self.servo_kp = model.actuator_gainprm[self.actuators, 0].copy()
+        self.servo_lead = -model.actuator_biasprm[self.actuators, 2] / self.servo_kp
+        self._qacc, self._torque = np.zeros(model.nv), np.zeros(model.nv)
         self.ctrl_low = model.actuator_ctrlrange[self.actuators, 0].copy()
         self.ctrl_high = model.actuator_ctrlrange[self.actuators, 1].copy()
         self._ctrl = np.empty(len(self.actuators))
         # The table is static: its top height and extent are fixed once.
-        mujoco.mj_kinematics(model, self._scratch)
-        centre = self._scratch.geom_xpos[self.table_geom]
+        mujoco.mj_kinematics(model, self.scratch)
+        centre = self.scratch.geom_xpos[self.table_geom]
         half = model.geom_size[self.table_geom]
         self.table_top = float(centre[2] + half[2])
         self.table_low, self.table_high = centre[:2] - half[:2], centre[:2] + half[:2]
@@ -110,6 +114,14 @@ class TapPhysics:
         np.minimum(np.maximum(q, self.ctrl_low, out=self._ctrl), self.ctrl_high, out=self._ctrl)
         self.data.ctrl[self.actuators] = self._ctrl
 
+    def inertial_lead(self, qdd: np.ndarray) -> np.ndarray:
+        """Servo target offsets [rad] whose spring torques accelerate the robot's joints at ``qdd`` [rad/s^2]
+        (ACTIVE_JOINTS order) in the current configuration: M qdd / kp (acceleration feedforward)."""
+        self._qacc[:] = 0.0
+        self._qacc[self.robot_qvel] = qdd
+        mujoco.mj_mulM(self.model, self.data, self._torque, self._qacc)
+        return self._torque[self.robot_qvel] / self.servo_kp
+
     def joint_targets(self) -> np.ndarray:
         """Current servo targets [rad]."""
         return self.data.ctrl[self.actuators].copy()
@@ -117,10 +129,6 @@ class TapPhysics:
     def hand_position(self) -> np.ndarray:
         """``p_world_hand``: palm centre in the world frame [m]."""
         return self.data.site_xpos[self.palm_site].copy()
-
-    def palm_touch(self) -> float:
-        """Normal force on the palm's touch sensor [N]."""
-        return float(self.data.sensordata[self.touch_adr])
 
     def hand_touches_object(self) -> bool:
         """Whether any contact joins the hand (or wrist, forearm) and the object."""
@@ -167,7 +175,7 @@ class TapPhysics:
         m.body_iquat[self.object_body] = [1.0, 0.0, 0.0, 0.0]
         self.active_geom = g
         self.geometry = geometry
-        mujoco.mj_setConst(m, self._scratch)  # on scratch data: it resets the state it is given to qpos0
+        mujoco.mj_setConst(m, self.scratch)  # on scratch data: it resets the state it is given to qpos0
         quat_yaw = np.array([np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)])
         quat = np.empty(4)
         mujoco.mju_mulQuat(quat, quat_yaw, geometry.quat_rest)

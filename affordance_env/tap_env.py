@@ -15,7 +15,6 @@ from affordance_env.camera import RangeCamera
 from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
 from affordance_env.kinematics import Kinematics
 from affordance_env.motion import (
-    CONTROL_DT,
     HOLD_MAX_TIME,
     HOLD_SPEED_TOLERANCE,
     MotionExecutor,
@@ -34,8 +33,8 @@ PLACEMENT_HALF_WIDTH = np.array([0.03, 0.03])
 RESET_OPTIONS = ("object_type", "size", "position", "yaw")
 #: Yaw jitter of boxes and lying cylinders [rad].
 YAW_JITTER = 0.25
-#: Longest time the object is given to settle after placement [s].
-SETTLE_TIME = 0.5
+#: The placed object is at rest for the initial snapshot when slower than these [m/s], [rad/s].
+REST_SPEED, REST_ANGULAR_SPEED = 1e-3, 1e-2
 #: The hand may start the stroke at most this far from the planned pre-stroke pose [m], and may have moved
 #: the object at most this much before the stroke [m]; otherwise the interaction is marked failed.
 MAX_START_ERROR, MAX_OBJECT_MOVED_BEFORE = 0.01, 0.003
@@ -62,6 +61,10 @@ def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: t
     if not stroke.contact:
         return "tap: the hand never touched the object"
     return None
+
+
+def _object_at_rest(physics: TapPhysics) -> bool:
+    return physics.object_speed() < REST_SPEED and physics.object_angular_speed() < REST_ANGULAR_SPEED
 
 
 def default_reward(info: dict[str, Any]) -> float:
@@ -322,10 +325,9 @@ class TapAffordanceEnv(gym.Env):
         physics.reset_home()
         self._q_home = physics.joint_targets()
         geometry = object_geometry(object_type, size)
-        physics.set_object(geometry, xy, yaw)
-        self._settle_object()
+        physics.set_object(geometry, xy, yaw)  # 0.1 mm above the table: it settles while the head turns
         attention = attend(physics, self.attention_camera, self.motion.move_joints)
-        still = self.motion.hold_still()
+        still = self.motion.hold_still(also=_object_at_rest)
         self._q_home = physics.joint_targets()  # the arm's home, with the gaze on the object
         obs, features = self._snapshot()
         pose = physics.object_pose()
@@ -339,14 +341,6 @@ class TapAffordanceEnv(gym.Env):
             "still": still,
         }
         return obs, info
-
-    def _settle_object(self) -> None:
-        """Let the freshly placed object come to rest (it is placed 0.1 mm above the table)."""
-        physics = self.physics
-        for _ in range(round(SETTLE_TIME / CONTROL_DT)):
-            physics.step(self.motion.steps_per_tick)
-            if physics.object_speed() < 1e-3 and physics.object_angular_speed() < 1e-2:
-                return
 
     def _wait_outcome(self, monitor: ObjectMonitor, since: float) -> tuple[str, float]:
         """Simulate until the object has left the table, has been at rest since ``since`` [s] or later, or
@@ -378,7 +372,7 @@ class TapAffordanceEnv(gym.Env):
         monitor = physics.start_monitor()  # from now on, whatever the arm does
         try:
             stroke = self.motion.stroke(plan)
-            still = self.motion.go_home(self._q_home)
+            still = self.motion.go_home(self._q_home, via=stroke.q_withdraw)
             outcome, outcome_time = self._wait_outcome(
                 monitor, stroke.contact_time if stroke.contact else physics.data.time)
         finally:

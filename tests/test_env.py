@@ -291,7 +291,7 @@ def test_leaving_the_table_is_measured_when_it_happens_not_when_the_arm_is_back(
     import affordance_env.motion as motion
 
     travels = []
-    for home_time in (0.3, 1.5):
+    for home_time in (0.6, 1.5):
         monkeypatch.setattr(motion, "HOME_TIME", home_time)
         env = TapAffordanceEnv(camera_width=32, camera_height=24)
         env.reset(seed=4, options={"object_type": "sphere", "size": 0.08, "position": (-0.3, 0.05)})

@@ -16,7 +16,6 @@ def test_every_element_is_named(model):
         "joint": (model.njnt, mujoco.mjtObj.mjOBJ_JOINT),
         "geom": (model.ngeom, mujoco.mjtObj.mjOBJ_GEOM),
         "camera": (model.ncam, mujoco.mjtObj.mjOBJ_CAMERA),
-        "sensor": (model.nsensor, mujoco.mjtObj.mjOBJ_SENSOR),
         "actuator": (model.nu, mujoco.mjtObj.mjOBJ_ACTUATOR),
         "site": (model.nsite, mujoco.mjtObj.mjOBJ_SITE),
     }

@@ -3,6 +3,7 @@
 The Parquet dataset stays the source of truth; :func:`export_minari` writes a copy that Minari users load with
 ``minari.load_dataset(dataset_id)``. One episode per interaction, of one step:
 
+- episodes: the valid interactions in order, numbered 0..n-1 (failed ones are left out), each with its seed.
 - observations: a ``Dict`` of ``features`` (49,) float32, and ``range`` (H, W) float32 and ``mask`` (H, W)
   int8 when the dataset saved its images (``save_images``); two of each, before and after the interaction.
   The environment's ``joints`` observation is not stored in datasets, so it is not in the export.
@@ -91,12 +92,14 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
     actions = frame[[f"action_{j}" for j in range(3)]].to_numpy(np.float32)
     rewards = frame["displacement"].to_numpy(np.float64)
     buffers = []
-    for i, (episode, seed) in enumerate(zip(frame["episode"], frame["seed"], strict=True)):
+    for i, seed in enumerate(frame["seed"]):
         observations = {"features": np.stack([stages["initial"][i], stages["final"][i]])}
         if with_images:
             observations["range"] = np.stack([decoded["initial_range"][i], decoded["final_range"][i]])
             observations["mask"] = np.stack([decoded["initial_mask"][i], decoded["final_mask"][i]]).astype(np.int8)
-        buffers.append(EpisodeBuffer(id=int(episode), seed=int(seed), observations=observations,
+        # Minari numbers episodes 0..n-1 (it counts them from the largest id); the valid interactions are
+        # renumbered in order, each keeps its seed.
+        buffers.append(EpisodeBuffer(id=i, seed=int(seed), observations=observations,
                                      actions=actions[i : i + 1], rewards=[float(rewards[i])], terminations=[True],
                                      truncations=[False]))
     import gymnasium as gym
