@@ -179,19 +179,22 @@ class MotionExecutor:
         p_contact = p_hand_start
         dt = physics.model.opt.timestep
         stopped = False
+        palm = physics.data.site_xpos[physics.palm_site]  # a view: the palm position after each step
         for i in range(len(line)):
             physics.set_joint_targets(line.target(i))
             for _ in range(self.steps_per_tick):
-                p_before = physics.hand_position()
-                physics.step()
-                p_hand = physics.hand_position()
-                if not contact and physics.hand_touches_object():
-                    contact = True
-                    contact_time = float(physics.data.time)
-                    hand_speed = float(np.linalg.norm(p_hand - p_before) / dt)
-                    p_contact = p_hand
+                if not contact:
+                    p_before = palm.copy()
+                    physics.step()
+                    if physics.hand_touches_object():
+                        contact = True
+                        contact_time = float(physics.data.time)
+                        hand_speed = float(np.linalg.norm(palm - p_before) / dt)
+                        p_contact = palm.copy()
+                else:
+                    physics.step()
                 # The hand stops once the palm itself has travelled the follow-through past the first touch.
-                if contact and np.dot(p_hand - p_contact, plan.direction) >= plan.follow_through:
+                if contact and np.dot(palm - p_contact, plan.direction) >= plan.follow_through:
                     physics.set_joint_targets(physics.joint_positions())
                     stopped = True
                     break

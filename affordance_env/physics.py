@@ -32,6 +32,13 @@ def _id(model: mujoco.MjModel, kind: mujoco.mjtObj, name: str) -> int:
     return index
 
 
+def _as_slice(indices: np.ndarray) -> slice | np.ndarray:
+    """``indices`` as a slice if they are consecutive and increasing, else unchanged."""
+    if indices.size and np.array_equal(indices, np.arange(indices[0], indices[0] + indices.size)):
+        return slice(int(indices[0]), int(indices[0]) + indices.size)
+    return indices
+
+
 class TapPhysics:
     """The model and data of the tap scene with named queries.
 
@@ -54,6 +61,11 @@ class TapPhysics:
         self.robot_qpos = np.array([model.jnt_qposadr[_id(model, obj.mjOBJ_JOINT, n)] for n in ACTIVE_JOINTS])
         self.robot_qvel = np.array([model.jnt_dofadr[_id(model, obj.mjOBJ_JOINT, n)] for n in ACTIVE_JOINTS])
         self.actuators = np.array([_id(model, obj.mjOBJ_ACTUATOR, n) for n in ACTIVE_JOINTS])
+        # Index with slices where the indices run in order (they do in the built scene): a slice is a view,
+        # cheaper than fancy indexing at every control tick.
+        self._qpos = _as_slice(self.robot_qpos)
+        self._qvel = _as_slice(self.robot_qvel)
+        self._act = _as_slice(self.actuators)
         self.palm_site = _id(model, obj.mjOBJ_SITE, "palm")
         self.head_site = _id(model, obj.mjOBJ_SITE, "head")
         self.table_geom = _id(model, obj.mjOBJ_GEOM, "table_top")
@@ -66,7 +78,7 @@ class TapPhysics:
         #: servo's damping lag, so the joint follows a moving reference (velocity feedforward).
         self.servo_kp = model.actuator_gainprm[self.actuators, 0].copy()
         self.servo_lead = -model.actuator_biasprm[self.actuators, 2] / self.servo_kp
-        self._qacc, self._torque = np.zeros(model.nv), np.zeros(model.nv)
+        self._qacc, self._torque = np.zeros(model.nv), np.zeros(model.nv)  # only the robot's part of qacc is set
         self.ctrl_low = model.actuator_ctrlrange[self.actuators, 0].copy()
         self.ctrl_high = model.actuator_ctrlrange[self.actuators, 1].copy()
         self._ctrl = np.empty(len(self.actuators))
@@ -102,29 +114,28 @@ class TapPhysics:
 
     def joint_positions(self) -> np.ndarray:
         """Robot joint angles in ACTIVE_JOINTS order [rad]."""
-        return self.data.qpos[self.robot_qpos].copy()
+        return self.data.qpos[self._qpos].copy()
 
     def joint_velocities(self) -> np.ndarray:
         """Robot joint velocities in ACTIVE_JOINTS order [rad/s]."""
-        return self.data.qvel[self.robot_qvel].copy()
+        return self.data.qvel[self._qvel].copy()
 
     def set_joint_targets(self, q: np.ndarray) -> None:
         """Command the position servos to ``q`` [rad] (ACTIVE_JOINTS order), clipped to the joint ranges."""
         # np.minimum/np.maximum into the control vector: np.clip's wrapper costs more than the clipping
         np.minimum(np.maximum(q, self.ctrl_low, out=self._ctrl), self.ctrl_high, out=self._ctrl)
-        self.data.ctrl[self.actuators] = self._ctrl
+        self.data.ctrl[self._act] = self._ctrl
 
     def inertial_lead(self, qdd: np.ndarray) -> np.ndarray:
         """Servo target offsets [rad] whose spring torques accelerate the robot's joints at ``qdd`` [rad/s^2]
         (ACTIVE_JOINTS order) in the current configuration: M qdd / kp (acceleration feedforward)."""
-        self._qacc[:] = 0.0
-        self._qacc[self.robot_qvel] = qdd
+        self._qacc[self._qvel] = qdd
         mujoco.mj_mulM(self.model, self.data, self._torque, self._qacc)
-        return self._torque[self.robot_qvel] / self.servo_kp
+        return self._torque[self._qvel] / self.servo_kp
 
     def joint_targets(self) -> np.ndarray:
         """Current servo targets [rad]."""
-        return self.data.ctrl[self.actuators].copy()
+        return self.data.ctrl[self._act].copy()
 
     def hand_position(self) -> np.ndarray:
         """``p_world_hand``: palm centre in the world frame [m]."""
