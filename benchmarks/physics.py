@@ -2,7 +2,8 @@
 
 Prints steps per second of (a) the full scene (iCub, table, one object) at the home pose with the servos
 holding it, and (b) a bare MuJoCo scene with the same table and object and no robot, measured in the same
-run, and their ratio: how close the robot model comes to the cost of the physics it has to do anyway.
+run, and their ratio: how close the robot model comes to the cost of the physics it has to do anyway; then,
+from MuJoCo's own timers, where a step of each scene goes (microseconds per step, by pipeline stage).
 
     python benchmarks/physics.py [--steps 20000] [--object sphere]
 """
@@ -42,6 +43,32 @@ def steps_per_second(model: mujoco.MjModel, data: mujoco.MjData, steps: int) -> 
     return steps / (time.perf_counter() - start)
 
 
+#: MuJoCo's timers reported, as (label, timer); the nested ones are indented.
+STAGES = (
+    ("step", mujoco.mjtTimer.mjTIMER_STEP),
+    ("  position", mujoco.mjtTimer.mjTIMER_POSITION),
+    ("    kinematics", mujoco.mjtTimer.mjTIMER_POS_KINEMATICS),
+    ("    inertia", mujoco.mjtTimer.mjTIMER_POS_INERTIA),
+    ("    collision: broad phase", mujoco.mjtTimer.mjTIMER_COL_BROAD),
+    ("    collision: narrow phase", mujoco.mjtTimer.mjTIMER_COL_NARROW),
+    ("    making constraints", mujoco.mjtTimer.mjTIMER_POS_MAKE),
+    ("  velocity (passive, bias)", mujoco.mjtTimer.mjTIMER_VELOCITY),
+    ("  actuation", mujoco.mjtTimer.mjTIMER_ACTUATION),
+    ("  constraint solver", mujoco.mjtTimer.mjTIMER_CONSTRAINT),
+    ("  integration", mujoco.mjtTimer.mjTIMER_ADVANCE),
+)
+
+
+def stage_times(model: mujoco.MjModel, data: mujoco.MjData, steps: int) -> dict[str, float]:
+    """Microseconds per step in each of STAGES over ``steps`` steps."""
+    mujoco.mj_step(model, data, 100)
+    for _, timer in STAGES:
+        data.timer[timer].duration = 0.0
+        data.timer[timer].number = 0
+    mujoco.mj_step(model, data, steps)
+    return {label: 1e6 * data.timer[timer].duration / steps for label, timer in STAGES}
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--steps", type=int, default=20000)
@@ -76,6 +103,13 @@ def main() -> None:
     print(f"  bare scene (table + object)         : {bare_rate:10,.0f} steps/s")
     print(f"  ratio tap scene / bare scene        : {full / bare_rate:10.2f}")
     print(f"  real-time factor of the tap scene   : {full * physics.model.opt.timestep:10.1f} x")
+    physics.reset_home()
+    physics.set_object(geometry, np.array([-0.30, 0.03]), 0.0)
+    mujoco.mj_resetData(bare, bare_data)
+    stages = stage_times(physics.model, physics.data, args.steps), stage_times(bare, bare_data, args.steps)
+    print("where a step goes (MuJoCo's timers, microseconds per step): tap scene | bare scene")
+    for label, _ in STAGES:
+        print(f"  {label:<28}: {stages[0][label]:6.2f} | {stages[1][label]:6.2f}")
 
 
 if __name__ == "__main__":
