@@ -22,7 +22,8 @@ move 2-3 cm, at the hardest (+1) four in five roll off the 1 m wide table (see `
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -43,6 +44,12 @@ APPROACH_CLEARANCE = 0.06
 HAND_BELOW_PALM = 0.033
 #: Lowest palm-centre height above the table [m]: the hand reaches 3.3 cm below the palm centre.
 MIN_PALM_HEIGHT = 0.04
+#: Joint range the IK keeps to when the hand reaches across the body (tap_back) or strokes close to it (push),
+#: fingers level and thumb up, the palm 4 cm above the table: the wrist's yaw within 3 degrees of its lower limit
+#: (-20 degrees), which bends the forearm up from the hand and holds it 5-10 mm clear of the table. With the wrist
+#: free, the IK's solutions lay the forearm on the table: the servos then stop the hand 1-6 cm short of the
+#: pre-stroke pose.
+FOREARM_RAISED: dict[str, tuple[float, float]] = {"r_wrist_yaw": (-0.35, -0.30)}
 
 
 @dataclass(frozen=True)
@@ -56,6 +63,10 @@ class Behavior:
             normal), (3, 3).
         contact_offset: Distance from the palm frame origin to the hand surface that leads the stroke [m].
         description: One line for the documentation.
+        approach_clearance: Clearance between the hand's lowest point and the object's top at the pose above the
+            pre-stroke pose, which the hand reaches first [m].
+        joint_ranges: Narrower joint ranges ``{name: (low, high)}`` [rad] that the IK keeps to for every pose of
+            the stroke: a posture of the arm (see :data:`FOREARM_RAISED`). Empty: the robot's joint limits.
     """
 
     name: str
@@ -63,6 +74,8 @@ class Behavior:
     R_world_hand: np.ndarray
     contact_offset: float
     description: str
+    approach_clearance: float = APPROACH_CLEARANCE
+    joint_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
 
 
 def _rotation(fingers: tuple[float, float, float], palm_normal: tuple[float, float, float]) -> np.ndarray:
@@ -106,6 +119,7 @@ class StrokePlan:
         speed: Hand speed along the stroke [m/s].
         R_world_hand: Hand orientation during the stroke.
         follow_through: Travel after first contact [m].
+        joint_ranges: The behaviour's joint ranges for the IK (:attr:`Behavior.joint_ranges`).
     """
 
     p_above: np.ndarray
@@ -115,6 +129,7 @@ class StrokePlan:
     speed: float
     R_world_hand: np.ndarray
     follow_through: float
+    joint_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
 
 
 def check_action(action: np.ndarray) -> np.ndarray:
@@ -166,11 +181,12 @@ def plan_stroke(
     p_end = centre + d * (half - behavior.contact_offset + FOLLOW_THROUGH)
     return StrokePlan(
         p_above=np.array([p_start[0], p_start[1], table_top + 2 * geometry.half_height + HAND_BELOW_PALM
-                          + APPROACH_CLEARANCE]),
+                          + behavior.approach_clearance]),
         p_start=p_start,
         p_end=p_end,
         direction=d,
         speed=SPEED_CANONICAL * SPEED_FACTOR ** a[2],
         R_world_hand=behavior.R_world_hand,
         follow_through=FOLLOW_THROUGH,
+        joint_ranges=behavior.joint_ranges,
     )
