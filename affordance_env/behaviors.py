@@ -46,9 +46,9 @@ HAND_BELOW_PALM = 0.033
 MIN_PALM_HEIGHT = 0.04
 #: Joint range the IK keeps to when the hand reaches across the body (tap_back) or strokes close to it (push),
 #: fingers level and thumb up, the palm 4 cm above the table: the wrist's yaw within 3 degrees of its lower limit
-#: (-20 degrees), which bends the forearm up from the hand and holds it 5-10 mm clear of the table. With the wrist
-#: free, the IK's solutions lay the forearm on the table: the servos then stop the hand 1-6 cm short of the
-#: pre-stroke pose.
+#: (-20 degrees), which bends the forearm up from the hand and holds it at least 5 mm (typically 9 mm) clear of the
+#: table. With the wrist free, the IK's solutions put the forearm into the table (up to 8 mm for tap_back, 34 mm for
+#: push): the arm then rests on it, and the hand stops 1-6 cm short of the pre-stroke pose.
 FOREARM_RAISED: dict[str, tuple[float, float]] = {"r_wrist_yaw": (-0.35, -0.30)}
 
 
@@ -92,10 +92,12 @@ BEHAVIORS: dict[str, Behavior] = {
     "tap_back": Behavior(
         "tap_back", np.array([0.0, 1.0]), _rotation((-1, 0, 0), (0, -1, 0)), 0.039,
         "tap from the other side: the back of the hand hits the object from its left, moving right (+y)",
+        joint_ranges=FOREARM_RAISED,
     ),
     "push": Behavior(
         "push", np.array([-1.0, 0.0]), _rotation((0, -1, 0), (1, 0, 0)), 0.039,
         "push from the front: the back of the hand pushes the object's near face away from the robot (-x)",
+        joint_ranges=FOREARM_RAISED,
     ),
 }
 
