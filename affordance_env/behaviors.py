@@ -56,6 +56,10 @@ FOREARM_RAISED: dict[str, tuple[float, float]] = {"r_wrist_yaw": (-0.35, -0.30)}
 #: robot (the less, the further right), short of the stroke's far end for large objects right of centre; turned,
 #: it reaches 36-39 cm. Pushed balls move within 2 degrees of straight ahead (6 degrees with the fingers across).
 PUSH_HAND_TURN = np.radians(15.0)
+#: Approach clearance of tap_back [m]: its hand crosses over the object, from home on the object's right to its
+#: left, and the forearm, trailing behind and below the hand, swept the top of objects 9-10 cm tall with the
+#: ``APPROACH_CLEARANCE`` of the other behaviours.
+CROSSING_CLEARANCE = 0.08
 
 
 @dataclass(frozen=True)
@@ -98,7 +102,7 @@ BEHAVIORS: dict[str, Behavior] = {
     "tap_back": Behavior(
         "tap_back", np.array([0.0, 1.0]), _rotation((-1, 0, 0), (0, -1, 0)), 0.039,
         "tap from the other side: the back of the hand hits the object from its left, moving right (+y)",
-        joint_ranges=FOREARM_RAISED,
+        approach_clearance=CROSSING_CLEARANCE, joint_ranges=FOREARM_RAISED,
     ),
     "push": Behavior(
         "push", np.array([-1.0, 0.0]),
