@@ -56,6 +56,11 @@ FOREARM_RAISED: dict[str, tuple[float, float]] = {"r_wrist_yaw": (-0.35, -0.30)}
 #: robot (the less, the further right), short of the stroke's far end for large objects right of centre; turned,
 #: it reaches 36-39 cm. Pushed balls move within 2 degrees of straight ahead (6 degrees with the fingers across).
 PUSH_HAND_TURN = np.radians(15.0)
+#: Default distance [m] beyond which an interaction succeeds (the env's ``roll_threshold``): see :func:`is_success`.
+ROLL_THRESHOLD = 0.03
+#: What a behaviour's success is (:attr:`Behavior.success_rule`): ``"rolled"``, the object rolled more than the
+#: threshold (the paper's label for the tap); ``"moved"``, its centre travelled more than the threshold on the table.
+SUCCESS_RULES = ("rolled", "moved")
 #: Approach clearance of tap_back [m]: its hand crosses over the object, from home on the object's right to its
 #: left, and the forearm, trailing behind and below the hand, swept the top of objects 9-10 cm tall with the
 #: ``APPROACH_CLEARANCE`` of the other behaviours.
@@ -77,6 +82,7 @@ class Behavior:
             pre-stroke pose, which the hand reaches first [m].
         joint_ranges: Narrower joint ranges ``{name: (low, high)}`` [rad] that the IK keeps to for every pose of
             the stroke: a posture of the arm (see :data:`FOREARM_RAISED`). Empty: the robot's joint limits.
+        success_rule: What makes an interaction a success, one of :data:`SUCCESS_RULES` (see :func:`is_success`).
     """
 
     name: str
@@ -86,6 +92,11 @@ class Behavior:
     description: str
     approach_clearance: float = APPROACH_CLEARANCE
     joint_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    success_rule: str = "rolled"
+
+    def __post_init__(self) -> None:
+        if self.success_rule not in SUCCESS_RULES:
+            raise ValueError(f"success_rule must be one of {SUCCESS_RULES}, got {self.success_rule!r}.")
 
 
 def _rotation(fingers: tuple[float, float, float], palm_normal: tuple[float, float, float]) -> np.ndarray:
@@ -110,9 +121,26 @@ BEHAVIORS: dict[str, Behavior] = {
                   (np.cos(PUSH_HAND_TURN), -np.sin(PUSH_HAND_TURN), 0)),
         0.039,
         "push from the front: the back of the hand pushes the object's near face away from the robot (-x)",
-        joint_ranges=FOREARM_RAISED,
+        joint_ranges=FOREARM_RAISED, success_rule="moved",
     ),
 }
+
+
+def is_success(rule: str, rolled: bool | np.ndarray, displacement: float | np.ndarray,
+               threshold: float = ROLL_THRESHOLD) -> bool | np.ndarray:
+    """The success/fail label of interactions by a behaviour whose :attr:`~Behavior.success_rule` is ``rule``.
+
+    ``"rolled"`` (tap, tap_back: the paper's label): ``rolled``, the object rolled more than ``threshold``;
+    ``"moved"`` (push): ``displacement > threshold``, the object's centre travelled more than ``threshold`` [m] on
+    the table, rolling or sliding. Scalars give a bool, arrays an array.
+    """
+    if rule == "rolled":
+        label = np.asarray(rolled, dtype=bool)
+    elif rule == "moved":
+        label = np.asarray(displacement, dtype=np.float64) > threshold
+    else:
+        raise ValueError(f"rule must be one of {SUCCESS_RULES}, got {rule!r}.")
+    return bool(label) if label.ndim == 0 else label
 
 
 def get_behavior(name: str) -> Behavior:

@@ -282,6 +282,32 @@ def test_a_stroke_started_off_its_pose_is_reported():
     assert info["failure"].startswith("reach: the stroke started"), info["failure"]
 
 
+def test_success_is_rolled_for_taps_and_moved_for_push():
+    tap = TapAffordanceEnv(camera_width=32, camera_height=24)
+    for object_type, succeeds in (("sphere", True), ("box", False)):  # a tapped ball rolls, a box slides
+        tap.reset(seed=0, options={"object_type": object_type, "size": 0.06})
+        info = tap.step(np.zeros(3))[4]
+        assert info["failure"] is None
+        assert type(info["success"]) is bool and info["success"] is info["rolled"] is succeeds
+    # push: success is the displacement beyond roll_threshold, rolling or sliding; a pushed box slides 1-2 cm
+    for threshold, succeeds in ((0.03, False), (0.01, True)):
+        push = TapAffordanceEnv(behavior="push", roll_threshold=threshold, camera_width=32, camera_height=24)
+        push.reset(seed=0, options={"object_type": "box", "size": 0.06})
+        info = push.step(np.zeros(3))[4]
+        assert info["failure"] is None and not info["rolled"]
+        assert 0.01 < info["displacement"] < 0.03
+        assert type(info["success"]) is bool and info["success"] is succeeds
+    push.reset(seed=0, options={"object_type": "sphere", "size": 0.06})
+    info = push.step(np.zeros(3))[4]
+    assert info["success"] and info["displacement"] > 0.03
+    # a failed interaction is no success
+    hand = push.physics.hand_geoms
+    push.physics.model.geom_contype[hand] = push.physics.model.geom_conaffinity[hand] = 0  # a ghost hand
+    push.reset(seed=0, options={"object_type": "sphere", "size": 0.06})
+    info = push.step(np.zeros(3))[4]
+    assert info["failure"].startswith("tap:") and info["success"] is False
+
+
 def test_labels_come_from_the_motion_a_toppled_box_is_not_rolled():
     # On a grippy surface a hard, high tap tips a 6 cm box over its edge: it travels 9 cm, but by tipping, not
     # by rolling; a ball rolls. The labels say so from the measured motion, with no reference to the type.
