@@ -22,7 +22,8 @@ move 2-3 cm, at the hardest (+1) four in five roll off the 1 m wide table (see `
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -43,6 +44,27 @@ APPROACH_CLEARANCE = 0.06
 HAND_BELOW_PALM = 0.033
 #: Lowest palm-centre height above the table [m]: the hand reaches 3.3 cm below the palm centre.
 MIN_PALM_HEIGHT = 0.04
+#: Joint range the IK keeps to when the hand reaches across the body (tap_back) or strokes close to it (push),
+#: fingers level and thumb up, the palm 4 cm above the table: the wrist's yaw within 3 degrees of its lower limit
+#: (-20 degrees), which bends the forearm up from the hand and holds it at least 5 mm (typically 9 mm) clear of the
+#: table. With the wrist free, the IK's solutions put the forearm into the table (up to 8 mm for tap_back, 34 mm for
+#: push): the arm then rests on it, and the hand stops 1-6 cm short of the pre-stroke pose.
+FOREARM_RAISED: dict[str, tuple[float, float]] = {"r_wrist_yaw": (-0.35, -0.30)}
+#: The push's hand is turned by this angle about the vertical from straight across [rad]: the fingers point to the
+#: robot's left and a little forward, and the back of the hand faces a little to the right of straight ahead. With
+#: the fingers straight across, the forearm lies across the body and the hand reaches 30-35 cm in front of the
+#: robot (the less, the further right), short of the stroke's far end for large objects right of centre; turned,
+#: it reaches 36-39 cm. Pushed balls move within 2 degrees of straight ahead (6 degrees with the fingers across).
+PUSH_HAND_TURN = np.radians(15.0)
+#: Default distance [m] beyond which an interaction succeeds (the env's ``roll_threshold``): see :func:`is_success`.
+ROLL_THRESHOLD = 0.03
+#: What a behaviour's success is (:attr:`Behavior.success_rule`): ``"rolled"``, the object rolled more than the
+#: threshold (the paper's label for the tap); ``"moved"``, its centre travelled more than the threshold on the table.
+SUCCESS_RULES = ("rolled", "moved")
+#: Approach clearance of tap_back [m]: its hand crosses over the object, from home on the object's right to its
+#: left, and the forearm, trailing behind and below the hand, swept the top of objects 9-10 cm tall with the
+#: ``APPROACH_CLEARANCE`` of the other behaviours.
+CROSSING_CLEARANCE = 0.08
 
 
 @dataclass(frozen=True)
@@ -56,6 +78,11 @@ class Behavior:
             normal), (3, 3).
         contact_offset: Distance from the palm frame origin to the hand surface that leads the stroke [m].
         description: One line for the documentation.
+        approach_clearance: Clearance between the hand's lowest point and the object's top at the pose above the
+            pre-stroke pose, which the hand reaches first [m].
+        joint_ranges: Narrower joint ranges ``{name: (low, high)}`` [rad] that the IK keeps to for every pose of
+            the stroke: a posture of the arm (see :data:`FOREARM_RAISED`). Empty: the robot's joint limits.
+        success_rule: What makes an interaction a success, one of :data:`SUCCESS_RULES` (see :func:`is_success`).
     """
 
     name: str
@@ -63,6 +90,13 @@ class Behavior:
     R_world_hand: np.ndarray
     contact_offset: float
     description: str
+    approach_clearance: float = APPROACH_CLEARANCE
+    joint_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    success_rule: str = "rolled"
+
+    def __post_init__(self) -> None:
+        if self.success_rule not in SUCCESS_RULES:
+            raise ValueError(f"success_rule must be one of {SUCCESS_RULES}, got {self.success_rule!r}.")
 
 
 def _rotation(fingers: tuple[float, float, float], palm_normal: tuple[float, float, float]) -> np.ndarray:
@@ -79,12 +113,34 @@ BEHAVIORS: dict[str, Behavior] = {
     "tap_back": Behavior(
         "tap_back", np.array([0.0, 1.0]), _rotation((-1, 0, 0), (0, -1, 0)), 0.039,
         "tap from the other side: the back of the hand hits the object from its left, moving right (+y)",
+        approach_clearance=CROSSING_CLEARANCE, joint_ranges=FOREARM_RAISED,
     ),
     "push": Behavior(
-        "push", np.array([-1.0, 0.0]), _rotation((0, -1, 0), (1, 0, 0)), 0.039,
+        "push", np.array([-1.0, 0.0]),
+        _rotation((-np.sin(PUSH_HAND_TURN), -np.cos(PUSH_HAND_TURN), 0),
+                  (np.cos(PUSH_HAND_TURN), -np.sin(PUSH_HAND_TURN), 0)),
+        0.039,
         "push from the front: the back of the hand pushes the object's near face away from the robot (-x)",
+        joint_ranges=FOREARM_RAISED, success_rule="moved",
     ),
 }
+
+
+def is_success(rule: str, rolled: bool | np.ndarray, displacement: float | np.ndarray,
+               threshold: float = ROLL_THRESHOLD) -> bool | np.ndarray:
+    """The success/fail label of interactions by a behaviour whose :attr:`~Behavior.success_rule` is ``rule``.
+
+    ``"rolled"`` (tap, tap_back: the paper's label): ``rolled``, the object rolled more than ``threshold``;
+    ``"moved"`` (push): ``displacement > threshold``, the object's centre travelled more than ``threshold`` [m] on
+    the table, rolling or sliding. Scalars give a bool, arrays an array.
+    """
+    if rule == "rolled":
+        label = np.asarray(rolled, dtype=bool)
+    elif rule == "moved":
+        label = np.asarray(displacement, dtype=np.float64) > threshold
+    else:
+        raise ValueError(f"rule must be one of {SUCCESS_RULES}, got {rule!r}.")
+    return bool(label) if label.ndim == 0 else label
 
 
 def get_behavior(name: str) -> Behavior:
@@ -106,6 +162,7 @@ class StrokePlan:
         speed: Hand speed along the stroke [m/s].
         R_world_hand: Hand orientation during the stroke.
         follow_through: Travel after first contact [m].
+        joint_ranges: The behaviour's joint ranges for the IK (:attr:`Behavior.joint_ranges`).
     """
 
     p_above: np.ndarray
@@ -115,6 +172,7 @@ class StrokePlan:
     speed: float
     R_world_hand: np.ndarray
     follow_through: float
+    joint_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
 
 
 def check_action(action: np.ndarray) -> np.ndarray:
@@ -166,11 +224,12 @@ def plan_stroke(
     p_end = centre + d * (half - behavior.contact_offset + FOLLOW_THROUGH)
     return StrokePlan(
         p_above=np.array([p_start[0], p_start[1], table_top + 2 * geometry.half_height + HAND_BELOW_PALM
-                          + APPROACH_CLEARANCE]),
+                          + behavior.approach_clearance]),
         p_start=p_start,
         p_end=p_end,
         direction=d,
         speed=SPEED_CANONICAL * SPEED_FACTOR ** a[2],
         R_world_hand=behavior.R_world_hand,
         follow_through=FOLLOW_THROUGH,
+        joint_ranges=behavior.joint_ranges,
     )

@@ -52,7 +52,8 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     env.add_argument("--camera-height", type=int, default=None, help="range image height [pixels]")
     env.add_argument("--camera-fovy", type=float, default=None, help="vertical field of view [deg]")
     env.add_argument("--roll-threshold", type=float, default=None,
-                     help="rolling distance above which an interaction is 'rolled' [m]")
+                     help="rolling distance above which an interaction is 'rolled' [m]; for push, the "
+                          "displacement above which it is a 'success'")
     env.add_argument("--settle-timeout", type=float, default=None,
                      help="longest simulated wait for the outcome after the first touch [s]")
     env.add_argument("--range-noise", default=None, choices=("kinect_v1",),

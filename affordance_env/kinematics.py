@@ -6,6 +6,7 @@ reduced to :data:`~affordance_env.robot_model.ACTIVE_JOINTS`; configurations are
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,7 +20,8 @@ class IKResult:
     """Outcome of :meth:`Kinematics.solve_ik`.
 
     Attributes:
-        q: Joint configuration reached, in :data:`ACTIVE_JOINTS` order [rad]; within the joint limits.
+        q: Joint configuration reached, in :data:`ACTIVE_JOINTS` order [rad]; within the joint limits (and the
+            ``joint_ranges`` asked for).
         success: Whether both errors are within the requested tolerances.
         position_error: Distance between reached and target hand position [m].
         orientation_error: Angle between reached and target hand orientation [rad] (0 if none was asked).
@@ -84,6 +86,28 @@ class Kinematics:
         """``T_world_head``: world pose of the head frame at ``q``."""
         return self.frame_pose(q, self.head_frame_id)
 
+    def joint_limits(
+        self, joint_ranges: Mapping[str, tuple[float, float]] | None = None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """(lower, upper) joint limits [rad], ACTIVE_JOINTS order: the model's, narrowed by ``joint_ranges``.
+
+        Args:
+            joint_ranges: ``{joint name: (low, high)}`` for joints of REACH_JOINTS; each range is intersected with
+                the model's. None or empty: the model's limits themselves (the arrays, not copies).
+        """
+        if not joint_ranges:
+            return self.lower, self.upper
+        lower, upper = self.lower.copy(), self.upper.copy()
+        for name, (low, high) in joint_ranges.items():
+            if name not in REACH_JOINTS:
+                raise ValueError(f"joint_ranges: {name!r} is not a joint the IK moves; those are {REACH_JOINTS}.")
+            j = ACTIVE_JOINTS.index(name)
+            lower[j], upper[j] = max(lower[j], float(low)), min(upper[j], float(high))
+            if not lower[j] <= upper[j]:
+                raise ValueError(f"joint_ranges: {name!r} range ({low}, {high}) misses the joint's limits "
+                                 f"({self.lower[j]:.3f}, {self.upper[j]:.3f}) rad.")
+        return lower, upper
+
     def solve_ik(
         self,
         p_world_target: np.ndarray,
@@ -95,11 +119,13 @@ class Kinematics:
         orientation_tolerance: float = 0.15,
         max_iterations: int = 150,
         damping: float = 1e-4,
+        joint_ranges: Mapping[str, tuple[float, float]] | None = None,
     ) -> IKResult:
         """Damped least-squares IK of the palm over the torso and right-arm joints.
 
-        The neck keeps its value from ``q_init``. Every iterate is clipped to the joint limits, so the returned
-        configuration is always feasible; ``success`` tells whether it reaches the target.
+        The neck keeps its value from ``q_init``. Every iterate is clipped to the joint limits (narrowed by
+        ``joint_ranges``), so the returned configuration is always feasible; ``success`` tells whether it reaches
+        the target.
 
         Args:
             p_world_target: Target palm position in the world frame [m], shape (3,).
@@ -110,6 +136,8 @@ class Kinematics:
             orientation_tolerance: Orientation error accepted as success [rad].
             max_iterations: Iteration budget.
             damping: Levenberg-Marquardt damping of the least-squares step.
+            joint_ranges: Narrower ranges for some joints, ``{name: (low, high)}`` [rad] (see :meth:`joint_limits`):
+                a posture the solution must keep, e.g. a wrist angle that holds the forearm off the table.
         """
         p_target = np.asarray(p_world_target, dtype=float)
         if p_target.shape != (3,) or not np.all(np.isfinite(p_target)):
@@ -118,9 +146,10 @@ class Kinematics:
             R_world_target = np.asarray(R_world_target, dtype=float)
             if R_world_target.shape != (3, 3) or np.abs(R_world_target @ R_world_target.T - np.eye(3)).max() > 1e-6:
                 raise ValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
-        q = np.clip(self._check_q(q_init).copy(), self.lower, self.upper)
+        lower, upper = self.joint_limits(joint_ranges)
+        q = np.clip(self._check_q(q_init).copy(), lower, upper)
         dofs = self.reach_dofs
-        lower, upper = self.lower[dofs], self.upper[dofs]
+        lower, upper = lower[dofs], upper[dofs]
         model, data, frame = self.model, self.data, self.hand_frame_id
         n_error = 3 if R_world_target is None else 6
         regulariser = damping * np.eye(n_error)

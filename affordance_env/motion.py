@@ -154,7 +154,8 @@ class MotionExecutor:
 
     def _ik(self, p: np.ndarray, q_init: np.ndarray, plan: StrokePlan) -> IKResult:
         return self.kinematics.solve_ik(
-            p, q_init, plan.R_world_hand, position_tolerance=1e-3, orientation_tolerance=IK_ORIENTATION_TOLERANCE
+            p, q_init, plan.R_world_hand, position_tolerance=1e-3, orientation_tolerance=IK_ORIENTATION_TOLERANCE,
+            joint_ranges=plan.joint_ranges,
         )
 
     def plan_approach(self, plan: StrokePlan) -> tuple[IKResult, IKResult]:

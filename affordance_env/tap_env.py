@@ -10,7 +10,15 @@ import numpy as np
 from gymnasium import spaces
 
 from affordance_env.attention import attend
-from affordance_env.behaviors import ACTION_DIM, BEHAVIORS, check_action, get_behavior, plan_stroke
+from affordance_env.behaviors import (
+    ACTION_DIM,
+    BEHAVIORS,
+    ROLL_THRESHOLD,
+    check_action,
+    get_behavior,
+    is_success,
+    plan_stroke,
+)
 from affordance_env.camera import RangeCamera
 from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
 from affordance_env.kinematics import Kinematics
@@ -138,11 +146,13 @@ class TapAffordanceEnv(gym.Env):
     ``final_features``, ``object`` with ``initial_pose`` and ``final_pose``, ``displacement`` [m] (horizontal
     travel of the centre on the table: to where it rests, or to where it left the table),
     ``rolling_distance`` [m] (the part of the travel covered rolling: contact point at rest, centre at constant
-    height), ``rolled`` (``rolling_distance`` above ``roll_threshold``: the paper's success label), ``tilt``
-    [rad] (how far the initially vertical body axis turned), ``toppled`` (tilt above 45 degrees after the centre
-    rose over an edge), ``outcome`` (``"rest"``, ``"off_table"`` or ``"timeout"``), ``outcome_time`` [s] (when,
-    after the first touch, the object came to rest or left the table), ``contact`` (the hand touched the
-    object), ``hand_speed`` [m/s],
+    height), ``rolled`` (``rolling_distance`` above ``roll_threshold``), ``success`` (the paper's success/fail
+    label, one rule per behaviour: for ``tap`` and ``tap_back`` it is ``rolled``; for ``push`` the object moved,
+    ``displacement`` above ``roll_threshold`` (3 cm by default), rolling or sliding; always False for a failed
+    interaction, see ``failure``), ``tilt`` [rad] (how far the initially vertical body axis turned),
+    ``toppled`` (tilt above 45 degrees after the centre rose over an edge), ``outcome`` (``"rest"``,
+    ``"off_table"`` or ``"timeout"``), ``outcome_time`` [s] (when, after the first touch, the object came to rest
+    or left the table), ``contact`` (the hand touched the object), ``hand_speed`` [m/s],
     ``ik`` (``success``, ``position_error`` [m], ``orientation_error`` [rad]), ``visible`` (object seen in the
     final snapshot),
     ``failure``: None, or why the interaction is not a valid sample: ``"physics: ..."`` (MuJoCo reported an
@@ -161,7 +171,8 @@ class TapAffordanceEnv(gym.Env):
     | ``size_range`` | (0.04, 0.10) | object size range [m] |
     | ``camera_width``, ``camera_height`` | 160, 120 | range image size [pixels] (the iCub eye camera's 4:3) |
     | ``camera_fovy`` | 57.4 | vertical field of view [deg]; the iCub eye camera's (fy = 219 px at 320 x 240) |
-    | ``roll_threshold`` | 0.03 | rolling distance above which an interaction is ``rolled`` [m] |
+    | ``roll_threshold`` | 0.03 | rolling distance above which an interaction is ``rolled`` [m]; for ``push``, the
+      displacement above which it is a ``success`` |
     | ``settle_timeout`` | 3.0 | longest simulated wait for the outcome after the first touch [s] |
     | ``range_noise`` | None | ``"kinect_v1"``: the axial depth noise of a structured-light camera (Nguyen, Izadi
       and Lovell 2012, :mod:`affordance_env.range_noise`), drawn from ``self.np_random``; None: exact ranges |
@@ -184,7 +195,7 @@ class TapAffordanceEnv(gym.Env):
         camera_width: int = 160,
         camera_height: int = 120,
         camera_fovy: float = 57.4,
-        roll_threshold: float = 0.03,
+        roll_threshold: float = ROLL_THRESHOLD,
         settle_timeout: float = 3.0,
         range_noise: str | None = None,
         reward_fn: Callable[[dict[str, Any]], float] | None = None,
@@ -401,6 +412,9 @@ class TapAffordanceEnv(gym.Env):
             if fault
             else effect_features(initial["features"].values, final_features)
         )
+        # The success label: a failed interaction is no sample, so no success either.
+        success = failure is None and labels is not None and is_success(
+            self.behavior.success_rule, labels.rolled, displacement, self.roll_threshold)
         info = {
             "object": {"type": initial["geometry"].object_type, "size": initial["geometry"].size,
                        "initial_pose": initial["pose"], "final_pose": final_pose},
@@ -410,6 +424,7 @@ class TapAffordanceEnv(gym.Env):
             "displacement": displacement,
             "rolling_distance": 0.0 if fault else monitor.rolling_distance,
             "rolled": labels is not None and labels.rolled,
+            "success": bool(success),
             "toppled": labels is not None and labels.toppled,
             "tilt": 0.0 if fault else labels.tilt,
             "outcome": "fault" if fault else outcome,

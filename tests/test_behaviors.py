@@ -11,6 +11,7 @@ from affordance_env.behaviors import (
     check_action,
     get_behavior,
     half_extent_along,
+    is_success,
     plan_stroke,
 )
 from affordance_env.objects import object_geometry
@@ -78,3 +79,15 @@ def test_bad_actions(action, match):
 def test_unknown_behavior_lists_valid_ones():
     with pytest.raises(ValueError, match="tap, tap_back, push"):
         get_behavior("grasp")
+
+
+def test_success_rules():
+    assert BEHAVIORS["tap"].success_rule == BEHAVIORS["tap_back"].success_rule == "rolled"
+    assert BEHAVIORS["push"].success_rule == "moved"
+    assert is_success("rolled", True, 0.0) is True and is_success("rolled", False, 0.2) is False
+    assert is_success("moved", False, 0.031) is True and is_success("moved", True, 0.02) is False
+    assert is_success("moved", False, 0.02, threshold=0.01) is True
+    np.testing.assert_array_equal(is_success("moved", np.zeros(3, bool), np.array([0.01, 0.03, 0.05])),
+                                  [False, False, True])
+    with pytest.raises(ValueError, match="rolled"):
+        is_success("slid", True, 0.1)

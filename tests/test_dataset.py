@@ -55,7 +55,7 @@ def reference(reference_dir):
 def test_schema_columns_and_metadata(reference, tmp_path):
     assert len(reference) + len(reference.attrs["failures"]) == 24
     pose = [f"{stage}_{f}" for stage in ("initial", "final") for f in ("x", "y", "z", "qw", "qx", "qy", "qz")]
-    required = ["action_0", "action_1", "action_2", "type", "size", *pose, "displacement", "rolled",
+    required = ["action_0", "action_1", "action_2", "type", "size", *pose, "displacement", "rolled", "success",
                 "rolling_distance", "tilt", "toppled", "outcome", "outcome_time", "contact", "visible_initial",
                 "visible_final", "ik_success", "behavior", "episode", "seed"]
     required += [f"{stage}_{name}" for stage in ("initial", "final", "effect") for name in FEATURE_NAMES]
@@ -65,9 +65,10 @@ def test_schema_columns_and_metadata(reference, tmp_path):
     assert reference.select_dtypes("number").apply(np.isfinite).all().all()
     assert not reference.isna().any().any()
     assert reference.rolled.dtype == bool and set(reference.behavior) == {"tap"}
+    assert reference.success.dtype == bool and (reference.success == reference.rolled).all()  # tap: success = rolled
     manifest = reference.attrs["manifest"]
     assert manifest["feature_names"] == list(FEATURE_NAMES) and manifest["feature_groups"] == FEATURE_GROUPS
-    assert manifest["schema_version"] == 3 and manifest["complete"] and manifest["rows"] == len(reference)
+    assert manifest["schema_version"] == 4 and manifest["complete"] and manifest["rows"] == len(reference)
     assert manifest["settings"]["env_options"]["camera_width"] == 32
     assert manifest["settings"]["env_options"]["settle_timeout"] == 3.0  # defaults are recorded too
 
@@ -76,7 +77,7 @@ def test_chunk_files(tmp_path, reference):
     collect(tmp_path / "d", 8, workers=1, **RUN)
     chunk = tmp_path / "d" / "chunk-00000.parquet"
     meta = json.loads(pq.read_schema(chunk).metadata[b"tap_affordance"])
-    assert meta["schema_version"] == 3 and meta["feature_names"] == list(FEATURE_NAMES)
+    assert meta["schema_version"] == 4 and meta["feature_names"] == list(FEATURE_NAMES)
     assert meta["package_version"] and meta["settings"]["env_options"]["camera_height"] == 32
     assert (meta["chunk"]["start"], meta["chunk"]["stop"]) == (0, 8)
     plain = pd.read_parquet(chunk)
@@ -314,22 +315,42 @@ def test_schema_version_1_datasets_are_read(reference, tmp_path):
         collect(out, 8, workers=1, **RUN)
 
 
-def test_schema_version_2_datasets_are_read(reference, reference_dir, tmp_path):
-    # Version 2 had no rolling_distance, tilt, toppled or outcome_time columns.
-    out = tmp_path / "v2"
+def _as_old_version(source, out, version: int, dropped: list[str]) -> None:
+    """Rewrite the dataset ``source`` into ``out`` as schema ``version`` without the columns ``dropped``."""
     out.mkdir()
-    added = ["rolling_distance", "tilt", "toppled", "outcome_time"]
-    manifest = {**reference.attrs["manifest"], "schema_version": 2}
-    for index in range(3):
-        chunk = pq.read_table(reference_dir / f"chunk-{index:05d}.parquet")
+    manifest = {**json.loads((source / "manifest.json").read_text()), "schema_version": version}
+    for chunk_file in sorted(source.glob("chunk-*.parquet")):
+        chunk = pq.read_table(chunk_file)
         meta = json.loads(chunk.schema.metadata[b"tap_affordance"])
-        meta["schema_version"] = 2
-        chunk = chunk.drop_columns(added).replace_schema_metadata({b"tap_affordance": json.dumps(meta)})
-        pq.write_table(chunk, out / f"chunk-{index:05d}.parquet")
+        meta["schema_version"] = version
+        chunk = chunk.drop_columns(dropped).replace_schema_metadata({b"tap_affordance": json.dumps(meta)})
+        pq.write_table(chunk, out / chunk_file.name)
     (out / "manifest.json").write_text(json.dumps(manifest))
-    frame = load_dataset(out)
+
+
+def test_schema_version_2_datasets_are_read(reference, reference_dir, tmp_path):
+    # Version 2 had no rolling_distance, tilt, toppled, outcome_time or success columns; success is derived.
+    added = ["rolling_distance", "tilt", "toppled", "outcome_time"]
+    _as_old_version(reference_dir, tmp_path / "v2", 2, [*added, "success"])
+    frame = load_dataset(tmp_path / "v2")
     assert len(frame) == len(reference) and not set(added) & set(frame.columns)
     pd.testing.assert_frame_equal(frame, reference.drop(columns=added), check_exact=True)
+
+
+def test_schema_version_3_datasets_get_the_success_label_derived(tmp_path):
+    # Version 3 stored no success column: it is derived by the env's rule, here push's (displacement beyond
+    # roll_threshold), and equals what a version 4 dataset stores. Extending such a dataset is refused.
+    run = {**RUN, "env_options": {**SMALL, "behavior": "push"}}
+    collect(tmp_path / "v4", 8, workers=1, **run)
+    stored = load_dataset(tmp_path / "v4")
+    assert stored.success.dtype == bool and stored.success.any() and not stored.success.all()
+    assert (stored.success == (stored.displacement > 0.03)).all()
+    _as_old_version(tmp_path / "v4", tmp_path / "v3", 3, ["success"])
+    derived = load_dataset(tmp_path / "v3")
+    assert derived.attrs["manifest"]["schema_version"] == 3
+    pd.testing.assert_frame_equal(derived, stored, check_exact=True)
+    with pytest.raises(DatasetError, match="schema_version: dataset has 3"):
+        collect(tmp_path / "v3", 8, workers=1, **run)
 
 
 def test_progress_bar_only_on_a_terminal_and_not_in_ci(monkeypatch):

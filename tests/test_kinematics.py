@@ -52,6 +52,28 @@ def test_ik_reaches_the_tap_workspace(kinematics):
     assert reached / n >= 0.95
 
 
+def test_ik_keeps_to_narrower_joint_ranges(kinematics):
+    q_home = np.zeros(kinematics.nq)
+    q_home[ACTIVE_JOINTS.index("r_elbow")] = 1.2
+    wrist = ACTIVE_JOINTS.index("r_wrist_yaw")
+    ranges = {"r_wrist_yaw": (-0.35, -0.30)}  # the lower end lies beyond the joint's own limit: intersected
+    lower, upper = kinematics.joint_limits(ranges)
+    assert lower[wrist] == kinematics.lower[wrist] and upper[wrist] == -0.30
+    result = kinematics.solve_ik(np.array([-0.30, 0.08, 0.0]), q_home, BEHAVIORS["tap"].R_world_hand,
+                                 joint_ranges=ranges)
+    assert result.success
+    assert kinematics.lower[wrist] <= result.q[wrist] <= -0.30
+    # without ranges, the limits are the model's
+    assert kinematics.joint_limits(None)[0] is kinematics.lower
+
+
+@pytest.mark.parametrize("ranges, match", [({"neck_yaw": (0.0, 0.1)}, "not a joint the IK moves"),
+                                           ({"r_wrist_yaw": (0.5, 0.6)}, "misses the joint's limits")])
+def test_bad_joint_ranges_raise(kinematics, ranges, match):
+    with pytest.raises(ValueError, match=match):
+        kinematics.solve_ik(np.array([-0.30, 0.08, 0.0]), np.zeros(kinematics.nq), joint_ranges=ranges)
+
+
 def test_unreachable_target_is_reported_as_failure(kinematics):
     target = np.array([-2.0, 0.0, 0.0])
     result = kinematics.solve_ik(target, np.zeros(kinematics.nq), max_iterations=20)

@@ -32,7 +32,8 @@ from affordance_env.behaviors import ACTION_DIM
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
 
 #: Version of the on-disk format; :func:`~affordance_env.dataset.load_dataset` reads versions 1 up to this one.
-SCHEMA_VERSION = 3
+#: Version 4 added the ``success`` column.
+SCHEMA_VERSION = 4
 FORMAT = "tap-affordance-dataset"
 MANIFEST = "manifest.json"
 METADATA_KEY = b"tap_affordance"
@@ -51,7 +52,7 @@ def arrow_schema(save_images: bool = False) -> pa.Schema:
     fields += [(f"action_{j}", pa.float32()) for j in range(ACTION_DIM)]
     fields += [(f"{stage}_{f}", pa.float64()) for stage in ("initial", "final") for f in POSE_FIELDS]
     fields += [("displacement", pa.float64()), ("rolling_distance", pa.float64()), ("rolled", pa.bool_()),
-               ("tilt", pa.float64()), ("toppled", pa.bool_()), ("outcome", pa.string()),
+               ("success", pa.bool_()), ("tilt", pa.float64()), ("toppled", pa.bool_()), ("outcome", pa.string()),
                ("outcome_time", pa.float64()), ("contact", pa.bool_()), ("hand_speed", pa.float64()),
                ("visible_initial", pa.bool_()), ("visible_final", pa.bool_()), ("ik_success", pa.bool_())]
     fields += [(f"{stage}_{name}", pa.float64())
@@ -69,10 +70,11 @@ def _record(episode: int, env_seed: int, action: np.ndarray, reset_info: dict, i
     for stage in ("initial", "final"):
         row.update({f"{stage}_{f}": float(v) for f, v in zip(POSE_FIELDS, obj[f"{stage}_pose"], strict=True)})
     row.update(displacement=float(info["displacement"]), rolling_distance=float(info["rolling_distance"]),
-               rolled=bool(info["rolled"]), tilt=float(info["tilt"]), toppled=bool(info["toppled"]),
-               outcome=info["outcome"], outcome_time=float(info["outcome_time"]), contact=bool(info["contact"]),
-               hand_speed=float(info["hand_speed"]), visible_initial=bool(reset_info["visible"]),
-               visible_final=bool(info["visible"]), ik_success=bool(info["ik"]["success"]))
+               rolled=bool(info["rolled"]), success=bool(info["success"]), tilt=float(info["tilt"]),
+               toppled=bool(info["toppled"]), outcome=info["outcome"], outcome_time=float(info["outcome_time"]),
+               contact=bool(info["contact"]), hand_speed=float(info["hand_speed"]),
+               visible_initial=bool(reset_info["visible"]), visible_final=bool(info["visible"]),
+               ik_success=bool(info["ik"]["success"]))
     for stage, values in (("initial", info["initial_features"]), ("final", info["final_features"]),
                           ("effect", info["effect"])):
         row.update({f"{stage}_{name}": float(v) for name, v in zip(FEATURE_NAMES, values, strict=True)})

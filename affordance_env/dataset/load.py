@@ -11,6 +11,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from affordance_env.behaviors import ROLL_THRESHOLD, get_behavior, is_success
 from affordance_env.dataset.format import (
     IMAGE_COLUMNS,
     MANIFEST,
@@ -52,15 +53,36 @@ def images(frame: pd.DataFrame, column: str) -> np.ndarray:
     return np.stack(decoded) if decoded else np.zeros((0, *shape), bool)
 
 
+def _derived_success(frame: pd.DataFrame, manifest: dict) -> np.ndarray:
+    """The ``success`` label of a dataset of schema version 3 or older, which did not store it: computed from
+    ``behavior``, ``rolled`` and ``displacement`` by the rule the environment uses (:func:`is_success`)."""
+    settings = manifest.get("settings")
+    options = settings.get("env_options") if isinstance(settings, dict) else None
+    threshold = float((options if isinstance(options, dict) else {}).get("roll_threshold", ROLL_THRESHOLD))
+    success = np.zeros(len(frame), dtype=bool)
+    rolled, displacement = frame["rolled"].to_numpy(bool), frame["displacement"].to_numpy(np.float64)
+    for name in frame["behavior"].unique():
+        try:
+            rule = get_behavior(name).success_rule
+        except ValueError as exc:
+            raise DatasetError(f"the dataset's behavior {name!r} is unknown to this tap-affordance, so its "
+                               f"success label cannot be derived ({exc})") from None
+        rows = (frame["behavior"] == name).to_numpy()
+        success[rows] = is_success(rule, rolled[rows], displacement[rows], threshold)
+    return success
+
+
 def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_incomplete: bool = False
                  ) -> pd.DataFrame:
     """Read a dataset directory into a DataFrame, one row per interaction, ordered by episode.
 
     Columns (:func:`arrow_schema`): ``episode`` (index i), ``seed`` (env seed of interaction i), ``behavior``,
     ``type``, ``size`` [m], ``action_0..2``, ``initial_x, _y, _z, _qw, _qx, _qy, _qz`` and ``final_...``
-    (object position [m] and quaternion), ``displacement`` [m], ``rolling_distance`` [m], ``rolled``, ``tilt``
-    [rad], ``toppled``, ``outcome``, ``outcome_time`` [s] (see the environment's ``info``; datasets of schema
-    version 2 and older lack ``rolling_distance``, ``tilt``, ``toppled`` and ``outcome_time``), ``contact``,
+    (object position [m] and quaternion), ``displacement`` [m], ``rolling_distance`` [m], ``rolled``,
+    ``success``, ``tilt`` [rad], ``toppled``, ``outcome``, ``outcome_time`` [s] (see the environment's ``info``;
+    datasets of schema version 2 and older lack ``rolling_distance``, ``tilt``, ``toppled`` and ``outcome_time``;
+    those of version 3 and older did not store ``success``: it is derived on loading by the environment's rule,
+    from ``behavior``, ``rolled``, ``displacement`` and the dataset's ``roll_threshold``), ``contact``,
     ``hand_speed`` [m/s], ``visible_initial``, ``visible_final``, ``ik_success``, then ``initial_<f>``,
     ``final_<f>``, ``effect_<f>`` for each name ``f`` of ``FEATURE_NAMES``; with ``with_images`` also the
     encoded images (decode them with :func:`images`). ``frame.attrs["manifest"]`` holds the manifest and
@@ -124,6 +146,8 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
     if version == 1:  # version 1 named the poses object_initial_x ...
         frame = frame.rename(columns={f"object_{stage}_{f}": f"{stage}_{f}"
                                       for stage in ("initial", "final") for f in POSE_FIELDS})
+    if "success" not in frame.columns:  # versions 1 to 3: derived, in the column's place after rolled
+        frame.insert(frame.columns.get_loc("rolled") + 1, "success", _derived_success(frame, manifest))
     frame.attrs["manifest"] = manifest
     frame.attrs["failures"] = {int(k): v for k, v in sorted(failures.items(), key=lambda kv: int(kv[0]))}
     return frame
