@@ -44,11 +44,12 @@ APPROACH_CLEARANCE = 0.06
 HAND_BELOW_PALM = 0.033
 #: Lowest palm-centre height above the table [m]: the hand reaches 3.3 cm below the palm centre.
 MIN_PALM_HEIGHT = 0.04
-#: Joint range the IK keeps to when the hand reaches across the body (tap_back) or strokes close to it (push),
-#: fingers level and thumb up, the palm 4 cm above the table: the wrist's yaw within 3 degrees of its lower limit
+#: Joint range the IK keeps to for every stroke (the fingers level, the palm 4 cm above the table, a low tap
+#: 2.5 cm): the wrist's yaw within 3 degrees of its lower limit
 #: (-20 degrees), which bends the forearm up from the hand and holds it at least 5 mm (typically 9 mm) clear of the
 #: table. With the wrist free, the IK's solutions put the forearm into the table (up to 8 mm for tap_back, 34 mm for
-#: push): the arm then rests on it, and the hand stops 1-6 cm short of the pre-stroke pose.
+#: push, and for a fifth of the taps at random actions): the arm then rests on it, and the hand stops 1-6 cm short
+#: of the pre-stroke pose.
 FOREARM_RAISED: dict[str, tuple[float, float]] = {"r_wrist_yaw": (-0.35, -0.30)}
 #: The push's hand is turned by this angle about the vertical from straight across [rad]: the fingers point to the
 #: robot's left and a little forward, and the back of the hand faces a little to the right of straight ahead. With
@@ -79,7 +80,9 @@ class Behavior:
         contact_offset: Distance from the palm frame origin to the hand surface that leads the stroke [m].
         description: One line for the documentation.
         approach_clearance: Clearance between the hand's lowest point and the object's top at the pose above the
-            pre-stroke pose, which the hand reaches first [m].
+            pre-stroke pose, which the hand passes through on its way there and back [m]; None: the hand goes
+            straight between home and the pre-stroke pose (the tap: home is on the side it strikes from, so the
+            way never crosses the object).
         joint_ranges: Narrower joint ranges ``{name: (low, high)}`` [rad] that the IK keeps to for every pose of
             the stroke: a posture of the arm (see :data:`FOREARM_RAISED`). Empty: the robot's joint limits.
         success_rule: What makes an interaction a success, one of :data:`SUCCESS_RULES` (see :func:`is_success`).
@@ -90,7 +93,7 @@ class Behavior:
     R_world_hand: np.ndarray
     contact_offset: float
     description: str
-    approach_clearance: float = APPROACH_CLEARANCE
+    approach_clearance: float | None = APPROACH_CLEARANCE
     joint_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     success_rule: str = "rolled"
 
@@ -109,6 +112,7 @@ BEHAVIORS: dict[str, Behavior] = {
     "tap": Behavior(
         "tap", np.array([0.0, -1.0]), _rotation((-1, 0, 0), (0, -1, 0)), 0.012,
         "the paper's tap: the palm hits the object from its right side, moving to the robot's left (-y)",
+        approach_clearance=None, joint_ranges=FOREARM_RAISED,
     ),
     "tap_back": Behavior(
         "tap_back", np.array([0.0, 1.0]), _rotation((-1, 0, 0), (0, -1, 0)), 0.039,
@@ -155,7 +159,8 @@ class StrokePlan:
     """Cartesian plan of one stroke (world frame, metres).
 
     Attributes:
-        p_above: Palm position above the pre-stroke pose, high enough to clear the object; reached first.
+        p_above: Palm position above the pre-stroke pose, high enough to clear the object, which the hand passes
+            through on its way there and back; None: the hand goes straight.
         p_start: Pre-stroke palm position, ``CLEARANCE`` from the object.
         p_end: Palm position at maximum travel (the stroke stops earlier on contact).
         direction: Unit stroke direction (3,).
@@ -165,7 +170,7 @@ class StrokePlan:
         joint_ranges: The behaviour's joint ranges for the IK (:attr:`Behavior.joint_ranges`).
     """
 
-    p_above: np.ndarray
+    p_above: np.ndarray | None
     p_start: np.ndarray
     p_end: np.ndarray
     direction: np.ndarray
@@ -222,9 +227,10 @@ def plan_stroke(
     p_start = centre - d * (half + behavior.contact_offset + CLEARANCE)
     # Without contact the hand travels through where the object was, then stops.
     p_end = centre + d * (half - behavior.contact_offset + FOLLOW_THROUGH)
+    p_above = None if behavior.approach_clearance is None else np.array(
+        [p_start[0], p_start[1], table_top + 2 * geometry.half_height + HAND_BELOW_PALM + behavior.approach_clearance])
     return StrokePlan(
-        p_above=np.array([p_start[0], p_start[1], table_top + 2 * geometry.half_height + HAND_BELOW_PALM
-                          + behavior.approach_clearance]),
+        p_above=p_above,
         p_start=p_start,
         p_end=p_end,
         direction=d,

@@ -61,8 +61,8 @@ class StrokeOutcome:
         hand_travel: Distance the palm travelled along the stroke direction [m].
         start_error: Distance of the palm from the pre-stroke pose when the stroke started [m].
         object_moved: How far the object moved before the stroke started (touched during the reach) [m].
-        q_withdraw: Joint targets of the pose above the pre-stroke pose: the way home passes there, so that it
-            never crosses the object.
+        q_withdraw: Joint targets of the pose above the pre-stroke pose, which the way home passes through so that
+            it never crosses the object; None if the plan has no such pose.
     """
 
     ik_success: bool
@@ -158,12 +158,12 @@ class MotionExecutor:
             joint_ranges=plan.joint_ranges,
         )
 
-    def plan_approach(self, plan: StrokePlan) -> tuple[IKResult, IKResult]:
-        """IK of the pose above the pre-stroke pose and of the pre-stroke pose itself."""
+    def plan_approach(self, plan: StrokePlan) -> tuple[IKResult | None, IKResult]:
+        """IK of the pose above the pre-stroke pose (None if the plan has none) and of the pre-stroke pose."""
         # The pre-stroke pose first, the pose above it from there: the two differ by a short vertical move, so
         # the descent (and the way up after the stroke) is a small joint motion, not a change of arm posture.
         start = self._ik(plan.p_start, self.physics.joint_targets(), plan)
-        above = self._ik(plan.p_above, start.q, plan)
+        above = None if plan.p_above is None else self._ik(plan.p_above, start.q, plan)
         return above, start
 
     def stroke(self, plan: StrokePlan) -> StrokeOutcome:
@@ -172,7 +172,7 @@ class MotionExecutor:
         above, start = self.plan_approach(plan)
         line = StrokeLine(self, plan, start.q)
         p_object_before = physics.object_pose()[:3]
-        self.move_through([above.q, start.q])  # down onto the pre-stroke pose from above it
+        self.move_through([start.q] if above is None else [above.q, start.q])  # through the pose above, if any
         start_error = self.settle(plan.p_start)
         object_moved = float(np.linalg.norm(physics.object_pose()[:3] - p_object_before))
         p_hand_start = physics.hand_position()
@@ -208,7 +208,7 @@ class MotionExecutor:
         rot_err = max(r.orientation_error for r in stroke_results)
         ik_ok = pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE
         return StrokeOutcome(ik_ok, pos_err, rot_err, contact, contact_time, hand_speed, travel, start_error,
-                             object_moved, above.q)
+                             object_moved, None if above is None else above.q)
 
     def go_home(self, q_home: np.ndarray, via: np.ndarray | None = None) -> bool:
         """Return to ``q_home`` through ``via`` (after :meth:`stroke`: up and back above the pre-stroke pose) and

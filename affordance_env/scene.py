@@ -52,7 +52,8 @@ RANGE_CAMERA_POS_HEAD = (0.0, 0.035, 0.06)
 RANGE_CAMERA_QUAT_HEAD = (0.0, 0.0, 1.0, 0.0)
 RANGE_CAMERA_FOVY_DEG = 50.0
 
-#: The ``home`` keyframe: arm raised above the table beside the workspace, head looking down at the table.
+#: The ``home`` keyframe: arm raised above the table beside the workspace, head looking down at the table; the
+#: wrist yawed as every stroke holds it (``behaviors.FOREARM_RAISED``), so reaching does not swing it.
 HOME_QPOS: dict[str, float] = {
     "torso_pitch": 0.4,
     "torso_roll": 0.0,
@@ -66,7 +67,7 @@ HOME_QPOS: dict[str, float] = {
     "r_elbow": 1.2,
     "r_wrist_prosup": 0.0,
     "r_wrist_pitch": 0.0,
-    "r_wrist_yaw": 0.0,
+    "r_wrist_yaw": -0.33,
 }
 
 

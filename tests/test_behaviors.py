@@ -38,8 +38,12 @@ def test_canonical_tap_starts_beside_the_object_at_clearance():
     assert plan.speed == pytest.approx(SPEED_CANONICAL)
     # without contact, the palm surface would end FOLLOW_THROUGH beyond where the object's far side was
     assert plan.p_end[1] - 0.012 == pytest.approx(p_object[1] - 0.03 - FOLLOW_THROUGH)
-    # the approach pose clears the object's top with the hand's lowest point
-    assert plan.p_above[2] - 0.033 > TABLE + 0.06
+    # the tap comes straight from home, which is on its side of the object; the behaviours whose hand
+    # crosses over or comes around the object pass above it, clearing its top with the hand's lowest point
+    assert plan.p_above is None
+    for name in ("tap_back", "push"):
+        above = plan_stroke(get_behavior(name), sphere, p_object, 0.0, TABLE, np.zeros(3)).p_above
+        assert above[2] - 0.033 > TABLE + 0.06
 
 
 def test_action_moves_height_lateral_offset_and_speed():
