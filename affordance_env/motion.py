@@ -268,7 +268,9 @@ class StrokeLine:
     def _waypoint(self, k: int) -> np.ndarray:
         while len(self._q_ik) <= k:
             plan = self._plan
-            q_init = self._q_ik[-1] if self._q_ik else self._q_start
+            # warm start: the last solution, extrapolated one spacing along the line
+            q_init = (self._q_start if not self._q_ik else self._q_ik[-1] if len(self._q_ik) < 2
+                      else 2.0 * self._q_ik[-1] - self._q_ik[-2])
             result = self._executor._ik(plan.p_start + self._s_ik[len(self._q_ik)] * plan.direction, q_init, plan)
             self.results.append(result)
             self._q_ik.append(result.q)
