@@ -90,7 +90,10 @@ class TapAffordanceEnv(gym.Env):
     One episode is one interaction: ``reset`` places the object, lets it settle, turns the head so that the object
     is at the image centre, and takes the initial snapshot; ``step`` executes the behaviour (default: the paper's
     tap) and takes the final snapshot. The hand is driven by Pinocchio inverse kinematics and MuJoCo position
-    servos; the stroke stops a short follow-through after the hand first touches the object.
+    servos: the arm and head move along minimum-jerk profiles at up to 100 degrees per second (the iCub's joint
+    speed limit) with velocity and inertial feedforward, so the robot is still again as soon as a move ends; the
+    stroke moves the palm in a straight line at the action's speed and stops a short follow-through after the hand
+    first touches the object.
 
     The world: a 60 x 100 cm wooden lab table whose top is what objects rest on and roll on (rolling resistance of
     wood on wood, see ``assets/README.md``); past its edges an object falls to the floor. The range camera in the
