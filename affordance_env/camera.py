@@ -251,7 +251,7 @@ class RangeCamera:
 
         d_geom, a_geom = cone(geoms)
         d_target, a_target = cone(targets)
-        between = np.arccos(np.clip(d_geom @ d_target.T, -1.0, 1.0))  # (geoms, targets)
+        between = np.arccos(np.minimum(np.maximum(d_geom @ d_target.T, -1.0), 1.0))  # (geoms, targets)
         return (between <= a_geom[:, None] + a_target[None, :]).any(axis=1)
 
     def _rectangles(self, geoms: np.ndarray, data: mujoco.MjData, p_world_camera: np.ndarray,
@@ -317,7 +317,12 @@ class RangeCamera:
         geoms, candidates = self._bounded_geoms, None
         if occluded is not None:
             geoms = geoms[self._may_hide(geoms, np.atleast_1d(occluded), data, p_world_camera)]
-            candidates = np.flatnonzero(np.isin(self._geom_ids, occluded)) if geoms.size else np.empty(0, np.intp)
+            if not geoms.size:
+                candidates = np.empty(0, np.intp)
+            elif np.ndim(occluded) == 0:
+                candidates = np.flatnonzero(self._geom_ids == occluded)
+            else:
+                candidates = np.flatnonzero(np.isin(self._geom_ids, occluded))
         rays = self._rays_near(geoms, data, p_world_camera, R_world_camera, candidates)
         if rays.size:
             near_normal = np.empty(3 * rays.size) if normals else None
