@@ -132,8 +132,8 @@ class Kinematics:
     ) -> IKResult:
         """Damped least-squares IK of the palm over the variant's reach joints (torso and arm).
 
-        The neck and the fingers keep their values from ``q_init``. Every iterate is clipped to the joint limits, so the returned
-        configuration is always feasible; ``success`` tells whether it reaches the target.
+        The neck and the fingers keep their values from ``q_init``. Every iterate is clipped to the joint limits, so
+        the returned configuration is always feasible; ``success`` tells whether it reaches the target.
 
         Args:
             p_world_target: Target palm position in the world frame [m], shape (3,).

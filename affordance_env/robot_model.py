@@ -90,6 +90,18 @@ HAND_COUPLINGS: dict[str, tuple[str, tuple[float, ...]]] = {
     "l_hand_medium_distal_joint": ("l_hand_medium_proximal_joint", _FINGER_COUPLING),
     "l_hand_pinky_distal_joint": ("l_hand_pinky_proximal_joint", _FINGER_COUPLING),
 }
+#: The open hand (driven joints [rad]): fingers straight, the thumb turned under the palm to face them (the
+#: metacarpus, thumb opposition, at 1.1 rad: at 0 the thumb lies in the palm's plane, pointing away from the
+#: fingers' side; the grasp turns it further as it closes).
+HAND_OPEN: dict[str, float] = {
+    "l_hand_metacarpus_joint": 1.1,
+    "l_hand_thumb_rotation_joint": 0.0,
+    "l_hand_thumb_proximal_joint": 0.0,
+    "l_hand_index_adduction_joint": 0.0,
+    "l_hand_index_proximal_joint": 0.0,
+    "l_hand_medium_proximal_joint": 0.0,
+    "l_hand_pinky_proximal_joint": 0.0,
+}
 #: All 11 joints of the hand: the driven ones, then the coupled distal ones.
 HAND_JOINTS: tuple[str, ...] = HAND_DRIVEN_JOINTS + tuple(HAND_COUPLINGS)
 #: Links of the mk3 hand.

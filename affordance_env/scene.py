@@ -12,16 +12,16 @@ import numpy as np
 
 from affordance_env.assets_path import assets_dir
 from affordance_env.robot_model import (
-    CAMERA_VISIBLE_LINKS,
+    CAMERA_VISIBLE_LINKS,  # noqa: F401 (the tap variant's, named here beside the geom groups as before)
     HAND_COUPLINGS,
     HAND_JOINTS,
     HAND_MOUNT_FRAME,
     HAND_MOUNT_POS,
+    HAND_OPEN,
     HAND_ROOT_LINK,
     HEAD_FRAME,
     NECK_JOINTS,
     TORSO_JOINTS,
-    RobotVariant,
     coupled_position,
     get_variant,
     hand_urdf,
@@ -69,10 +69,19 @@ DAMPING = 0.1
 #: motor and gearbox, keeps the light links (10-17 g, inertias of 1e-6 kg m^2) well conditioned at the 2 ms
 #: timestep: 1e-3 kg m^2 gives a servo period of 2 pi sqrt(1e-3 / 1) = 0.2 s, a hundred timesteps.
 HAND_KP, HAND_DAMPING, HAND_ARMATURE = 1.0, 0.03, 1e-3
+#: Timestep of the grasp variant [s]. The tap scene's 2 ms resolves the impact of a tap; a grasp has no impact,
+#: and its fastest dynamics are resolved at 5 ms with at least 2 steps per time constant (MuJoCo's stability
+#: bound) and mostly 4 or more: the contacts' (MuJoCo's default 20 ms), the finger coupling's (10 ms, below), the
+#: finger servos' (sqrt(armature / kp) = 32 ms) and the arm servos' (25 ms and more). Over the 90 canonical
+#: grasps of ``benchmarks/grasp.py`` (seeds 0-89) 89 end the same at 2 ms and at 5 ms (48 and 49 held; at 2.5 ms
+#: all 90 end as at 2 ms); a step of the grasp, with its many contacts on a 30-degree-of-freedom robot, costs some
+#: 50 microseconds, so at 2 ms a grasp cost 3.3 taps, and at 5 ms it costs about 1.4. It divides the 10 ms control
+#: tick.
+GRASP_TIMESTEP = 0.005
 #: Coupling of the distal finger joints to their proximal joints (MuJoCo ``equality joint``): the linkage is
-#: stiff, so the constraint is solved with a time constant of 5 ms (2.5 timesteps, MuJoCo's stable minimum is 2)
-#: and critical damping.
-COUPLING_SOLREF = (0.005, 1.0)
+#: stiff, so the constraint is solved with a time constant of 10 ms (2 timesteps of the grasp variant, MuJoCo's
+#: stable minimum) and critical damping.
+COUPLING_SOLREF = (0.01, 1.0)
 
 #: Range camera: position in the head frame [m] (about eye height, in front of the head origin) and its
 #: orientation (MuJoCo cameras look along their -z axis; this one looks along the head's z axis, image up =
@@ -100,8 +109,8 @@ HOME_QPOS: dict[str, float] = {
 
 
 #: The ``home`` keyframe of the grasp variant: the left arm raised as the right one is for the tap (the left
-#: arm's joint axes mirror the right arm's, so the same angles give the mirror pose), the hand open with the
-#: thumb opposed to the fingers (the metacarpus turned 1.2 rad: at 0 the thumb lies in the palm's plane).
+#: arm's joint axes mirror the right arm's, so the same angles give the mirror pose), the hand open
+#: (HAND_OPEN: the thumb opposed to the fingers) and each distal joint where its coupling puts it.
 GRASP_HOME_QPOS: dict[str, float] = {
     **{name: HOME_QPOS[name] for name in TORSO_JOINTS + NECK_JOINTS},
     "l_shoulder_pitch": -1.0,
@@ -111,9 +120,9 @@ GRASP_HOME_QPOS: dict[str, float] = {
     "l_wrist_prosup": 0.0,
     "l_wrist_pitch": 0.0,
     "l_wrist_yaw": 0.0,
-    "l_hand_metacarpus_joint": 1.2,
-    **{name: 0.0 for name in HAND_JOINTS if name not in HAND_COUPLINGS and name != "l_hand_metacarpus_joint"},
-    **{distal: float(coupled_position(distal, 0.0)) for distal in HAND_COUPLINGS},
+    **HAND_OPEN,
+    **{distal: float(coupled_position(distal, HAND_OPEN[proximal]))
+       for distal, (proximal, _) in HAND_COUPLINGS.items()},
 }
 
 
@@ -292,7 +301,9 @@ def build_spec(variant: str = "tap") -> mujoco.MjSpec:
         act.ctrllimited = True
     spec.add_sensor(name="palm_touch", type=mujoco.mjtSensor.mjSENS_TOUCH, objtype=mujoco.mjtObj.mjOBJ_SITE,
                     objname="palm_touch")
-    # 6b. The fingered hand's coupling: each distal joint follows its proximal joint.
+    # 6b. The fingered hand's coupling: each distal joint follows its proximal joint; its timestep.
+    if variant_.fingered:
+        spec.option.timestep = GRASP_TIMESTEP
     for distal, (proximal, coefficients) in HAND_COUPLINGS.items() if variant_.fingered else ():
         equality = spec.add_equality(name=f"{distal}_coupling", type=mujoco.mjtEq.mjEQ_JOINT, name1=distal,
                                      name2=proximal, objtype=mujoco.mjtObj.mjOBJ_JOINT, solref=list(COUPLING_SOLREF))

@@ -10,21 +10,30 @@ import numpy as np
 from gymnasium import spaces
 
 from affordance_env.attention import attend
-from affordance_env.behaviors import ACTION_DIM, BEHAVIORS, check_action, get_behavior, plan_stroke
+from affordance_env.behaviors import (
+    ACTION_DIM,
+    BEHAVIORS,
+    GraspBehavior,
+    check_action,
+    get_behavior,
+    plan_grasp,
+    plan_stroke,
+)
 from affordance_env.camera import RangeCamera
 from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
 from affordance_env.kinematics import Kinematics
 from affordance_env.motion import (
     CONTROL_DT,
+    GRASP_HOME_TIME,
     HOLD_MAX_TIME,
     HOLD_SPEED_TOLERANCE,
+    GraspOutcome,
     MotionExecutor,
 )
 from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size, object_geometry
-from affordance_env.outcome import REST_DURATION, ObjectMonitor, outcome_labels
+from affordance_env.outcome import REST_DURATION, ObjectMonitor, grasp_success, outcome_labels
 from affordance_env.physics import TapPhysics
 from affordance_env.range_noise import add_kinect_noise, check_range_noise
-from affordance_env.robot_model import ACTIVE_JOINTS
 from affordance_env.scene import build_model
 
 #: Region of the table where objects are placed: centre (x, y) and half-widths [m].
@@ -42,8 +51,8 @@ MAX_START_ERROR, MAX_OBJECT_MOVED_BEFORE = 0.01, 0.003
 
 
 def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: tuple[bool, bool]) -> str | None:
-    """Why an interaction cannot be used, or None; see the class docstring. ``still``: whether the robot was
-    still for the initial and for the final snapshot."""
+    """Why an interaction cannot be used, or None; see the class docstring. ``stroke``: a StrokeOutcome or a
+    GraspOutcome; ``still``: whether the robot was still for the initial and for the final snapshot."""
     if fault is not None:
         return f"physics: {fault}"
     for snapshot, was_still in zip(("initial", "final"), still, strict=True):
@@ -52,9 +61,12 @@ def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: t
                     f"{HOLD_SPEED_TOLERANCE:g} rad/s after {HOLD_MAX_TIME:g} s of holding still)")
     if not visible_initially:
         return "perception: the object was not visible in the initial snapshot"
+    what = "grasp" if isinstance(stroke, GraspOutcome) else "stroke"
     if not stroke.ik_success:
-        return (f"ik: the stroke was not reachable (position error {stroke.ik_position_error * 1e3:.1f} mm, "
+        return (f"ik: the {what} was not reachable (position error {stroke.ik_position_error * 1e3:.1f} mm, "
                 f"orientation error {stroke.ik_orientation_error:.2f} rad)")
+    if what == "grasp":  # the hand meets the object on its way down, and may miss it: that is the grasp's outcome
+        return None
     if stroke.object_moved > MAX_OBJECT_MOVED_BEFORE:
         return f"reach: the arm moved the object by {stroke.object_moved * 1e3:.1f} mm before the stroke"
     if stroke.start_error > MAX_START_ERROR:
@@ -211,8 +223,9 @@ class TapAffordanceEnv(gym.Env):
         self.reward_fn = default_reward if reward_fn is None else reward_fn
         self.render_mode = render_mode
 
-        self.physics = TapPhysics(build_model())
-        self.kinematics = Kinematics()
+        robot = self.behavior.robot
+        self.physics = TapPhysics(build_model(robot), robot)
+        self.kinematics = Kinematics(variant=robot)
         self.motion = MotionExecutor(self.physics, self.kinematics)
         self.camera = RangeCamera(self.physics.model, width=camera_width, height=camera_height, fovy_deg=camera_fovy)
         self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy)
@@ -226,7 +239,7 @@ class TapAffordanceEnv(gym.Env):
             self.physics.on_step = self._record_frame
 
         H, W = camera_height, camera_width
-        nq = len(ACTIVE_JOINTS)
+        nq = self.kinematics.nq
         self.observation_space = spaces.Dict(
             {
                 "range": spaces.Box(0.0, self.camera.max_range, (H, W), np.float32),
@@ -371,14 +384,19 @@ class TapAffordanceEnv(gym.Env):
         action = check_action(action)
         initial, self._initial = self._initial, None
         physics = self.physics
-        plan = plan_stroke(self.behavior, initial["geometry"], initial["pose"][:3], initial["yaw"],
-                           physics.table_top, action)
+        grasping = isinstance(self.behavior, GraspBehavior)
+        plan = (plan_grasp if grasping else plan_stroke)(
+            self.behavior, initial["geometry"], initial["pose"][:3], initial["yaw"], physics.table_top, action)
         monitor = physics.start_monitor()  # from now on, whatever the arm does
         try:
-            stroke = self.motion.stroke(plan)
-            still = self.motion.go_home(self._q_home)
-            outcome, outcome_time = self._wait_outcome(
-                monitor, stroke.contact_time if stroke.contact else physics.data.time)
+            stroke = self.motion.grasp(plan) if grasping else self.motion.stroke(plan)
+            # The grasp ends further from home than a stroke: a smooth move arrives with less lag to settle.
+            still = (self.motion.go_home(self._q_home, GRASP_HOME_TIME, smooth=True) if grasping
+                     else self.motion.go_home(self._q_home))
+            # The outcome is awaited from the first touch of a stroke, or from the release of a grasp.
+            since = stroke.release_time if grasping else (
+                stroke.contact_time if stroke.contact else physics.data.time)
+            outcome, outcome_time = self._wait_outcome(monitor, since)
         finally:
             physics.monitor = None
         if self.render_mode is not None:
@@ -426,6 +444,10 @@ class TapAffordanceEnv(gym.Env):
             "behavior": self.behavior.name,
             "failure": failure,
         }
+        if grasping:
+            info["success"] = not fault and grasp_success(stroke.rise, stroke.links_holding, stroke.on_table)
+            info["grasp"] = {"rise": stroke.rise, "links_holding": stroke.links_holding,
+                             "on_table": stroke.on_table}
         reward = float(self.reward_fn(info))
         return obs, reward, True, False, info
 
