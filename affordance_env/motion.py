@@ -67,7 +67,7 @@ class StrokeOutcome:
 #: Grasp timing [s]: reach above the object, descend to it, keep squeezing after the closing ramp, lift, carry the
 #: object beside and down to the table, open the hand, withdraw above it. The lift (8 cm in 0.3 s) and the carry
 #: are a relaxed pace for a hand; the descent and the lift are short moves.
-GRASP_REACH_TIME, GRASP_DESCEND_TIME, SQUEEZE_TIME = 0.3, 0.15, 0.05
+GRASP_REACH_TIME, GRASP_DESCEND_TIME, SQUEEZE_TIME = 0.3, 0.3, 0.05
 LIFT_TIME, PLACE_TIME, OPEN_TIME, RETREAT_TIME = 0.25, 0.3, 0.15, 0.15
 #: The palm waits at most this long [s] to come within SETTLE_TOLERANCE of the grasp pose before the hand closes:
 #: a large object or the table may stop it short (the thumb of the open hand hangs 6.6 cm below the palm).
@@ -85,8 +85,8 @@ class GraspOutcome:
         ik_position_error: Largest IK position error over the poses [m].
         ik_orientation_error: Largest IK orientation error over the poses [rad].
         contact: The hand touched the object.
-        contact_time: Simulation time of the first touch [s] (NaN without contact).
-        hand_speed: Palm speed at the first touch [m/s] (0 without contact).
+        contact_time: Simulation time of the first touch [s], to the control tick (NaN without contact).
+        hand_speed: Palm speed over the control tick of the first touch [m/s] (0 without contact).
         rise: How far the object's centre had risen above its start at the end of the hold [m].
         links_holding: Hand links touching the object at the end of the hold.
         on_table: Whether the object touched the table at the end of the hold.
@@ -220,19 +220,18 @@ class MotionExecutor:
                              object_moved)
 
     def _tick_watching(self, q: np.ndarray, watch: dict) -> None:
-        """One control tick towards ``q``, noting in ``watch`` the first hand-object touch and the palm speed."""
+        """One control tick towards ``q``, noting in ``watch`` the first hand-object touch (to the tick) and the
+        palm's speed over that tick."""
         physics = self.physics
         physics.set_joint_targets(q)
         if watch["contact"]:
             physics.step(self.steps_per_tick)
             return
-        for _ in range(self.steps_per_tick):
-            p_before = physics.hand_position()
-            physics.step()
-            if not watch["contact"] and physics.hand_touches_object():
-                watch.update(contact=True, time=float(physics.data.time),
-                             speed=float(np.linalg.norm(physics.hand_position() - p_before)
-                                         / physics.model.opt.timestep))
+        p_before = physics.hand_position()
+        physics.step(self.steps_per_tick)
+        if physics.hand_touches_object():
+            watch.update(contact=True, time=float(physics.data.time),
+                         speed=float(np.linalg.norm(physics.hand_position() - p_before) / CONTROL_DT))
 
     def _ramp(self, q_target: np.ndarray, duration: float, watch: dict) -> None:
         """:meth:`move_joints` with ``smooth`` that watches for the first touch (:meth:`_tick_watching`)."""

@@ -93,6 +93,17 @@ class TapAffordanceEnv(gym.Env):
     tap) and takes the final snapshot. The hand is driven by Pinocchio inverse kinematics and MuJoCo position
     servos; the stroke stops a short follow-through after the hand first touches the object.
 
+    ``behavior="grasp"`` is the paper's grasp, by the left arm with the fingered iCub hand of ``icub-models``
+    (``left_hand_mk3``: 11 finger joints driven by 7 servos, each distal joint coupled to its proximal one as on
+    the real hand; the right arm then hangs still): palm down over the object, the open hand descends to just
+    above the object's top, the fingers and the opposed thumb close on a ramp, the hand lifts 8 cm, holds still
+    for 1 s, carries the object 6 cm to the robot's left, puts it down and opens; the arm returns home and the
+    final snapshot sees the object where it was put down (a held object moved 6 cm) or where the attempt left it.
+    Only the fingers' servos move the object (no welds, no applied forces). Whether the object fits the open hand,
+    between the thumb and the fingertips, decides the outcome: with the default sizes about half the canonical
+    grasps hold (``info["success"]``), nearly all under 6.4 cm and few over 8.2 cm (``benchmarks/grasp.py``).
+    The grasp variant of the scene integrates at 5 ms instead of 2 (``affordance_env.scene.GRASP_TIMESTEP``).
+
     The world: a 60 x 100 cm wooden lab table whose top is what objects rest on and roll on (rolling resistance of
     wood on wood, see ``assets/README.md``); past its edges an object falls to the floor. The range camera in the
     head has the iCub eye camera's field of view (57 x 72 degrees at the default 4:3 image). The head keeps the
@@ -110,6 +121,14 @@ class TapAffordanceEnv(gym.Env):
     | 1 | lateral offset of the stroke, across its direction | -2 .. +2 cm |
     | 2 | hand speed along the stroke, 0.2 x 3 ** a m/s | 0.067 .. 0.6 m/s |
 
+    For ``behavior="grasp"``, 0 is the canonical grasp:
+
+    | index | meaning | range |
+    |-------|---------|-------|
+    | 0 | height of the palm above the object's top when the hand closes | -0.5 .. +1.5 cm |
+    | 1 | offset of the object across the hand, towards the little finger | -1.5 .. +1.5 cm |
+    | 2 | time to close the hand, 0.4 / 2 ** a s | 0.8 .. 0.2 s |
+
     Values outside [-1, 1], NaN or a wrong shape raise ``ValueError``.
 
     ## Observation Space
@@ -120,7 +139,9 @@ class TapAffordanceEnv(gym.Env):
     | ``range`` | (H, W) | float32 | distance along each pixel's ray [m]; 0 where nothing is hit |
     | ``mask`` | (H, W) | int8 | 1 on pixels of the object of interest |
     | ``features`` | (49,) | float32 | the paper's features, named by ``affordance_env.FEATURE_NAMES`` |
-    | ``joints`` | (13,) | float32 | robot joint angles [rad], order ``affordance_env.ACTIVE_JOINTS`` |
+    | ``joints`` | (13,) | float32 | robot joint angles [rad], order ``affordance_env.ACTIVE_JOINTS``; for the grasp
+      (24,): torso, neck, left arm and the 11 finger joints, order ``affordance_env.robot_model.VARIANTS["grasp"]
+      .active_joints`` |
 
     ## Rewards
     ``reward_fn(info)``; the default is the object's displacement on the table [m]. Affordance learning does not
@@ -137,8 +158,8 @@ class TapAffordanceEnv(gym.Env):
     The episode terminates after one interaction (``terminated=True``). The object is followed at every control
     tick from the start of the step, whatever the arm is doing (:mod:`affordance_env.outcome`). Once the arm is
     back home and still, the simulation goes on until the object is at rest (still for 50 ms after the first
-    touch), has left the table (detected the moment its centre crosses the table's edge), or ``settle_timeout``
-    seconds have passed since the first touch; then the final snapshot is taken.
+    touch; for the grasp, after the hand opened), has left the table (detected the moment its centre crosses the
+    table's edge), or ``settle_timeout`` seconds have passed since then; then the final snapshot is taken.
 
     ## Info
     After ``reset``: ``object`` (``type``, ``size`` [m], ``pose`` (7,) position and quaternion), ``attention``,
@@ -154,20 +175,28 @@ class TapAffordanceEnv(gym.Env):
     object), ``hand_speed`` [m/s],
     ``ik`` (``success``, ``position_error`` [m], ``orientation_error`` [rad]), ``visible`` (object seen in the
     final snapshot),
+    for the grasp only: ``success`` (the grasp held the object: at the end of the 1 s hold its centre had risen at
+    least 5 cm, ``affordance_env.outcome.GRASP_LIFT_THRESHOLD``, and it touched the hand and not the table; held
+    objects rise 6-9 cm, the others stay within millimetres of the table), ``grasp`` (``rise`` [m] at the end
+    of the hold, ``links_holding``: names of the hand links touching the object then, ``on_table``),
     ``failure``: None, or why the interaction is not a valid sample: ``"physics: ..."`` (MuJoCo reported an
     instability or the state became non-finite; then obs is blank, ``effect`` is zeros and ``outcome`` is
     ``"fault"``), ``"snapshot: ..."`` (the robot's head or arm still moved when a snapshot was taken),
-    ``"perception: ..."`` (object not visible initially), ``"ik: ..."`` (stroke not reachable),
+    ``"perception: ..."`` (object not visible initially), ``"ik: ..."`` (stroke or grasp not reachable),
     ``"reach: ..."`` (the arm touched the object before the stroke, or the stroke started more than 1 cm from
-    its planned pose), ``"tap: ..."`` (the hand never touched the object). The next ``reset`` recovers from any of them.
+    its planned pose), ``"tap: ..."`` (the hand never touched the object). A grasp is invalid only for physics,
+    snapshot, perception or ik: its hand meets the object on the way down, and a miss is a failed grasp
+    (``success`` False), not an invalid one. The next ``reset`` recovers from any of them.
 
     ## Arguments
 
     | argument | default | meaning |
     |----------|---------|---------|
-    | ``behavior`` | ``"tap"`` | ``"tap"``; ``"tap_back"`` (other side, back of hand); ``"push"`` (from the front) |
+    | ``behavior`` | ``"tap"`` | ``"tap"``; ``"tap_back"`` (other side, back of hand); ``"push"`` (from the front);
+      ``"grasp"`` (left arm, fingered hand; see Description) |
     | ``object_types`` | all four | types to sample from |
-    | ``size_range`` | (0.04, 0.10) | object size range [m] |
+    | ``size_range`` | (0.04, 0.10) | object size range [m]; for the grasp it straddles the critical size (about 7 cm,
+      up to 9 cm for spheres, which the fingers wrap): both outcomes occur |
     | ``camera_width``, ``camera_height`` | 160, 120 | range image size [pixels] (the iCub eye camera's 4:3) |
     | ``camera_fovy`` | 57.4 | vertical field of view [deg]; the iCub eye camera's (fy = 219 px at 320 x 240) |
     | ``roll_threshold`` | 0.03 | rolling distance above which an interaction is ``rolled`` [m] |

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from affordance_env.kinematics import Kinematics
+from affordance_env.objects import object_geometry
 from affordance_env.physics import TapPhysics
 from affordance_env.robot_model import (
     ARM_JOINTS,
@@ -178,3 +179,22 @@ def test_distal_joints_follow_while_the_fingers_close_and_nothing_touches_itself
     assert q[joints.index("l_hand_index_proximal_joint")] > 1.5  # the fingers closed (no object in the way)
     assert q[joints.index("l_hand_index_distal_joint")] > 1.4
     assert physics.unstable() is None
+
+
+@pytest.mark.parametrize("object_type", ["box", "horizontal_cylinder"])
+def test_grasp_scene_steps_under_control_noise_and_objects_rest(object_type):
+    physics = TapPhysics(build_model("grasp"), "grasp")  # its own model: set_object changes it
+    assert physics.model.opt.timestep == pytest.approx(0.005)
+    rng = np.random.default_rng(0)
+    for size, yaw in ((0.042, 0.2), (0.07, -0.1)):  # a small lying cylinder is the one that could creep
+        physics.reset_home()
+        physics.set_object(object_geometry(object_type, size), np.array([-0.31, 0.04]), yaw)
+        home = physics.joint_targets()
+        physics.step(20)
+        p0 = physics.object_pose()[:3]
+        for _ in range(200):  # 2 s, the servos' targets jittered as in the tap scene's test
+            physics.set_joint_targets(home + rng.normal(0.0, 0.02, home.shape))
+            physics.step(2)
+        assert physics.unstable() is None and all(w.number == 0 for w in physics.data.warning)
+        assert np.linalg.norm(physics.object_pose()[:3] - p0) < 2e-4, (object_type, size)
+        assert np.max(np.abs(physics.joint_positions() - home)) < 0.1
