@@ -67,8 +67,8 @@ class StrokeOutcome:
 #: Grasp timing [s]: reach above the object, descend to it, keep squeezing after the closing ramp, lift, carry the
 #: object beside and down to the table, open the hand, withdraw above it. The lift (8 cm in 0.3 s) and the carry
 #: are a relaxed pace for a hand; the descent and the lift are short moves.
-GRASP_REACH_TIME, GRASP_DESCEND_TIME, SQUEEZE_TIME = 0.3, 0.3, 0.05
-LIFT_TIME, PLACE_TIME, OPEN_TIME, RETREAT_TIME = 0.25, 0.3, 0.15, 0.15
+GRASP_REACH_TIME, GRASP_DESCEND_TIME, GRASP_SQUEEZE_TIME = 0.3, 0.3, 0.05
+GRASP_LIFT_TIME, GRASP_PLACE_TIME, GRASP_OPEN_TIME, GRASP_RETREAT_TIME = 0.25, 0.3, 0.15, 0.15
 #: The palm waits at most this long [s] to come within SETTLE_TOLERANCE of the grasp pose before the hand closes:
 #: a large object or the table may stop it short (the thumb of the open hand hangs 6.6 cm below the palm).
 GRASP_SETTLE_MAX_TIME = 0.1
@@ -276,16 +276,16 @@ class MotionExecutor:
         # Close from where the arm stands (short of the grasp pose if something stopped it), the fingers on a ramp.
         q_arm = physics.joint_targets()
         self._ramp(with_hand(q_arm, plan.hand_closed), plan.close_time, watch)
-        self._ramp(with_hand(q_arm, plan.hand_closed), SQUEEZE_TIME, watch)
-        self._ramp(with_hand(q_lift, plan.hand_closed), LIFT_TIME, watch)
+        self._ramp(with_hand(q_arm, plan.hand_closed), GRASP_SQUEEZE_TIME, watch)
+        self._ramp(with_hand(q_lift, plan.hand_closed), GRASP_LIFT_TIME, watch)
         self._ramp(with_hand(q_lift, plan.hand_closed), plan.hold_time, watch)
         rise = float(physics.object_pose()[2]) - z_start
         holding = tuple(sorted(physics.links_touching_object()))
         on_table = physics.object_touches_table()
-        self._ramp(with_hand(q_place, plan.hand_closed), PLACE_TIME, watch)
-        self._ramp(with_hand(q_place, plan.hand_open), OPEN_TIME, watch)
+        self._ramp(with_hand(q_place, plan.hand_closed), GRASP_PLACE_TIME, watch)
+        self._ramp(with_hand(q_place, plan.hand_open), GRASP_OPEN_TIME, watch)
         release_time = float(physics.data.time)
-        self._ramp(with_hand(q_retreat, plan.hand_open), RETREAT_TIME, watch)
+        self._ramp(with_hand(q_retreat, plan.hand_open), GRASP_RETREAT_TIME, watch)
         return GraspOutcome(ik_ok, pos_err, rot_err, watch["contact"], watch["time"], watch["speed"], rise,
                             holding, on_table, release_time)
 
