@@ -77,7 +77,7 @@ HAND_KP, HAND_DAMPING, HAND_ARMATURE = 1.0, 0.03, 1e-3
 #: against 100, 53 and 7 % at 2 ms; 84 of the 90 end the same (at 2.5 ms, 88 end as at 2 ms): the others are
 #: pushed objects whose fate, like that of a tapped ball at the table's edge, turns on small differences. A step
 #: of the grasp, with its many contacts on a 30-degree-of-freedom robot, costs some 50 microseconds, so at 2 ms
-#: a grasp costs three to four taps, and at 5 ms under two (``benchmarks/env.py --behavior tap grasp``). It
+#: a grasp costs three to four taps, and at 5 ms about 1.6 (``benchmarks/env.py --behavior tap grasp``). It
 #: divides the 10 ms control tick.
 GRASP_TIMESTEP = 0.005
 #: Coupling of the distal finger joints to their proximal joints (MuJoCo ``equality joint``): the linkage is

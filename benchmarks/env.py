@@ -4,8 +4,8 @@
 
 Prints interactions per second (reset + step), and the share of wall time spent inside ``mj_step`` (physics),
 in ray casting (range camera) and in the 49 features, measured by timing those calls in the same run. With
-several behaviours, each is measured in turn in the same run, and the wall time per interaction of each is
-compared with the first's.
+several behaviours, they take turns round by round in the same run (so that they share the machine's load),
+and the wall time per interaction of each is compared with the first's.
 """
 
 from __future__ import annotations
@@ -50,23 +50,28 @@ def main() -> None:
     per_interaction = {}
     try:
         size = {k: v for k, v in (("camera_width", args.width), ("camera_height", args.height)) if v is not None}
-        for behavior in args.behavior:
-            env = TapAffordanceEnv(behavior=behavior, **size)
+        envs = {behavior: TapAffordanceEnv(behavior=behavior, **size) for behavior in args.behavior}
+        for env in envs.values():
             env.reset(seed=0)
             env.step(np.zeros(3))
-            rounds = []  # the same interactions each round; the machine's load varies, the best round is the figure
-            for _ in range(args.repeats):
+        # The same interactions each round; the behaviours take turns round by round, so that they share the
+        # machine's varying load; the best round of each is its figure.
+        rounds = {behavior: [] for behavior in envs}
+        simulated = dict.fromkeys(envs, 0.0)
+        for _ in range(args.repeats):
+            for behavior, env in envs.items():
                 spent.clear()
-                simulated = 0.0
+                simulated[behavior] = 0.0
                 start = time.perf_counter()
                 for i in range(args.episodes):
                     env.reset(seed=i)
                     env.step(np.zeros(3))
-                    simulated += env.physics.data.time  # reset starts the clock at 0
-                rounds.append((time.perf_counter() - start, dict(spent)))
-            wall, best = min(rounds, key=lambda r: r[0])
+                    simulated[behavior] += env.physics.data.time  # reset starts the clock at 0
+                rounds[behavior].append((time.perf_counter() - start, dict(spent)))
+        for behavior, env in envs.items():
+            wall, best = min(rounds[behavior], key=lambda r: r[0])
             per_interaction[behavior] = wall / args.episodes
-            _report(env, behavior, args, wall, best, rounds, simulated)
+            _report(env, behavior, args, wall, best, rounds[behavior], simulated[behavior])
     finally:
         mujoco.mj_step, mujoco.mj_multiRay = original["mj_step"], original["mj_multiRay"]
     first = args.behavior[0]
