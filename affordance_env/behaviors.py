@@ -28,16 +28,16 @@ index       meaning                                                          ran
 ==========  ===============================================================  ======================
 0           height of the palm above the object's top when the hand closes   -0.5 .. +1.5 cm
 1           offset of the object across the hand (towards the little finger) -1.5 .. +1.5 cm
-2           time to close the hand, 0.5 s / 2 ** action[2]                   1.0 .. 0.25 s
+2           time to close the hand, 0.4 s / 2 ** action[2]                   0.8 .. 0.2 s
 ==========  ===============================================================  ======================
 
-The grasp: palm down above the object, fingers pointing forward and to the right (120 degrees from the robot's
-forward direction; turned with the object's yaw), the thumb opposed (under the palm, on the robot's side) and the
-fingers open; the palm descends to just above the object's top, the fingers and the thumb close on a ramp, the
-palm rises LIFT_HEIGHT and holds still for HOLD_TIME, then carries the object PLACE_SHIFT to the robot's left,
-lowers it to the table and opens the hand. An object fits the open hand if it passes between the thumb, which
-hangs 6.6 cm below the palm, and the fingertips: larger objects meet the thumb on the way down and are not
-enclosed, which makes a critical size of about 6-7 cm (more for spheres, which the fingers wrap).
+The grasp: palm down above the object, fingers pointing forward and to the right (60 degrees right of straight
+ahead; turned with the object's yaw), the thumb opposed (under the palm, on the robot's side) and the fingers
+open; the palm descends to just above the object's top, the fingers and the thumb close on a ramp, the palm
+rises LIFT_HEIGHT and holds still for HOLD_TIME, then carries the object PLACE_SHIFT to the robot's left, lowers
+it to the table and opens the hand. An object fits the open hand if it passes between the thumb, which hangs
+6.4 cm below the palm, and the fingertips: larger objects meet the thumb on the way down and are not enclosed,
+which makes a critical size of about 7 cm (10-11 cm for spheres, which the fingers wrap).
 """
 
 from __future__ import annotations
@@ -251,7 +251,7 @@ GRASP_LATERAL_RANGE = 0.015
 #: Time to close the hand at action[2] = 0 [s], and the factor by which action[2] = -1 / +1 lengthens / shortens it.
 CLOSE_TIME_CANONICAL, CLOSE_TIME_FACTOR = 0.4, 2.0
 #: Height of the approach pose above the grasp pose [m]: the open hand's lowest point, the thumb's tip, hangs
-#: 6.6 cm below the palm.
+#: 6.4 cm below the palm.
 GRASP_APPROACH_HEIGHT = 0.08
 #: The palm rises this much [m] with the closed hand, and holds still there for HOLD_TIME [s].
 LIFT_HEIGHT, HOLD_TIME = 0.08, 1.0

@@ -70,7 +70,7 @@ class StrokeOutcome:
 GRASP_REACH_TIME, GRASP_DESCEND_TIME, GRASP_SQUEEZE_TIME = 0.3, 0.3, 0.05
 GRASP_LIFT_TIME, GRASP_PLACE_TIME, GRASP_OPEN_TIME, GRASP_RETREAT_TIME = 0.25, 0.3, 0.15, 0.15
 #: The palm waits at most this long [s] to come within SETTLE_TOLERANCE of the grasp pose before the hand closes:
-#: a large object or the table may stop it short (the thumb of the open hand hangs 6.6 cm below the palm).
+#: a large object or the table may stop it short (the thumb of the open hand hangs 6.4 cm below the palm).
 GRASP_SETTLE_MAX_TIME = 0.1
 #: Time to return home after a grasp [s], along a smoothstep.
 GRASP_HOME_TIME = 0.4

@@ -195,8 +195,8 @@ class TapAffordanceEnv(gym.Env):
     | ``behavior`` | ``"tap"`` | ``"tap"``; ``"tap_back"`` (other side, back of hand); ``"push"`` (from the front);
       ``"grasp"`` (left arm, fingered hand; see Description) |
     | ``object_types`` | all four | types to sample from |
-    | ``size_range`` | (0.04, 0.10) | object size range [m]; for the grasp it straddles the critical size (about 7 cm,
-      up to 9 cm for spheres, which the fingers wrap): both outcomes occur |
+    | ``size_range`` | (0.04, 0.10) | object size range [m]; for the grasp it straddles the critical size (about 7 cm;
+      spheres, which the fingers wrap, are held up to 10 cm, not at 11): both outcomes occur |
     | ``camera_width``, ``camera_height`` | 160, 120 | range image size [pixels] (the iCub eye camera's 4:3) |
     | ``camera_fovy`` | 57.4 | vertical field of view [deg]; the iCub eye camera's (fy = 219 px at 320 x 240) |
     | ``roll_threshold`` | 0.03 | rolling distance above which an interaction is ``rolled`` [m] |
