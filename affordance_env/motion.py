@@ -65,8 +65,9 @@ class StrokeOutcome:
 
 
 #: Grasp timing [s]: reach above the object, descend to it, keep squeezing after the closing ramp, lift, carry the
-#: object beside and down to the table, open the hand, withdraw above it. The lift (8 cm in 0.3 s) and the carry
-#: are a relaxed pace for a hand; the descent and the lift are short moves.
+#: object beside and down to the table, open the hand, withdraw above it. Every move follows a smoothstep: the
+#: open hand comes down 8 cm in 0.3 s (at most 0.4 m/s), the held object goes up 8 cm in 0.25 s and down and 6 cm
+#: aside in 0.3 s, a brisk but unhurried pace for a hand.
 GRASP_REACH_TIME, GRASP_DESCEND_TIME, GRASP_SQUEEZE_TIME = 0.3, 0.3, 0.05
 GRASP_LIFT_TIME, GRASP_PLACE_TIME, GRASP_OPEN_TIME, GRASP_RETREAT_TIME = 0.25, 0.3, 0.15, 0.15
 #: The palm waits at most this long [s] to come within SETTLE_TOLERANCE of the grasp pose before the hand closes:
