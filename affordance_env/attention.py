@@ -13,11 +13,14 @@ import numpy as np
 
 from affordance_env.camera import RangeCamera, project
 from affordance_env.physics import TapPhysics
-from affordance_env.robot_model import ACTIVE_JOINTS
 
 #: Neck joints used for gaze: pitch (image rows) and yaw (image columns).
 GAZE_JOINTS = ("neck_pitch", "neck_yaw")
-_GAZE_IDX = np.array([ACTIVE_JOINTS.index(n) for n in GAZE_JOINTS])
+
+
+def _gaze_indices(physics: TapPhysics) -> np.ndarray:
+    """Positions of GAZE_JOINTS in the robot's joint vector."""
+    return np.array([physics.variant.active_joints.index(n) for n in GAZE_JOINTS])
 
 
 @dataclass(frozen=True)
@@ -54,7 +57,7 @@ def _image_jacobian(
     scratch.qpos[:] = physics.data.qpos
     jac = np.empty((2, 2))
     eps = 1e-4
-    for j, joint in enumerate(_GAZE_IDX):
+    for j, joint in enumerate(_gaze_indices(physics)):
         uv = []
         for sign in (1.0, -1.0):
             scratch.qpos[physics.robot_qpos[joint]] = physics.data.qpos[physics.robot_qpos[joint]] + sign * eps
@@ -101,7 +104,7 @@ def attend(
             return AttentionResult(True, True, float(np.linalg.norm(error)), iteration - 1)
         jac = _image_jacobian(camera, physics, p_world, scratch)
         q = physics.joint_targets()
-        q[_GAZE_IDX] -= np.linalg.lstsq(jac, error, rcond=None)[0]
+        q[_gaze_indices(physics)] -= np.linalg.lstsq(jac, error, rcond=None)[0]
         move_joints(q, move_time)
         move_joints(q, hold_time)
         seen = _centroid(camera, physics)

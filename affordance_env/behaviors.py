@@ -1,10 +1,12 @@
-"""The robot's behaviours: where the hand starts, which way it moves and how fast, for one action.
+"""The robot's behaviours: where the hand goes, how it moves and how fast, for one action.
 
-A behaviour is a straight hand stroke along a horizontal direction, with a fixed hand orientation and a
-contact surface on the hand. :func:`plan_stroke` turns (behaviour, object, action) into Cartesian waypoints;
-it is a pure function, and :mod:`affordance_env.motion` executes the plan on the simulated robot.
+Two kinds of behaviour. A stroke (``tap``, ``tap_back``, ``push``) is a straight hand stroke along a horizontal
+direction, with a fixed hand orientation and a contact surface on the hand; :func:`plan_stroke` turns (behaviour,
+object, action) into Cartesian waypoints. The ``grasp`` (:class:`GraspBehavior`) takes the object from above
+with the fingered left hand, lifts it, holds it and puts it down beside where it was; :func:`plan_grasp` plans
+it. Both are pure functions; :mod:`affordance_env.motion` executes the plans on the simulated robot.
 
-The action is three numbers in [-1, 1]; 0 is the paper's canonical tap:
+The action is three numbers in [-1, 1]; for a stroke, 0 is the paper's canonical tap:
 
 ==========  ===============================================================  ======================
 index       meaning                                                          range
@@ -18,6 +20,24 @@ The canonical tap is moderate (the paper: "moderately hitting an object from its
 lying cylinder rolls some 5 to 25 cm on the table and stays in view; the speed scale is geometric, because the
 distance a struck object rolls grows with the square of its speed: at the gentlest tap (-1) rolling objects
 move 2-3 cm, at the hardest (+1) four in five roll off the 1 m wide table (see ``assets/README.md``).
+
+For the grasp, 0 is the canonical grasp:
+
+==========  ===============================================================  ======================
+index       meaning                                                          range
+==========  ===============================================================  ======================
+0           height of the palm above the object's top when the hand closes   -0.5 .. +1.5 cm
+1           offset of the object across the hand (towards the little finger) -1.5 .. +1.5 cm
+2           time to close the hand, 0.4 s / 2 ** action[2]                   0.8 .. 0.2 s
+==========  ===============================================================  ======================
+
+The grasp: palm down above the object, fingers pointing forward and to the right (60 degrees right of straight
+ahead; turned with the object's yaw), the thumb opposed (under the palm, on the robot's side) and the fingers
+open; the palm descends to just above the object's top, the fingers and the thumb close on a ramp, the palm
+rises LIFT_HEIGHT and holds still for HOLD_TIME, then carries the object PLACE_SHIFT to the robot's left, lowers
+it to the table and opens the hand. An object fits the open hand if it passes between the thumb, which hangs
+6.4 cm below the palm, and the fingertips: larger objects meet the thumb on the way down and are not enclosed,
+which makes a critical size of about 7 cm (10-11 cm for spheres, which the fingers wrap).
 """
 
 from __future__ import annotations
@@ -28,6 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from affordance_env.objects import ObjectGeometry
+from affordance_env.robot_model import HAND_OPEN
 
 ACTION_DIM = 3
 HEIGHT_RANGE = 0.015  # [m]
@@ -86,6 +107,7 @@ class Behavior:
         joint_ranges: Narrower joint ranges ``{name: (low, high)}`` [rad] that the IK keeps to for every pose of
             the stroke: a posture of the arm (see :data:`FOREARM_RAISED`). Empty: the robot's joint limits.
         success_rule: What makes an interaction a success, one of :data:`SUCCESS_RULES` (see :func:`is_success`).
+        robot: The robot variant it needs (:data:`affordance_env.robot_model.VARIANTS`).
     """
 
     name: str
@@ -96,10 +118,29 @@ class Behavior:
     approach_clearance: float | None = APPROACH_CLEARANCE
     joint_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
     success_rule: str = "rolled"
+    robot: str = "tap"
 
     def __post_init__(self) -> None:
         if self.success_rule not in SUCCESS_RULES:
             raise ValueError(f"success_rule must be one of {SUCCESS_RULES}, got {self.success_rule!r}.")
+
+
+@dataclass(frozen=True)
+class GraspBehavior:
+    """Grasp from above with the fingered left hand, lift, hold, put down beside (see the module docstring).
+
+    Attributes:
+        name: Identifier used by ``behavior=`` of the environment.
+        R_world_hand: Orientation of the palm frame (``l_hand_dh_frame``: x along the fingers, the palm facing -z)
+            for an object at zero yaw, (3, 3).
+        description: One line for the documentation.
+        robot: The robot variant it needs.
+    """
+
+    name: str
+    R_world_hand: np.ndarray
+    description: str
+    robot: str = "grasp"
 
 
 def _rotation(fingers: tuple[float, float, float], palm_normal: tuple[float, float, float]) -> np.ndarray:
@@ -108,7 +149,21 @@ def _rotation(fingers: tuple[float, float, float], palm_normal: tuple[float, flo
     return np.column_stack([x, np.cross(z, x), z])
 
 
-BEHAVIORS: dict[str, Behavior] = {
+#: The grasp's fingers point this far [rad] from world +x (forward is -x, the robot's left -y), turned with the
+#: object's yaw: 120 degrees, forward and to the right, a direction the left arm reaches palm down over the whole
+#: placement region (at 180, straight ahead, a third of it is out of reach).
+GRASP_FINGERS_YAW = 2 * np.pi / 3
+
+
+def grasp_orientation(yaw: float) -> np.ndarray:
+    """Palm orientation of the grasp for an object at ``yaw`` [rad]: palm down, fingers at GRASP_FINGERS_YAW + yaw.
+
+    The left palm faces -z of its frame, so that axis points up."""
+    angle = GRASP_FINGERS_YAW + yaw
+    return _rotation((np.cos(angle), np.sin(angle), 0.0), (0.0, 0.0, 1.0))
+
+
+BEHAVIORS: dict[str, Behavior | GraspBehavior] = {
     "tap": Behavior(
         "tap", np.array([0.0, -1.0]), _rotation((-1, 0, 0), (0, -1, 0)), 0.012,
         "the paper's tap: the palm hits the object from its right side, moving to the robot's left (-y)",
@@ -126,6 +181,10 @@ BEHAVIORS: dict[str, Behavior] = {
         0.039,
         "push from the front: the back of the hand pushes the object's near face away from the robot (-x)",
         joint_ranges=FOREARM_RAISED, success_rule="moved",
+    ),
+    "grasp": GraspBehavior(
+        "grasp", grasp_orientation(0.0),
+        "grasp from above with the fingered left hand, lift 8 cm, hold 1 s, put down 6 cm to the robot's left",
     ),
 }
 
@@ -147,7 +206,7 @@ def is_success(rule: str, rolled: bool | np.ndarray, displacement: float | np.nd
     return bool(label) if label.ndim == 0 else label
 
 
-def get_behavior(name: str) -> Behavior:
+def get_behavior(name: str) -> Behavior | GraspBehavior:
     """The behaviour called ``name``; raises ValueError listing the valid names."""
     if name not in BEHAVIORS:
         raise ValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
@@ -238,4 +297,108 @@ def plan_stroke(
         R_world_hand=behavior.R_world_hand,
         follow_through=FOLLOW_THROUGH,
         joint_ranges=behavior.joint_ranges,
+    )
+
+
+# --- the grasp -----------------------------------------------------------------------------------------------
+#: Where the object's vertical axis passes through the hand when it closes, in the palm frame [m]: along the
+#: fingers (x) and towards the little finger (y). The opposed thumb hangs under the palm, 4 cm to the thumb side
+#: (-y), and the fingers curl in from 10 cm out, pushing the object back towards the thumb: 3 cm out and 2.5 cm
+#: to the thumb side the object lies between the thumb and the index and middle fingers. Over the 90 canonical
+#: grasps of ``benchmarks/grasp.py`` (97, 63 and 7 % held per third of sizes), this point moved by 5 mm along
+#: either axis holds 100 % of the smallest third and 7 % of the largest, and 47-80 % of the middle one: it sets
+#: where in the middle third the critical size falls.
+GRASP_CENTRE_HAND = (0.03, -0.025)
+#: Gap between the palm and the object's top when the hand closes [m], and the change action[0] = +-1 makes.
+GRASP_GAP, GRASP_HEIGHT_RANGE = 0.005, 0.01
+#: Shift of the object across the hand (along the palm's y axis) at action[1] = +-1 [m].
+GRASP_LATERAL_RANGE = 0.015
+#: Time to close the hand at action[2] = 0 [s], and the factor by which action[2] = -1 / +1 lengthens / shortens it.
+CLOSE_TIME_CANONICAL, CLOSE_TIME_FACTOR = 0.4, 2.0
+#: Height of the approach pose above the grasp pose [m]: the open hand's lowest point, the thumb's tip, hangs
+#: 6.4 cm below the palm.
+GRASP_APPROACH_HEIGHT = 0.08
+#: The palm rises this much [m] with the closed hand, and holds still there for HOLD_TIME [s].
+LIFT_HEIGHT, HOLD_TIME = 0.08, 1.0
+#: Where the object is put down, relative to where it was [m] (world x, y): to the robot's left, towards the
+#: arm, so that a grasped object ends 6 cm from where it stood: the final snapshot shows the grasp's effect.
+PLACE_SHIFT = (0.0, -0.06)
+#: The palm lowers the object to this height above the grasp pose [m] before the hand opens: a held object that
+#: has not slipped is released a few millimetres above the table.
+PLACE_CLEARANCE = 0.004
+#: Driven finger joints [rad] of the closed hand: the open hand's (HAND_OPEN: the thumb opposed to the straight
+#: fingers) with each flexion joint at its upper limit, so that the servos squeeze whatever stops the fingers
+#: short of it, and the thumb turned further under the palm (opposition 1.3 rad of its 1.4), towards the fingers.
+HAND_CLOSED: dict[str, float] = {
+    **HAND_OPEN,
+    "l_hand_metacarpus_joint": 1.3,
+    "l_hand_thumb_proximal_joint": 1.4835,
+    "l_hand_index_proximal_joint": 1.6581,
+    "l_hand_medium_proximal_joint": 1.6581,
+    "l_hand_pinky_proximal_joint": 1.6581,
+}
+
+
+@dataclass(frozen=True)
+class GraspPlan:
+    """Cartesian plan of one grasp: palm positions (``l_hand_dh_frame`` origin, world frame) [m].
+
+    Attributes:
+        p_above: Above the grasp pose, high enough that the open hand clears the object; reached first.
+        p_grasp: Where the hand closes: the palm just above the object's top.
+        p_lift: Where the closed hand holds the object: LIFT_HEIGHT above ``p_grasp``.
+        p_place: Where the hand opens: PLACE_SHIFT beside ``p_grasp`` and PLACE_CLEARANCE above it.
+        p_retreat: Above ``p_place``, where the open hand withdraws before going home.
+        R_world_hand: Palm orientation throughout.
+        close_time: Duration of the closing ramp [s].
+        hold_time: How long the lifted object is held still [s].
+        hand_open, hand_closed: Targets of the driven finger joints [rad], by joint name.
+    """
+
+    p_above: np.ndarray
+    p_grasp: np.ndarray
+    p_lift: np.ndarray
+    p_place: np.ndarray
+    p_retreat: np.ndarray
+    R_world_hand: np.ndarray
+    close_time: float
+    hold_time: float
+    hand_open: dict[str, float]
+    hand_closed: dict[str, float]
+
+
+def plan_grasp(
+    behavior: GraspBehavior, geometry: ObjectGeometry, p_world_object: np.ndarray, yaw: float, table_top: float,
+    action: np.ndarray,
+) -> GraspPlan:
+    """Plan the grasp of an object resting on the table.
+
+    Args:
+        behavior: The grasp behaviour.
+        geometry: The object's geometry (the paper takes shape, size and position from the simulator).
+        p_world_object: Object centre [m], (3,).
+        yaw: Object yaw [rad]; the hand turns with it (boxes and lying cylinders are then gripped across faces).
+        table_top: Height of the table top [m].
+        action: (3,) in [-1, 1]; see the module documentation.
+    """
+    a = check_action(action)
+    R = grasp_orientation(yaw)
+    top = float(p_world_object[2]) + geometry.half_height
+    if top <= table_top:
+        raise ValueError(f"the object's top ({top:.3f} m) must be above the table top ({table_top:.3f} m).")
+    centre_hand = np.array([GRASP_CENTRE_HAND[0], GRASP_CENTRE_HAND[1] + a[1] * GRASP_LATERAL_RANGE, 0.0])
+    p_grasp = np.array([p_world_object[0], p_world_object[1], 0.0]) - R @ centre_hand
+    p_grasp[2] = top + GRASP_GAP + a[0] * GRASP_HEIGHT_RANGE
+    p_place = p_grasp + np.array([PLACE_SHIFT[0], PLACE_SHIFT[1], PLACE_CLEARANCE])
+    return GraspPlan(
+        p_above=p_grasp + np.array([0.0, 0.0, GRASP_APPROACH_HEIGHT]),
+        p_grasp=p_grasp,
+        p_lift=p_grasp + np.array([0.0, 0.0, LIFT_HEIGHT]),
+        p_place=p_place,
+        p_retreat=p_place + np.array([0.0, 0.0, GRASP_APPROACH_HEIGHT]),
+        R_world_hand=R,
+        close_time=float(CLOSE_TIME_CANONICAL / CLOSE_TIME_FACTOR ** a[2]),
+        hold_time=HOLD_TIME,
+        hand_open=dict(HAND_OPEN),
+        hand_closed=dict(HAND_CLOSED),
     )

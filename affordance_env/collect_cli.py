@@ -43,7 +43,7 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
                         help="Dask scheduler to run on (e.g. tcp://host:8786); implies --scheduler dask. Its "
                              "workers must see --out and have the same tap-affordance version")
     env = parser.add_argument_group("environment options (default: the environment's own)")
-    env.add_argument("--behavior", default=None, help="tap | tap_back | push")
+    env.add_argument("--behavior", default=None, help="tap | tap_back | push | grasp")
     env.add_argument("--object-types", nargs="+", default=None, metavar="TYPE",
                      help="object types to sample from: sphere box horizontal_cylinder vertical_cylinder")
     env.add_argument("--size-range", nargs=2, type=float, default=None, metavar=("LOW", "HIGH"),

@@ -1,7 +1,11 @@
-"""Forward and inverse kinematics of the iCub's right hand and head with Pinocchio.
+"""Forward and inverse kinematics of the iCub's hand and head with Pinocchio.
 
 The model is built from the same URDF as the simulation (:func:`affordance_env.robot_model.icub_urdf`) and
-reduced to :data:`~affordance_env.robot_model.ACTIVE_JOINTS`; configurations are vectors in that joint order.
+reduced to the active joints of a robot variant (:data:`~affordance_env.robot_model.VARIANTS`): for ``"tap"``
+(the default) :data:`~affordance_env.robot_model.ACTIVE_JOINTS`, torso, neck and right arm; for ``"grasp"``
+torso, neck and left arm, with the ``left_hand_mk3`` hand model appended at ``l_hand_dh_frame`` as in the
+simulation. Configurations are vectors in the variant's ``active_joints`` order; Pinocchio's own joint order
+(depth first through its tree, the appended hand's joints after the arm's) is mapped to it by name.
 """
 
 from __future__ import annotations
@@ -12,7 +16,14 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
-from affordance_env.robot_model import ACTIVE_JOINTS, HAND_FRAME, HEAD_FRAME, REACH_JOINTS, icub_urdf
+from affordance_env.robot_model import (
+    HAND_MOUNT_FRAME,
+    HAND_MOUNT_POS,
+    HEAD_FRAME,
+    get_variant,
+    hand_urdf,
+    icub_urdf,
+)
 
 
 @dataclass(frozen=True)
@@ -20,8 +31,8 @@ class IKResult:
     """Outcome of :meth:`Kinematics.solve_ik`.
 
     Attributes:
-        q: Joint configuration reached, in :data:`ACTIVE_JOINTS` order [rad]; within the joint limits (and the
-            ``joint_ranges`` asked for).
+        q: Joint configuration reached, in the variant's active-joint order [rad]; within the joint limits (and
+            the ``joint_ranges`` asked for).
         success: Whether both errors are within the requested tolerances.
         position_error: Distance between reached and target hand position [m].
         orientation_error: Angle between reached and target hand orientation [rad] (0 if none was asked).
@@ -35,47 +46,70 @@ class IKResult:
     iterations: int
 
 
+def _build_model(variant: str) -> pin.Model:
+    """The Pinocchio model of robot ``variant``: the URDF reduced to its active joints, with the mk3 hand."""
+    robot = get_variant(variant)
+    full = pin.buildModelFromXML(icub_urdf())
+    locked = [full.getJointId(name) for name in full.names[1:] if name not in robot.active_joints]
+    model = pin.buildReducedModel(full, locked, pin.neutral(full))
+    if robot.fingered:
+        # The palm link (the hand model's root) at HAND_MOUNT_POS in HAND_MOUNT_FRAME, unrotated, as in MuJoCo.
+        T_mount_palm = pin.SE3(np.eye(3), np.array(HAND_MOUNT_POS))
+        model = pin.appendModel(model, pin.buildModelFromXML(hand_urdf()), model.getFrameId(HAND_MOUNT_FRAME),
+                                T_mount_palm)
+    return model
+
+
 class Kinematics:
     """Pinocchio model of the iCub reduced to the joints the project moves.
 
     Args:
-        hand_frame: Name of the end-effector frame.
+        hand_frame: Name of the end-effector frame; by default the variant's palm frame.
         head_frame: Name of the head frame (camera mount).
+        variant: Robot variant (:data:`~affordance_env.robot_model.VARIANTS`): ``"tap"`` or ``"grasp"``.
     """
 
-    def __init__(self, hand_frame: str = HAND_FRAME, head_frame: str = HEAD_FRAME) -> None:
-        full = pin.buildModelFromXML(icub_urdf())
-        locked = [full.getJointId(name) for name in full.names[1:] if name not in ACTIVE_JOINTS]
-        self.model = pin.buildReducedModel(full, locked, pin.neutral(full))
+    def __init__(self, hand_frame: str | None = None, head_frame: str = HEAD_FRAME, *, variant: str = "tap") -> None:
+        self.variant = get_variant(variant)
+        self.joint_names = self.variant.active_joints
+        hand_frame = self.variant.hand_frame if hand_frame is None else hand_frame
+        self.model = _build_model(self.variant.name)
         self.data = self.model.createData()
         names = list(self.model.names[1:])
-        order = [names.index(name) for name in ACTIVE_JOINTS]
-        if order != list(range(len(ACTIVE_JOINTS))):
-            raise RuntimeError(f"Pinocchio joint order {names} differs from ACTIVE_JOINTS {ACTIVE_JOINTS}.")
+        if sorted(names) != sorted(self.joint_names) or self.model.nq != len(names):
+            raise RuntimeError(f"Pinocchio joints {names} differ from the active joints {self.joint_names}.")
+        #: q_pinocchio = q[self._to_pin] and q = q_pinocchio[self._from_pin] (every joint is a 1-dof revolute).
+        self._to_pin = np.array([self.joint_names.index(name) for name in names])
+        self._from_pin = np.array([names.index(name) for name in self.joint_names])
         for frame in (hand_frame, head_frame):
             if not self.model.existFrame(frame):
                 available = sorted({f.name for f in self.model.frames})
                 raise ValueError(f"Frame {frame!r} does not exist in the model. Available frames: {available}")
         self.hand_frame_id = self.model.getFrameId(hand_frame)
         self.head_frame_id = self.model.getFrameId(head_frame)
-        self.lower = self.model.lowerPositionLimit.copy()
-        self.upper = self.model.upperPositionLimit.copy()
-        self.reach_dofs = np.array([ACTIVE_JOINTS.index(name) for name in REACH_JOINTS])
+        #: Joint limits [rad] in active-joint order.
+        self.lower = self.model.lowerPositionLimit[self._from_pin].copy()
+        self.upper = self.model.upperPositionLimit[self._from_pin].copy()
+        #: Indices of the reach joints in Pinocchio's order (the IK works in that order).
+        self._reach_pin = np.array([names.index(name) for name in self.variant.reach_joints])
+        #: Indices of the reach joints in active-joint order.
+        self.reach_dofs = np.array([self.joint_names.index(name) for name in self.variant.reach_joints])
 
     @property
     def nq(self) -> int:
-        """Number of joints (len(ACTIVE_JOINTS))."""
+        """Number of joints (the variant's active joints)."""
         return self.model.nq
 
     def _check_q(self, q: np.ndarray) -> np.ndarray:
         q = np.asarray(q, dtype=float)
         if q.shape != (self.nq,) or not np.all(np.isfinite(q)):
-            raise ValueError(f"q must be {self.nq} finite joint angles in ACTIVE_JOINTS order, got {q!r}.")
+            raise ValueError(f"q must be {self.nq} finite joint angles in the {self.variant.name!r} variant's "
+                             f"active-joint order, got {q!r}.")
         return q
 
     def frame_pose(self, q: np.ndarray, frame_id: int) -> pin.SE3:
         """World pose of frame ``frame_id`` at configuration ``q``."""
-        pin.framesForwardKinematics(self.model, self.data, self._check_q(q))
+        pin.framesForwardKinematics(self.model, self.data, self._check_q(q)[self._to_pin])
         return self.data.oMf[frame_id].copy()
 
     def hand_pose(self, q: np.ndarray) -> pin.SE3:
@@ -89,19 +123,21 @@ class Kinematics:
     def joint_limits(
         self, joint_ranges: Mapping[str, tuple[float, float]] | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """(lower, upper) joint limits [rad], ACTIVE_JOINTS order: the model's, narrowed by ``joint_ranges``.
+        """(lower, upper) joint limits [rad], in the variant's active-joint order: the model's, narrowed by
+        ``joint_ranges``.
 
         Args:
-            joint_ranges: ``{joint name: (low, high)}`` for joints of REACH_JOINTS; each range is intersected with
-                the model's. None or empty: the model's limits themselves (the arrays, not copies).
+            joint_ranges: ``{joint name: (low, high)}`` for joints of the variant's reach joints; each range is
+                intersected with the model's. None or empty: the model's limits themselves (the arrays, not copies).
         """
         if not joint_ranges:
             return self.lower, self.upper
         lower, upper = self.lower.copy(), self.upper.copy()
+        reach = self.variant.reach_joints
         for name, (low, high) in joint_ranges.items():
-            if name not in REACH_JOINTS:
-                raise ValueError(f"joint_ranges: {name!r} is not a joint the IK moves; those are {REACH_JOINTS}.")
-            j = ACTIVE_JOINTS.index(name)
+            if name not in reach:
+                raise ValueError(f"joint_ranges: {name!r} is not a joint the IK moves; those are {reach}.")
+            j = self.joint_names.index(name)
             lower[j], upper[j] = max(lower[j], float(low)), min(upper[j], float(high))
             if not lower[j] <= upper[j]:
                 raise ValueError(f"joint_ranges: {name!r} range ({low}, {high}) misses the joint's limits "
@@ -121,11 +157,11 @@ class Kinematics:
         damping: float = 1e-4,
         joint_ranges: Mapping[str, tuple[float, float]] | None = None,
     ) -> IKResult:
-        """Damped least-squares IK of the palm over the torso and right-arm joints.
+        """Damped least-squares IK of the palm over the variant's reach joints (torso and arm).
 
-        The neck keeps its value from ``q_init``. Every iterate is clipped to the joint limits (narrowed by
-        ``joint_ranges``), so the returned configuration is always feasible; ``success`` tells whether it reaches
-        the target.
+        The neck and the fingers keep their values from ``q_init``. Every iterate is clipped to the joint limits
+        (narrowed by ``joint_ranges``), so the returned configuration is always feasible; ``success`` tells whether
+        it reaches the target.
 
         Args:
             p_world_target: Target palm position in the world frame [m], shape (3,).
@@ -147,8 +183,9 @@ class Kinematics:
             if R_world_target.shape != (3, 3) or np.abs(R_world_target @ R_world_target.T - np.eye(3)).max() > 1e-6:
                 raise ValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
         lower, upper = self.joint_limits(joint_ranges)
-        q = np.clip(self._check_q(q_init).copy(), lower, upper)
-        dofs = self.reach_dofs
+        lower, upper = lower[self._to_pin], upper[self._to_pin]  # in Pinocchio's order from here on
+        q = np.clip(self._check_q(q_init)[self._to_pin], lower, upper)
+        dofs = self._reach_pin
         lower, upper = lower[dofs], upper[dofs]
         model, data, frame = self.model, self.data, self.hand_frame_id
         n_error = 3 if R_world_target is None else 6
@@ -181,4 +218,4 @@ class Kinematics:
             if R_world_target is not None:
                 rot_err = float(np.linalg.norm(pin.log3(R_world_target @ T_world_hand.rotation.T)))
         success = pos_err <= position_tolerance and rot_err <= orientation_tolerance
-        return IKResult(q, bool(success), pos_err, rot_err, iteration)
+        return IKResult(q[self._from_pin], bool(success), pos_err, rot_err, iteration)

@@ -1,8 +1,9 @@
-"""Executing behaviours on the simulated robot: joint-space moves, the Cartesian stroke, and waiting.
+"""Executing behaviours on the simulated robot: joint-space moves, the Cartesian stroke, the grasp, and waiting.
 
 The Cartesian stroke is turned into a joint trajectory by Pinocchio IK (one solve per control tick, warm
 started from the previous one) and tracked by MuJoCo's position servos, so the hand's real motion includes
-the servo lag and the arm's momentum.
+the servo lag and the arm's momentum. The grasp's poses are solved by the same IK and reached by joint-space
+ramps; the fingers are driven only by their servos, and only the hand's contacts move the object.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from affordance_env.behaviors import StrokePlan
+from affordance_env.behaviors import GraspPlan, StrokePlan
 from affordance_env.kinematics import IKResult, Kinematics
 from affordance_env.physics import TapPhysics
 
@@ -75,6 +76,51 @@ class StrokeOutcome:
     start_error: float
     object_moved: float
     q_withdraw: np.ndarray
+
+
+#: Grasp timing [s]: reach above the object, descend to it, keep squeezing after the closing ramp, lift, carry the
+#: object beside and down to the table, open the hand, withdraw above it. Every move follows a smoothstep: the
+#: open hand comes down 8 cm in 0.3 s (at most 0.4 m/s), the held object goes up 8 cm in 0.25 s and down and 6 cm
+#: aside in 0.3 s, a brisk but unhurried pace for a hand.
+GRASP_REACH_TIME, GRASP_DESCEND_TIME, GRASP_SQUEEZE_TIME = 0.3, 0.3, 0.05
+GRASP_LIFT_TIME, GRASP_PLACE_TIME, GRASP_OPEN_TIME, GRASP_RETREAT_TIME = 0.25, 0.3, 0.15, 0.15
+#: The palm waits at most this long [s] to come within SETTLE_TOLERANCE of the grasp pose before the hand closes:
+#: a large object or the table may stop it short (the thumb of the open hand hangs 6.4 cm below the palm).
+GRASP_SETTLE_MAX_TIME = 0.1
+
+
+@dataclass(frozen=True)
+class GraspOutcome:
+    """What happened during a grasp, measured in the simulation.
+
+    Attributes:
+        ik_success: Every pose of the grasp was reached by the IK within tolerance.
+        ik_position_error: Largest IK position error over the poses [m].
+        ik_orientation_error: Largest IK orientation error over the poses [rad].
+        contact: The hand touched the object.
+        contact_time: Simulation time of the first touch [s], to the control tick (NaN without contact).
+        hand_speed: Palm speed over the control tick of the first touch [m/s] (0 without contact).
+        rise: How far the object's centre had risen above its start at the end of the hold [m].
+        links_holding: Hand links touching the object at the end of the hold.
+        on_table: Whether the object touched the table at the end of the hold.
+        release_time: Simulation time when the hand had opened again [s].
+    """
+
+    ik_success: bool
+    ik_position_error: float
+    ik_orientation_error: float
+    contact: bool
+    contact_time: float
+    hand_speed: float
+    rise: float
+    links_holding: tuple[str, ...]
+    on_table: bool
+    release_time: float
+
+
+def _smoothstep(s: float) -> float:
+    """3 s^2 - 2 s^3: from 0 to 1 as s goes from 0 to 1, with zero slope at both ends."""
+    return s * s * (3.0 - 2.0 * s)
 
 
 class MotionExecutor:
@@ -209,6 +255,77 @@ class MotionExecutor:
         ik_ok = pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE
         return StrokeOutcome(ik_ok, pos_err, rot_err, contact, contact_time, hand_speed, travel, start_error,
                              object_moved, None if above is None else above.q)
+
+    def _tick_watching(self, q: np.ndarray, watch: dict) -> None:
+        """One control tick towards ``q``, noting in ``watch`` the first hand-object touch (to the tick) and the
+        palm's speed over that tick."""
+        physics = self.physics
+        physics.set_joint_targets(q)
+        if watch["contact"]:
+            physics.step(self.steps_per_tick)
+            return
+        p_before = physics.hand_position()
+        physics.step(self.steps_per_tick)
+        if physics.hand_touches_object():
+            watch.update(contact=True, time=float(physics.data.time),
+                         speed=float(np.linalg.norm(physics.hand_position() - p_before) / CONTROL_DT))
+
+    def _ramp(self, q_target: np.ndarray, duration: float, watch: dict) -> None:
+        """Ramp the targets to ``q_target`` over ``duration`` [s] along a smoothstep (zero speed at both ends),
+        watching for the first touch (:meth:`_tick_watching`)."""
+        q_from = self.physics.joint_targets()
+        n = max(1, round(duration / CONTROL_DT))
+        for k in range(1, n + 1):
+            self._tick_watching(q_from + (q_target - q_from) * _smoothstep(k / n), watch)
+
+    def grasp(self, plan: GraspPlan) -> GraspOutcome:
+        """Reach above the object with the open hand, descend, close the hand on a ramp, lift, hold, carry the
+        object beside and down to the table and open the hand; not the return home."""
+        physics, kinematics = self.physics, self.kinematics
+        joints = kinematics.joint_names
+
+        def with_hand(q: np.ndarray, hand: dict[str, float]) -> np.ndarray:
+            q = q.copy()
+            for name, value in hand.items():
+                q[joints.index(name)] = value
+            return q
+
+        def ik(p: np.ndarray, q_init: np.ndarray) -> IKResult:
+            return kinematics.solve_ik(p, q_init, plan.R_world_hand, position_tolerance=1e-3,
+                                       orientation_tolerance=IK_ORIENTATION_TOLERANCE)
+
+        q_open = with_hand(physics.joint_targets(), plan.hand_open)
+        results = [ik(plan.p_above, q_open)]
+        for p in (plan.p_grasp, plan.p_lift, plan.p_place, plan.p_retreat):
+            results.append(ik(p, results[-1].q))
+        pos_err = max(r.position_error for r in results)
+        rot_err = max(r.orientation_error for r in results)
+        ik_ok = pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE
+        q_above, q_grasp, q_lift, q_place, q_retreat = (r.q for r in results)
+        z_start = float(physics.object_pose()[2])
+        watch = {"contact": False, "time": float("nan"), "speed": 0.0}
+        self._ramp(q_above, GRASP_REACH_TIME, watch)
+        self.settle(plan.p_above, tolerance=0.01)
+        self._ramp(q_grasp, GRASP_DESCEND_TIME, watch)
+        for _ in range(max(1, round(GRASP_SETTLE_MAX_TIME / CONTROL_DT))):
+            if np.linalg.norm(physics.hand_position() - plan.p_grasp) <= SETTLE_TOLERANCE:
+                break
+            self._tick_watching(q_grasp, watch)
+        # Close from where the arm stands (short of the grasp pose if something stopped it), the fingers on a ramp.
+        q_arm = physics.joint_targets()
+        self._ramp(with_hand(q_arm, plan.hand_closed), plan.close_time, watch)
+        self._ramp(with_hand(q_arm, plan.hand_closed), GRASP_SQUEEZE_TIME, watch)
+        self._ramp(with_hand(q_lift, plan.hand_closed), GRASP_LIFT_TIME, watch)
+        self._ramp(with_hand(q_lift, plan.hand_closed), plan.hold_time, watch)
+        rise = float(physics.object_pose()[2]) - z_start
+        holding = tuple(sorted(physics.links_touching_object()))
+        on_table = physics.object_touches_table()
+        self._ramp(with_hand(q_place, plan.hand_closed), GRASP_PLACE_TIME, watch)
+        self._ramp(with_hand(q_place, plan.hand_open), GRASP_OPEN_TIME, watch)
+        release_time = float(physics.data.time)
+        self._ramp(with_hand(q_retreat, plan.hand_open), GRASP_RETREAT_TIME, watch)
+        return GraspOutcome(ik_ok, pos_err, rot_err, watch["contact"], watch["time"], watch["speed"], rise,
+                            holding, on_table, release_time)
 
     def go_home(self, q_home: np.ndarray, via: np.ndarray | None = None) -> bool:
         """Return to ``q_home`` through ``via`` (after :meth:`stroke`: up and back above the pre-stroke pose) and

@@ -21,6 +21,10 @@ The labels are pure functions of those records and of the initial and final pose
   body axes by any angle at a constant centre height, so it does not count as toppled.
 
 A standing cylinder that topples and then rolls away is both ``toppled`` and ``rolled``.
+
+A grasp's label, :func:`grasp_success`, is measured at the end of the hold, with the hand lifted and still:
+the object was lifted (its centre rose by at least :data:`GRASP_LIFT_THRESHOLD`), it touches the hand and not
+the table, so the hand alone holds it up.
 """
 
 from __future__ import annotations
@@ -46,6 +50,10 @@ MIN_MOTION_SPEED = 1e-3
 TOPPLE_ANGLE = math.pi / 4
 #: ... and the centre rose by more than this share of its initial height above the table.
 TOPPLE_RISE = 0.1
+#: A grasp lifted the object if its centre rose at least this much [m] by the end of the hold. The palm rises
+#: 8 cm: a held object rises with it, a few millimetres less if it sagged in the grip, while an object the hand
+#: did not enclose stays on the table or is pushed and tipped by a few centimetres at most.
+GRASP_LIFT_THRESHOLD = 0.05
 
 
 class ObjectMonitor:
@@ -148,3 +156,10 @@ def outcome_labels(monitor: ObjectMonitor, quat_initial: np.ndarray, quat_final:
     height = monitor.z_start - monitor.table_top
     toppled = angle > TOPPLE_ANGLE and monitor.max_rise > TOPPLE_RISE * height
     return Labels(rolled=monitor.rolling_distance > roll_threshold, toppled=bool(toppled), tilt=angle)
+
+
+def grasp_success(rise: float, links_holding: Sequence[str], on_table: bool,
+                  threshold: float = GRASP_LIFT_THRESHOLD) -> bool:
+    """Whether a grasp holds the object, at the end of the hold: its centre rose at least ``threshold`` [m],
+    hand links touch it (``links_holding``, their names) and the table does not (``on_table``)."""
+    return bool(rise >= threshold and len(links_holding) > 0 and not on_table)

@@ -14,7 +14,7 @@ import numpy as np
 
 from affordance_env.objects import PRIMITIVES, ObjectGeometry
 from affordance_env.outcome import ObjectMonitor
-from affordance_env.robot_model import ACTIVE_JOINTS, CONTACT_LINKS
+from affordance_env.robot_model import HAND_COUPLINGS, coupled_position, get_variant
 
 #: Geom group that hides the scene's inactive object primitives from the range camera and the renderer.
 HIDDEN_GEOM_GROUP = 3
@@ -45,9 +45,14 @@ class TapPhysics:
     Args:
         model: A model built by :func:`affordance_env.scene.build_model`. It is modified in place when the
             object changes (sizes, masses), so give each ``TapPhysics`` its own model.
+        variant: The robot variant the model was built with (``"tap"`` or ``"grasp"``).
+
+    Robot joint vectors (positions, velocities, servo targets) are in the variant's ``active_joints`` order.
     """
 
-    def __init__(self, model: mujoco.MjModel) -> None:
+    def __init__(self, model: mujoco.MjModel, variant: str = "tap") -> None:
+        self.variant = get_variant(variant)
+        joints = self.variant.active_joints
         self.model = model
         self.data = mujoco.MjData(model)
         #: Data for side computations (kinematics of other configurations); never the simulated state.
@@ -58,10 +63,16 @@ class TapPhysics:
         joint = _id(model, obj.mjOBJ_JOINT, "object_free")
         self.object_qpos = int(model.jnt_qposadr[joint])
         self.object_qvel = int(model.jnt_dofadr[joint])
-        self.robot_qpos = np.array([model.jnt_qposadr[_id(model, obj.mjOBJ_JOINT, n)] for n in ACTIVE_JOINTS])
-        self.robot_qvel = np.array([model.jnt_dofadr[_id(model, obj.mjOBJ_JOINT, n)] for n in ACTIVE_JOINTS])
-        self.actuators = np.array([_id(model, obj.mjOBJ_ACTUATOR, n) for n in ACTIVE_JOINTS])
-        # Index with slices where the indices run in order (they do in the built scene): a slice is a view,
+        self.robot_qpos = np.array([model.jnt_qposadr[_id(model, obj.mjOBJ_JOINT, n)] for n in joints])
+        self.robot_qvel = np.array([model.jnt_dofadr[_id(model, obj.mjOBJ_JOINT, n)] for n in joints])
+        actuated = self.variant.actuated_joints
+        self.actuators = np.array([_id(model, obj.mjOBJ_ACTUATOR, n) for n in actuated])
+        #: Positions of the actuated joints in the active-joint vector (None when every active joint has a servo).
+        self._actuated = None if actuated == joints else np.array([joints.index(n) for n in actuated])
+        #: Coupled joints without a servo: (index, index of the joint they follow, its name) in active order.
+        self._coupled = [(joints.index(d), joints.index(p), d) for d, (p, _) in HAND_COUPLINGS.items()
+                         if d in joints]
+        # Index with slices where the indices run in order (they do in the built scenes): a slice is a view,
         # cheaper than fancy indexing at every control tick.
         self._qpos = _as_slice(self.robot_qpos)
         self._qvel = _as_slice(self.robot_qvel)
@@ -70,18 +81,23 @@ class TapPhysics:
         self.head_site = _id(model, obj.mjOBJ_SITE, "head")
         self.table_geom = _id(model, obj.mjOBJ_GEOM, "table_top")
         self.home_key = _id(model, obj.mjOBJ_KEY, "home")
-        contact_bodies = {_id(model, obj.mjOBJ_BODY, n) for n in CONTACT_LINKS}
+        contact_bodies = {_id(model, obj.mjOBJ_BODY, n) for n in self.variant.contact_links}
         self.hand_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] in contact_bodies])
         self._is_hand_geom = np.zeros(model.ngeom, dtype=bool)
         self._is_hand_geom[self.hand_geoms] = True
-        #: kv / kp of each position servo [s]: a target led by this times the reference velocity cancels the
-        #: servo's damping lag, so the joint follows a moving reference (velocity feedforward).
-        self.servo_kp = model.actuator_gainprm[self.actuators, 0].copy()
-        self.servo_lead = -model.actuator_biasprm[self.actuators, 2] / self.servo_kp
+        #: Servo stiffness kp [N m/rad] and kv / kp [s] per active joint (a coupled joint has no servo: infinite
+        #: stiffness, no lead). A target led by kv / kp times the reference velocity cancels the servo's damping
+        #: lag, so the joint follows a moving reference (velocity feedforward).
+        actuated_index = slice(None) if self._actuated is None else self._actuated
+        self.servo_kp = np.full(len(joints), np.inf)
+        self.servo_kp[actuated_index] = model.actuator_gainprm[self.actuators, 0]
+        self.servo_lead = np.zeros(len(joints))
+        self.servo_lead[actuated_index] = -model.actuator_biasprm[self.actuators, 2] / self.servo_kp[actuated_index]
         self._qacc, self._torque = np.zeros(model.nv), np.zeros(model.nv)  # only the robot's part of qacc is set
         self.ctrl_low = model.actuator_ctrlrange[self.actuators, 0].copy()
         self.ctrl_high = model.actuator_ctrlrange[self.actuators, 1].copy()
         self._ctrl = np.empty(len(self.actuators))
+        self.body_names = [model.body(b).name for b in range(model.nbody)]
         # The table is static: its top height and extent are fixed once.
         mujoco.mj_kinematics(model, self.scratch)
         centre = self.scratch.geom_xpos[self.table_geom]
@@ -113,33 +129,60 @@ class TapPhysics:
         mujoco.mj_forward(self.model, self.data)
 
     def joint_positions(self) -> np.ndarray:
-        """Robot joint angles in ACTIVE_JOINTS order [rad]."""
+        """Robot joint angles in active-joint order [rad]."""
         return self.data.qpos[self._qpos].copy()
 
     def joint_velocities(self) -> np.ndarray:
-        """Robot joint velocities in ACTIVE_JOINTS order [rad/s]."""
+        """Robot joint velocities in active-joint order [rad/s]."""
         return self.data.qvel[self._qvel].copy()
 
     def set_joint_targets(self, q: np.ndarray) -> None:
-        """Command the position servos to ``q`` [rad] (ACTIVE_JOINTS order), clipped to the joint ranges."""
+        """Command the position servos to ``q`` [rad] (active-joint order), clipped to the joint ranges; the values
+        of coupled joints, which have no servo, are ignored."""
+        if self._actuated is not None:
+            q = np.asarray(q)[self._actuated]
         # np.minimum/np.maximum into the control vector: np.clip's wrapper costs more than the clipping
         np.minimum(np.maximum(q, self.ctrl_low, out=self._ctrl), self.ctrl_high, out=self._ctrl)
         self.data.ctrl[self._act] = self._ctrl
 
     def inertial_lead(self, qdd: np.ndarray) -> np.ndarray:
         """Servo target offsets [rad] whose spring torques accelerate the robot's joints at ``qdd`` [rad/s^2]
-        (ACTIVE_JOINTS order) in the current configuration: M qdd / kp (acceleration feedforward)."""
+        (active-joint order) in the current configuration: M qdd / kp (acceleration feedforward; 0 for coupled
+        joints, which have no servo)."""
         self._qacc[self._qvel] = qdd
         mujoco.mj_mulM(self.model, self.data, self._torque, self._qacc)
         return self._torque[self._qvel] / self.servo_kp
 
     def joint_targets(self) -> np.ndarray:
-        """Current servo targets [rad]."""
-        return self.data.ctrl[self._act].copy()
+        """Current servo targets [rad] in active-joint order; a coupled joint's is where its coupling puts it at
+        the target of the joint it follows."""
+        if self._actuated is None:
+            return self.data.ctrl[self._act].copy()
+        q = self.data.qpos[self._qpos].copy()
+        q[self._actuated] = self.data.ctrl[self.actuators]
+        for i, j, name in self._coupled:
+            q[i] = coupled_position(name, q[j])
+        return q
 
     def hand_position(self) -> np.ndarray:
         """``p_world_hand``: palm centre in the world frame [m]."""
         return self.data.site_xpos[self.palm_site].copy()
+
+    def links_touching_object(self) -> set[str]:
+        """Names of the robot links (of the variant's contact links) in contact with the object."""
+        links = set()
+        obj, hand = self.active_geom, self._is_hand_geom
+        for g1, g2 in self.data.contact.geom[: self.data.ncon].tolist():
+            if g1 == obj and hand[g2]:
+                links.add(self.body_names[self.model.geom_bodyid[g2]])
+            elif g2 == obj and hand[g1]:
+                links.add(self.body_names[self.model.geom_bodyid[g1]])
+        return links
+
+    def object_touches_table(self) -> bool:
+        """Whether any contact joins the object and the table top."""
+        pair = {self.active_geom, self.table_geom}
+        return any({g1, g2} == pair for g1, g2 in self.data.contact.geom[: self.data.ncon].tolist())
 
     def hand_touches_object(self) -> bool:
         """Whether any contact joins the hand (or wrist, forearm) and the object."""

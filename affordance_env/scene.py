@@ -1,6 +1,8 @@
 """Build the MuJoCo model: the iCub from its URDF, attached into the table scene of ``assets/scene.xml``.
 
 Every step that changes the URDF robot is listed in ``assets/README.md``; :func:`build_spec` is that list in code.
+Two robot variants (:data:`affordance_env.robot_model.VARIANTS`): ``"tap"``, the right arm with the V2.5 hand,
+and ``"grasp"``, the left arm with the fingered ``left_hand_mk3`` hand (:func:`hand_spec`).
 """
 
 from __future__ import annotations
@@ -10,13 +12,19 @@ import numpy as np
 
 from affordance_env.assets_path import assets_dir
 from affordance_env.robot_model import (
-    ACTIVE_JOINTS,
-    ARM_JOINTS,
-    CONTACT_LINKS,
-    HAND_FRAME,
+    CAMERA_VISIBLE_LINKS,  # noqa: F401 (the tap variant's, named here beside the geom groups as before)
+    HAND_COUPLINGS,
+    HAND_JOINTS,
+    HAND_MOUNT_FRAME,
+    HAND_MOUNT_POS,
+    HAND_OPEN,
+    HAND_ROOT_LINK,
     HEAD_FRAME,
     NECK_JOINTS,
     TORSO_JOINTS,
+    coupled_position,
+    get_variant,
+    hand_urdf,
     icub_urdf,
 )
 
@@ -27,15 +35,23 @@ _PREFIX = "icub:"
 ROBOT_CONTYPE, ROBOT_CONAFFINITY = 2, 4
 
 #: Geom groups (the world's geoms are in group 0; MuJoCo's renderer draws groups 0-2): the robot's parts that
-#: the head's range camera can see, the right arm from the upper arm down, are in SEEN_ROBOT_GEOM_GROUP; the rest
-#: of the robot, which the camera never sees (torso, head, the hanging left arm), is in ROBOT_GEOM_GROUP and is
-#: not ray cast: with it the range image costs six times as much and looks the same.
+#: the head's range camera can see, the acting arm from the upper arm down (CAMERA_VISIBLE_LINKS of the tap
+#: variant, ``camera_visible_links`` of a variant), are in SEEN_ROBOT_GEOM_GROUP; the rest of the robot, which
+#: the camera never sees (torso, head, the hanging other arm), is in ROBOT_GEOM_GROUP and is not ray cast: with
+#: it the range image costs six times as much and looks the same.
 ROBOT_GEOM_GROUP, SEEN_ROBOT_GEOM_GROUP = 1, 2
-#: URDF links of the arm that can come into the camera's view.
-CAMERA_VISIBLE_LINKS: tuple[str, ...] = ("r_upper_arm", "r_elbow_1", "r_forearm", "r_wrist_1", "r_hand")
 
 #: Sliding friction of the hand's contact geoms (they take priority over the object's friction).
 HAND_FRICTION = 0.3
+#: Friction of the fingered hand's geoms (grasp variant): sliding, torsional [m], rolling [m]. The mk3 hand's
+#: fingertips and palm carry the iCub's tactile skin under a silicone cover; silicone rubber on wood or plastic
+#: has a sliding friction coefficient of about 1 (0.8-1.2 in handbook tables), which is what lets a hand hold
+#: an object by squeezing it. Torsional: (2/3) mu a for a soft pad pressed to a contact patch of radius a of
+#: about 5 mm. Rolling: 0.1 mm, a soft pad's small resistance to rolling an object between the fingers.
+FINGER_FRICTION = (1.0, 0.0033, 0.0001)
+#: Contact dimensionality of the fingered hand: 4, sliding and torsional friction, the "soft finger" contact
+#: model of grasping (a pad resists a held object's spin about the contact normal).
+FINGER_CONDIM = 4
 
 #: Position-servo stiffness per joint group [N m / rad].
 SERVO_KP: dict[str, float] = {"torso": 300.0, "neck": 50.0, "arm": 60.0, "wrist": 10.0}
@@ -44,6 +60,30 @@ ARMATURE = 0.02
 #: Joint damping [N m s / rad]: a small viscous friction. The servos are critically damped by their actuators;
 #: 1 N m s/rad on top overdamped the wrist (0.6 s to settle after each move).
 DAMPING = 0.1
+#: Finger joints of the mk3 hand (grasp variant). Position-servo stiffness [N m / rad]: at a 1 rad tracking error
+#: a finger presses with 1 N m, some 20 N at a fingertip 5 cm from its joint, of the order of a human's firm
+#: grip, and far below the URDF's placeholder effort limit (50 000). Damping [N m s / rad] and armature
+#: [kg m^2]: the URDF's damping of 1 N m s/rad is a placeholder that, against kp = 1, makes the fingers lag
+#: 30 degrees behind a 1 s closing ramp (time constant damping / kp = 1 s); 0.03 is a small gear friction
+#: (0.03 s) and the fingers track to a fraction of a degree. The armature, the reflected inertia of the finger's
+#: motor and gearbox, keeps the light links (10-17 g, inertias of 1e-6 kg m^2) well conditioned at the 2 ms
+#: timestep: 1e-3 kg m^2 gives a servo period of 2 pi sqrt(1e-3 / 1) = 0.2 s, a hundred timesteps.
+HAND_KP, HAND_DAMPING, HAND_ARMATURE = 1.0, 0.03, 1e-3
+#: Timestep of the grasp variant [s]. The tap scene's 2 ms resolves the impact of a tap; a grasp has no impact,
+#: and its fastest dynamics are resolved at 5 ms with at least 2 steps per time constant (MuJoCo's stability
+#: bound) and mostly 4 or more: the contacts' (MuJoCo's default 20 ms), the finger coupling's (10 ms, below), the
+#: finger servos' (sqrt(armature / kp) = 32 ms) and the arm servos' (25 ms and more). Over the 90 canonical
+#: grasps of ``benchmarks/grasp.py`` (seeds 0-89) the share held per third of sizes is 97, 63 and 7 % at 5 ms
+#: against 100, 53 and 7 % at 2 ms; 84 of the 90 end the same (at 2.5 ms, 88 end as at 2 ms): the others are
+#: pushed objects whose fate, like that of a tapped ball at the table's edge, turns on small differences. A step
+#: of the grasp, with its many contacts on a 30-degree-of-freedom robot, costs some 50 microseconds, so at 2 ms
+#: a grasp costs three to four taps, and at 5 ms about 1.6 (``benchmarks/env.py --behavior tap grasp``). It
+#: divides the 10 ms control tick.
+GRASP_TIMESTEP = 0.005
+#: Coupling of the distal finger joints to their proximal joints (MuJoCo ``equality joint``): the linkage is
+#: stiff, so the constraint is solved with a time constant of 10 ms (2 timesteps of the grasp variant, MuJoCo's
+#: stable minimum) and critical damping.
+COUPLING_SOLREF = (0.01, 1.0)
 
 #: Range camera: position in the head frame [m] (about eye height, in front of the head origin) and its
 #: orientation (MuJoCo cameras look along their -z axis; this one looks along the head's z axis, image up =
@@ -71,32 +111,121 @@ HOME_QPOS: dict[str, float] = {
 }
 
 
+#: The ``home`` keyframe of the grasp variant: the left arm raised as the right one is for the tap (the left
+#: arm's joint axes mirror the right arm's, so the same angles give the mirror pose), the hand open
+#: (HAND_OPEN: the thumb opposed to the fingers) and each distal joint where its coupling puts it.
+GRASP_HOME_QPOS: dict[str, float] = {
+    **{name: HOME_QPOS[name] for name in TORSO_JOINTS + NECK_JOINTS},
+    "l_shoulder_pitch": -1.0,
+    "l_shoulder_roll": 0.45,
+    "l_shoulder_yaw": 0.0,
+    "l_elbow": 1.2,
+    "l_wrist_prosup": 0.0,
+    "l_wrist_pitch": 0.0,
+    "l_wrist_yaw": 0.0,
+    **HAND_OPEN,
+    **{distal: float(coupled_position(distal, HAND_OPEN[proximal]))
+       for distal, (proximal, _) in HAND_COUPLINGS.items()},
+}
+
+
+def home_qpos(variant: str = "tap") -> dict[str, float]:
+    """Joint angles [rad] of the ``home`` keyframe of the robot ``variant``, by joint name."""
+    return dict(HOME_QPOS) if get_variant(variant).name == "tap" else dict(GRASP_HOME_QPOS)
+
+
 def _servo_kp(joint: str) -> float:
     if joint in TORSO_JOINTS:
         return SERVO_KP["torso"]
     if joint in NECK_JOINTS:
         return SERVO_KP["neck"]
-    if joint in ARM_JOINTS[4:]:
+    if joint in HAND_JOINTS:
+        return HAND_KP
+    if joint.endswith(("_wrist_prosup", "_wrist_pitch", "_wrist_yaw")):
         return SERVO_KP["wrist"]
     return SERVO_KP["arm"]
 
 
-def robot_spec() -> mujoco.MjSpec:
+def hand_inertias() -> dict[str, list[float]]:
+    """Inertia tensors of the mk3 hand's links whose URDF inertia is a placeholder, from their meshes.
+
+    The URDF gives 11 of its 12 links Ixx = Iyy = Izz = 0.01 kg m^2, a placeholder some thousand times too large
+    for links of 10-100 g. Each link's tensor is computed from its (closed) mesh as a solid of uniform density
+    (MuJoCo's exact mesh inertia), scaled by the URDF mass over the mesh's mass, and expressed in the link frame
+    about the URDF's centre of mass (the mesh's centroid lies within 0.3 mm of it). Returns
+    ``{link: [Ixx, Iyy, Izz, Ixy, Ixz, Iyz]}`` [kg m^2] for those links.
+    """
+    spec = mujoco.MjSpec.from_string(hand_urdf())
+    spec.compiler.fusestatic = False
+    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_TRUE
+    for mesh in spec.meshes:
+        mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_EXACT
+    placeholder = {body.name: body.mass for body in spec.bodies
+                   if body.name != "world" and np.allclose(body.fullinertia[:3], 0.01)}
+    model = spec.compile()
+    tensors = {}
+    for name, urdf_mass in placeholder.items():
+        b = model.body(name).id
+        R = np.empty(9)
+        mujoco.mju_quat2Mat(R, model.body_iquat[b])
+        R = R.reshape(3, 3)
+        inertia = (urdf_mass / model.body_mass[b]) * (R @ np.diag(model.body_inertia[b]) @ R.T)
+        tensors[name] = [inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]]
+    return tensors
+
+
+def _contact_geom(geom: mujoco.MjsGeom) -> None:
+    geom.contype = ROBOT_CONTYPE
+    geom.conaffinity = ROBOT_CONAFFINITY
+    geom.priority = 1
+
+
+def hand_spec() -> mujoco.MjSpec:
+    """The ``left_hand_mk3`` hand as MuJoCo reads its URDF, made simulable (see ``assets/README.md``)."""
+    spec = mujoco.MjSpec.from_string(hand_urdf())
+    inertias = hand_inertias()
+    for body in spec.bodies:
+        if body.name == "world":
+            continue
+        # Plausible inertias in place of the URDF's placeholders; the URDF's mass and centre of mass are kept.
+        if body.name in inertias:
+            body.fullinertia = inertias[body.name]
+        body.gravcomp = 1.0
+        for i, geom in enumerate(body.geoms):
+            geom.name = f"{body.name}_collision" + (f"_{i}" if i else "")
+            # Contact bits as the tap's hand: the hand touches objects and the table, never itself.
+            _contact_geom(geom)
+            geom.friction = list(FINGER_FRICTION)
+            geom.condim = FINGER_CONDIM
+            geom.group = SEEN_ROBOT_GEOM_GROUP
+            geom.rgba = [0.75, 0.75, 0.78, 1.0] if body.name == HAND_ROOT_LINK else [0.35, 0.35, 0.38, 1.0]
+    for joint in spec.joints:
+        joint.damping = [HAND_DAMPING, 0.0, 0.0]
+        joint.armature = HAND_ARMATURE
+    return spec
+
+
+def robot_spec(variant: str = "tap") -> mujoco.MjSpec:
     """The iCub as MuJoCo reads its URDF, made simulable (see ``assets/README.md``)."""
+    robot = get_variant(variant)
+    contact_links = robot.contact_links
+    visible_links = robot.camera_visible_links
     spec = mujoco.MjSpec.from_string(icub_urdf())
-    # 1. Lock every joint the project does not move (legs, left arm): the bodies become static and are fused.
+    # 1. Lock every joint the project does not move (legs, the other arm): the bodies become static and are fused.
     for joint in list(spec.joints):
-        if joint.name not in ACTIVE_JOINTS:
+        if joint.name not in robot.active_joints:
             spec.delete(joint)
-    # 2. Collisions: only the right hand, wrist and forearm touch the world; nothing touches the robot itself.
+    if robot.fingered:
+        _replace_hand(spec)
+    # 2. Collisions: only the acting hand, wrist and forearm touch the world; nothing touches the robot itself.
     for body in spec.bodies:
         for i, geom in enumerate(body.geoms):
             geom.name = f"{body.name}_collision" + (f"_{i}" if i else "")
-            contact = body.name in CONTACT_LINKS
+            contact = body.name in contact_links
             geom.contype = ROBOT_CONTYPE if contact else 0
             geom.conaffinity = ROBOT_CONAFFINITY if contact else 0
             geom.rgba = [0.75, 0.75, 0.78, 1.0]
-            geom.group = SEEN_ROBOT_GEOM_GROUP if body.name in CAMERA_VISIBLE_LINKS else ROBOT_GEOM_GROUP
+            geom.group = SEEN_ROBOT_GEOM_GROUP if body.name in visible_links else ROBOT_GEOM_GROUP
             if contact:
                 # The hand's shell is smooth plastic: low friction, and it wins over the object's friction.
                 geom.friction = [HAND_FRICTION, 0.005, 0.0001]
@@ -109,20 +238,48 @@ def robot_spec() -> mujoco.MjSpec:
         joint.damping = [DAMPING, 0.0, 0.0]
         joint.armature = ARMATURE
     # 5. Palm site (for hand queries) and the range camera in the head.
-    palm = spec.body(HAND_FRAME)
+    palm = spec.body(robot.hand_frame)
     palm.add_site(name="palm", size=[0.005, 0.005, 0.005], rgba=[0.2, 0.8, 0.2, 0.0])
     head = spec.body(HEAD_FRAME)
     head.add_site(name="head", size=[0.01, 0.01, 0.01], rgba=[0, 0, 0, 0])
     head.add_camera(name="range_camera", pos=list(RANGE_CAMERA_POS_HEAD), quat=list(RANGE_CAMERA_QUAT_HEAD),
                     fovy=RANGE_CAMERA_FOVY_DEG)
+    if robot.fingered:
+        _attach_hand(spec)
     return spec
 
 
-def build_spec() -> mujoco.MjSpec:
-    """The full scene: table, object and lights from ``assets/scene.xml`` with the robot attached."""
+def _replace_hand(spec: mujoco.MjSpec) -> None:
+    """Remove the V2.5 left hand (its mesh and its mass, those of the whole V2.5 hand) from ``l_hand``."""
+    hand = spec.body("l_hand")
+    for geom in list(hand.geoms):
+        spec.delete(geom)
+    # The link keeps no mass of its own: the mk3 palm, fused into it, brings its own.
+    hand.explicitinertial = False
+    hand.mass = 0.0
+    hand.fullinertia = [np.nan] * 6  # unset: no inertia of its own
+    hand.inertia = [0.0, 0.0, 0.0]
+    hand.ipos = [0.0, 0.0, 0.0]
+
+
+def _attach_hand(spec: mujoco.MjSpec) -> None:
+    """Mount the mk3 hand (:func:`hand_spec`) in HAND_MOUNT_FRAME, at HAND_MOUNT_POS, without rotation."""
+    frame = spec.body(HAND_MOUNT_FRAME).add_frame(name="mk3_mount", pos=list(HAND_MOUNT_POS))
+    prefix = "mk3:"
+    frame.attach_body(hand_spec().body(HAND_ROOT_LINK), prefix, "")
+    # Back to the URDF's names (meshes keep the prefix: geoms refer to them by name).
+    for elements in (spec.bodies, spec.joints, spec.geoms):
+        for element in elements:
+            if element.name.startswith(prefix):
+                element.name = element.name.removeprefix(prefix)
+
+
+def build_spec(variant: str = "tap") -> mujoco.MjSpec:
+    """The full scene: table, object and lights from ``assets/scene.xml`` with the robot ``variant`` attached."""
+    variant_ = get_variant(variant)
     spec = mujoco.MjSpec.from_file(str(assets_dir() / "scene.xml"))
     spec.compiler.fusestatic = True  # the URDF's fixed links (frames, sensors) fold into their moving parents
-    robot = robot_spec()
+    robot = robot_spec(variant)
     frame = spec.worldbody.add_frame(name="robot_base")
     # Attach under a prefix (MuJoCo warns that unprefixed attachments may not save), then give the robot's
     # elements back their URDF names so that MuJoCo and Pinocchio share them. Meshes keep the prefix: geoms
@@ -132,25 +289,35 @@ def build_spec() -> mujoco.MjSpec:
         for element in elements:
             if element.name.startswith(_PREFIX):
                 element.name = element.name.removeprefix(_PREFIX)
-    # 6. Position actuators on every active joint. (No sensors: a touch sensor on the palm cost 9 % of every
+    # 6. Position actuators on every actuated joint. (No sensors: a touch sensor on the palm cost 4-9 % of every
     #    step, and the contacts between hand and object are read from the contact list when needed.)
-    for name in ACTIVE_JOINTS:
+    for name in variant_.actuated_joints:
         joint = spec.joint(name)
         act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         act.set_to_position(kp=_servo_kp(name), dampratio=1.0)
         act.ctrlrange = joint.range
         act.ctrllimited = True
+    # 6b. The fingered hand's coupling: each distal joint follows its proximal joint; its timestep.
+    if variant_.fingered:
+        spec.option.timestep = GRASP_TIMESTEP
+    for distal, (proximal, coefficients) in HAND_COUPLINGS.items() if variant_.fingered else ():
+        equality = spec.add_equality(name=f"{distal}_coupling", type=mujoco.mjtEq.mjEQ_JOINT, name1=distal,
+                                     name2=proximal, objtype=mujoco.mjtObj.mjOBJ_JOINT, solref=list(COUPLING_SOLREF))
+        data = np.zeros(len(equality.data))  # polycoef: distal = sum_i data[i] proximal^i, i = 0..4
+        data[: len(coefficients)] = coefficients
+        equality.data = data
     # 7. The home keyframe.
+    home = home_qpos(variant)
     model = spec.compile()
     qpos = model.qpos0.copy()
-    for name, value in HOME_QPOS.items():
+    for name, value in home.items():
         qpos[model.jnt_qposadr[model.joint(name).id]] = value
-    ctrl = np.array([HOME_QPOS[name] for name in ACTIVE_JOINTS])
+    ctrl = np.array([home[name] for name in variant_.actuated_joints])
     spec.add_key(name="home", qpos=qpos.tolist(), ctrl=ctrl.tolist())
     return spec
 
 
-def build_model() -> mujoco.MjModel:
+def build_model(variant: str = "tap") -> mujoco.MjModel:
     """Compile :func:`build_spec` (about 1 s: the robot meshes are processed)."""
-    return build_spec().compile()
+    return build_spec(variant).compile()
 

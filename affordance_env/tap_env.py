@@ -14,9 +14,11 @@ from affordance_env.behaviors import (
     ACTION_DIM,
     BEHAVIORS,
     ROLL_THRESHOLD,
+    GraspBehavior,
     check_action,
     get_behavior,
     is_success,
+    plan_grasp,
     plan_stroke,
 )
 from affordance_env.camera import RangeCamera
@@ -25,13 +27,13 @@ from affordance_env.kinematics import Kinematics
 from affordance_env.motion import (
     HOLD_MAX_TIME,
     HOLD_SPEED_TOLERANCE,
+    GraspOutcome,
     MotionExecutor,
 )
 from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size, object_geometry
-from affordance_env.outcome import REST_DURATION, ObjectMonitor, outcome_labels
+from affordance_env.outcome import REST_DURATION, ObjectMonitor, grasp_success, outcome_labels
 from affordance_env.physics import TapPhysics
 from affordance_env.range_noise import add_kinect_noise, check_range_noise
-from affordance_env.robot_model import ACTIVE_JOINTS
 from affordance_env.scene import build_model
 
 #: Region of the table where objects are placed: centre (x, y) and half-widths [m].
@@ -49,8 +51,8 @@ MAX_START_ERROR, MAX_OBJECT_MOVED_BEFORE = 0.01, 0.003
 
 
 def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: tuple[bool, bool]) -> str | None:
-    """Why an interaction cannot be used, or None; see the class docstring. ``still``: whether the robot was
-    still for the initial and for the final snapshot."""
+    """Why an interaction cannot be used, or None; see the class docstring. ``stroke``: a StrokeOutcome or a
+    GraspOutcome; ``still``: whether the robot was still for the initial and for the final snapshot."""
     if fault is not None:
         return f"physics: {fault}"
     for snapshot, was_still in zip(("initial", "final"), still, strict=True):
@@ -59,9 +61,12 @@ def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: t
                     f"{HOLD_SPEED_TOLERANCE:g} rad/s after {HOLD_MAX_TIME:g} s of holding still)")
     if not visible_initially:
         return "perception: the object was not visible in the initial snapshot"
+    what = "grasp" if isinstance(stroke, GraspOutcome) else "stroke"
     if not stroke.ik_success:
-        return (f"ik: the stroke was not reachable (position error {stroke.ik_position_error * 1e3:.1f} mm, "
+        return (f"ik: the {what} was not reachable (position error {stroke.ik_position_error * 1e3:.1f} mm, "
                 f"orientation error {stroke.ik_orientation_error:.2f} rad)")
+    if what == "grasp":  # the hand meets the object on its way down, and may miss it: that is the grasp's outcome
+        return None
     if stroke.object_moved > MAX_OBJECT_MOVED_BEFORE:
         return f"reach: the arm moved the object by {stroke.object_moved * 1e3:.1f} mm before the stroke"
     if stroke.start_error > MAX_START_ERROR:
@@ -95,6 +100,17 @@ class TapAffordanceEnv(gym.Env):
     stroke moves the palm in a straight line at the action's speed and stops a short follow-through after the hand
     first touches the object.
 
+    ``behavior="grasp"`` is the paper's grasp, by the left arm with the fingered iCub hand of ``icub-models``
+    (``left_hand_mk3``: 11 finger joints driven by 7 servos, each distal joint coupled to its proximal one as on
+    the real hand; the right arm then hangs still): palm down over the object, the open hand descends to just
+    above the object's top, the fingers and the opposed thumb close on a ramp, the hand lifts 8 cm, holds still
+    for 1 s, carries the object 6 cm to the robot's left, puts it down and opens; the arm returns home and the
+    final snapshot sees the object where it was put down (a held object moved 6 cm) or where the attempt left it.
+    Only the fingers' servos move the object (no welds, no applied forces). Whether the object fits the open hand,
+    between the thumb and the fingertips, decides the outcome: with the default sizes about half the canonical
+    grasps hold (``info["success"]``), nearly all under 6.4 cm and few over 8.2 cm (``benchmarks/grasp.py``).
+    The grasp variant of the scene integrates at 5 ms instead of 2 (``affordance_env.scene.GRASP_TIMESTEP``).
+
     The world: a 60 x 100 cm wooden lab table whose top is what objects rest on and roll on (rolling resistance of
     wood on wood, see ``assets/README.md``); past its edges an object falls to the floor. The range camera in the
     head has the iCub eye camera's field of view (57 x 72 degrees at the default 4:3 image). The head keeps the
@@ -112,6 +128,14 @@ class TapAffordanceEnv(gym.Env):
     | 1 | lateral offset of the stroke, across its direction | -2 .. +2 cm |
     | 2 | hand speed along the stroke, 0.2 x 3 ** a m/s | 0.067 .. 0.6 m/s |
 
+    For ``behavior="grasp"``, 0 is the canonical grasp:
+
+    | index | meaning | range |
+    |-------|---------|-------|
+    | 0 | height of the palm above the object's top when the hand closes | -0.5 .. +1.5 cm |
+    | 1 | offset of the object across the hand, towards the little finger | -1.5 .. +1.5 cm |
+    | 2 | time to close the hand, 0.4 / 2 ** a s | 0.8 .. 0.2 s |
+
     Values outside [-1, 1], NaN or a wrong shape raise ``ValueError``.
 
     ## Observation Space
@@ -122,7 +146,9 @@ class TapAffordanceEnv(gym.Env):
     | ``range`` | (H, W) | float32 | distance along each pixel's ray [m]; 0 where nothing is hit |
     | ``mask`` | (H, W) | int8 | 1 on pixels of the object of interest |
     | ``features`` | (49,) | float32 | the paper's features, named by ``affordance_env.FEATURE_NAMES`` |
-    | ``joints`` | (13,) | float32 | robot joint angles [rad], order ``affordance_env.ACTIVE_JOINTS`` |
+    | ``joints`` | (13,) | float32 | robot joint angles [rad], order ``affordance_env.ACTIVE_JOINTS``; for the grasp
+      (24,): torso, neck, left arm and the 11 finger joints, order ``affordance_env.robot_model.VARIANTS["grasp"]
+      .active_joints`` |
 
     ## Rewards
     ``reward_fn(info)``; the default is the object's displacement on the table [m]. Affordance learning does not
@@ -139,8 +165,8 @@ class TapAffordanceEnv(gym.Env):
     The episode terminates after one interaction (``terminated=True``). The object is followed at every control
     tick from the start of the step, whatever the arm is doing (:mod:`affordance_env.outcome`). Once the arm is
     back home and still, the simulation goes on until the object is at rest (still for 50 ms after the first
-    touch), has left the table (detected the moment its centre crosses the table's edge), or ``settle_timeout``
-    seconds have passed since the first touch; then the final snapshot is taken.
+    touch; for the grasp, after the hand opened), has left the table (detected the moment its centre crosses the
+    table's edge), or ``settle_timeout`` seconds have passed since then; then the final snapshot is taken.
 
     ## Info
     After ``reset``: ``object`` (``type``, ``size`` [m], ``pose`` (7,) position and quaternion), ``attention``,
@@ -158,20 +184,28 @@ class TapAffordanceEnv(gym.Env):
     or left the table), ``contact`` (the hand touched the object), ``hand_speed`` [m/s],
     ``ik`` (``success``, ``position_error`` [m], ``orientation_error`` [rad]), ``visible`` (object seen in the
     final snapshot),
+    for the grasp only: ``success`` (the grasp held the object: at the end of the 1 s hold its centre had risen at
+    least 5 cm, ``affordance_env.outcome.GRASP_LIFT_THRESHOLD``, and it touched the hand and not the table; held
+    objects rise 6-9 cm, the others stay within millimetres of the table), ``grasp`` (``rise`` [m] at the end
+    of the hold, ``links_holding``: names of the hand links touching the object then, ``on_table``),
     ``failure``: None, or why the interaction is not a valid sample: ``"physics: ..."`` (MuJoCo reported an
     instability or the state became non-finite; then obs is blank, ``effect`` is zeros and ``outcome`` is
     ``"fault"``), ``"snapshot: ..."`` (the robot's head or arm still moved when a snapshot was taken),
-    ``"perception: ..."`` (object not visible initially), ``"ik: ..."`` (stroke not reachable),
+    ``"perception: ..."`` (object not visible initially), ``"ik: ..."`` (stroke or grasp not reachable),
     ``"reach: ..."`` (the arm touched the object before the stroke, or the stroke started more than 1 cm from
-    its planned pose), ``"tap: ..."`` (the hand never touched the object). The next ``reset`` recovers from any of them.
+    its planned pose), ``"tap: ..."`` (the hand never touched the object). A grasp is invalid only for physics,
+    snapshot, perception or ik: its hand meets the object on the way down, and a miss is a failed grasp
+    (``success`` False), not an invalid one. The next ``reset`` recovers from any of them.
 
     ## Arguments
 
     | argument | default | meaning |
     |----------|---------|---------|
-    | ``behavior`` | ``"tap"`` | ``"tap"``; ``"tap_back"`` (other side, back of hand); ``"push"`` (from the front) |
+    | ``behavior`` | ``"tap"`` | ``"tap"``; ``"tap_back"`` (other side, back of hand); ``"push"`` (from the front);
+      ``"grasp"`` (left arm, fingered hand; see Description) |
     | ``object_types`` | all four | types to sample from |
-    | ``size_range`` | (0.04, 0.10) | object size range [m] |
+    | ``size_range`` | (0.04, 0.10) | object size range [m]; for the grasp it straddles the critical size (about 7 cm;
+      spheres, which the fingers wrap, are held up to 10 cm, not at 11): both outcomes occur |
     | ``camera_width``, ``camera_height`` | 160, 120 | range image size [pixels] (the iCub eye camera's 4:3) |
     | ``camera_fovy`` | 57.4 | vertical field of view [deg]; the iCub eye camera's (fy = 219 px at 320 x 240) |
     | ``roll_threshold`` | 0.03 | rolling distance above which an interaction is ``rolled`` [m]; for ``push``, the
@@ -228,8 +262,9 @@ class TapAffordanceEnv(gym.Env):
         self.reward_fn = default_reward if reward_fn is None else reward_fn
         self.render_mode = render_mode
 
-        self.physics = TapPhysics(build_model())
-        self.kinematics = Kinematics()
+        robot = self.behavior.robot
+        self.physics = TapPhysics(build_model(robot), robot)
+        self.kinematics = Kinematics(variant=robot)
         self.motion = MotionExecutor(self.physics, self.kinematics)
         self.camera = RangeCamera(self.physics.model, width=camera_width, height=camera_height, fovy_deg=camera_fovy,
                                   support="table_top")
@@ -245,7 +280,7 @@ class TapAffordanceEnv(gym.Env):
             self.physics.on_step = self._record_frame
 
         H, W = camera_height, camera_width
-        nq = len(ACTIVE_JOINTS)
+        nq = self.kinematics.nq
         self.observation_space = spaces.Dict(
             {
                 "range": spaces.Box(0.0, self.camera.max_range, (H, W), np.float32),
@@ -381,14 +416,17 @@ class TapAffordanceEnv(gym.Env):
         action = check_action(action)
         initial, self._initial = self._initial, None
         physics = self.physics
-        plan = plan_stroke(self.behavior, initial["geometry"], initial["pose"][:3], initial["yaw"],
-                           physics.table_top, action)
+        grasping = isinstance(self.behavior, GraspBehavior)
+        plan = (plan_grasp if grasping else plan_stroke)(
+            self.behavior, initial["geometry"], initial["pose"][:3], initial["yaw"], physics.table_top, action)
         monitor = physics.start_monitor()  # from now on, whatever the arm does
         try:
-            stroke = self.motion.stroke(plan)
-            still = self.motion.go_home(self._q_home, via=stroke.q_withdraw)
-            outcome, outcome_time = self._wait_outcome(
-                monitor, stroke.contact_time if stroke.contact else physics.data.time)
+            stroke = self.motion.grasp(plan) if grasping else self.motion.stroke(plan)
+            still = self.motion.go_home(self._q_home, via=None if grasping else stroke.q_withdraw)
+            # The outcome is awaited from the first touch of a stroke, or from the release of a grasp.
+            since = stroke.release_time if grasping else (
+                stroke.contact_time if stroke.contact else physics.data.time)
+            outcome, outcome_time = self._wait_outcome(monitor, since)
         finally:
             physics.monitor = None
         if self.render_mode is not None:
@@ -416,8 +454,11 @@ class TapAffordanceEnv(gym.Env):
             else effect_features(initial["features"].values, final_features)
         )
         # The success label: a failed interaction is no sample, so no success either.
-        success = failure is None and labels is not None and is_success(
-            self.behavior.success_rule, labels.rolled, displacement, self.roll_threshold)
+        if grasping:  # lifted and held, from the simulation
+            success = failure is None and grasp_success(stroke.rise, stroke.links_holding, stroke.on_table)
+        else:
+            success = failure is None and labels is not None and is_success(
+                self.behavior.success_rule, labels.rolled, displacement, self.roll_threshold)
         info = {
             "object": {"type": initial["geometry"].object_type, "size": initial["geometry"].size,
                        "initial_pose": initial["pose"], "final_pose": final_pose},
@@ -440,6 +481,9 @@ class TapAffordanceEnv(gym.Env):
             "behavior": self.behavior.name,
             "failure": failure,
         }
+        if grasping:
+            info["grasp"] = {"rise": stroke.rise, "links_holding": stroke.links_holding,
+                             "on_table": stroke.on_table}
         reward = float(self.reward_fn(info))
         return obs, reward, True, False, info
 

@@ -65,7 +65,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo = sub.add_parser("demo", help="tap a few objects with the canonical tap and print what happened")
     demo.add_argument("--episodes", type=int, default=8, help="number of interactions (default 8)")
     demo.add_argument("--seed", type=int, default=0, help="seed of the first interaction (default 0)")
-    demo.add_argument("--behavior", default="tap", help="tap | tap_back | push (default tap)")
+    demo.add_argument("--behavior", default="tap", help="tap | tap_back | push | grasp (default tap)")
     demo.add_argument("--object", default=None, help="only this object type (default: all four)")
     demo.set_defaults(func=_demo)
 

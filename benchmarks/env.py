@@ -1,9 +1,11 @@
 """Interactions per second of TapAffordance-v0 on one core, and where the time goes.
 
-    python benchmarks/env.py [--episodes 200] [--repeats 3] [--width W] [--height H] [--behavior tap]
+    python benchmarks/env.py [--episodes 200] [--repeats 3] [--width W] [--height H] [--behavior tap [grasp ...]]
 
 Prints interactions per second (reset + step), and the share of wall time spent inside ``mj_step`` (physics),
-in ray casting (range camera) and in the 49 features, measured by timing those calls in the same run.
+in ray casting (range camera) and in the 49 features, measured by timing those calls in the same run. With
+several behaviours, they take turns round by round in the same run (so that they share the machine's load),
+and the wall time per interaction of each is compared with the first's.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ def main() -> None:
     parser.add_argument("--episodes", type=int, default=200)
     parser.add_argument("--width", type=int, default=None, help="range image width (default: the env's)")
     parser.add_argument("--height", type=int, default=None, help="range image height (default: the env's)")
-    parser.add_argument("--behavior", default="tap")
+    parser.add_argument("--behavior", nargs="+", default=["tap"], help="one or more behaviours, measured in turn")
     parser.add_argument("--repeats", type=int, default=3, help="rounds over the same interactions; best reported")
     args = parser.parse_args()
 
@@ -45,32 +47,50 @@ def main() -> None:
     mujoco.mj_step = timed("mj_step", original["mj_step"])
     mujoco.mj_multiRay = timed("ray casting", original["mj_multiRay"])
     tap_env_module.compute_features = timed("features", tap_env_module.compute_features)
+    per_interaction = {}
     try:
         size = {k: v for k, v in (("camera_width", args.width), ("camera_height", args.height)) if v is not None}
-        env = TapAffordanceEnv(behavior=args.behavior, **size)
-        env.reset(seed=0)
-        env.step(np.zeros(3))
-        rounds = []  # the same interactions each round; the machine's load varies, the best round is the figure
+        envs = {behavior: TapAffordanceEnv(behavior=behavior, **size) for behavior in args.behavior}
+        for env in envs.values():
+            env.reset(seed=0)
+            env.step(np.zeros(3))
+        # The same interactions each round; the behaviours take turns round by round, so that they share the
+        # machine's varying load; the best round of each is its figure.
+        rounds = {behavior: [] for behavior in envs}
+        simulated = dict.fromkeys(envs, 0.0)
         for _ in range(args.repeats):
-            spent.clear()
-            simulated = 0.0
-            start = time.perf_counter()
-            for i in range(args.episodes):
-                env.reset(seed=i)
-                env.step(np.zeros(3))
-                simulated += env.physics.data.time  # reset starts the clock at 0
-            rounds.append((time.perf_counter() - start, dict(spent)))
-        wall, spent = min(rounds, key=lambda r: r[0])
+            for behavior, env in envs.items():
+                spent.clear()
+                simulated[behavior] = 0.0
+                start = time.perf_counter()
+                for i in range(args.episodes):
+                    env.reset(seed=i)
+                    env.step(np.zeros(3))
+                    simulated[behavior] += env.physics.data.time  # reset starts the clock at 0
+                rounds[behavior].append((time.perf_counter() - start, dict(spent)))
+        for behavior, env in envs.items():
+            wall, best = min(rounds[behavior], key=lambda r: r[0])
+            per_interaction[behavior] = wall / args.episodes
+            _report(env, behavior, args, wall, best, rounds[behavior], simulated[behavior])
     finally:
         mujoco.mj_step, mujoco.mj_multiRay = original["mj_step"], original["mj_multiRay"]
+    first = args.behavior[0]
+    for behavior in args.behavior[1:]:
+        ratio = per_interaction[behavior] / per_interaction[first]
+        print(f"{behavior}: {1e3 * per_interaction[behavior]:.1f} ms per interaction, "
+              f"{ratio:.2f} x {first}'s {1e3 * per_interaction[first]:.1f} ms")
+
+
+def _report(env: TapAffordanceEnv, behavior: str, args: argparse.Namespace, wall: float, spent: dict[str, float],
+            rounds: list, simulated: float) -> None:
     width, height = env.camera.intrinsics.width, env.camera.intrinsics.height
-    print(f"{args.episodes} interactions ({args.behavior}, {width}x{height} range image) in {wall:.2f} s "
+    print(f"{args.episodes} interactions ({behavior}, {width}x{height} range image) in {wall:.2f} s "
           f"(best of {args.repeats} rounds; all: {', '.join(f'{r[0]:.2f}' for r in rounds)} s)")
     print(f"  interactions per second (one core): {args.episodes / wall:8.1f}")
     steps = simulated / env.physics.model.opt.timestep / args.episodes
     print(f"  physics steps per interaction     : {steps:8.0f} ({simulated / args.episodes:.2f} s simulated)")
     for name in ("mj_step", "ray casting", "features"):
-        print(f"  share of wall time in {name:<12}: {100 * spent[name] / wall:7.1f} %")
+        print(f"  share of wall time in {name:<12}: {100 * spent.get(name, 0.0) / wall:7.1f} %")
     print(f"  everything else (IK, control, ...): {100 * (1 - sum(spent.values()) / wall):7.1f} %")
 
 

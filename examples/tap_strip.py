@@ -51,7 +51,8 @@ def main() -> None:
     axes[1, 4].set_title("effect (final - initial features)")
     axes[1, 5].axis("off")
     axes[1, 5].text(0, 0.5, f"{info['object']['type']}, {info['object']['size'] * 100:.1f} cm\n"
-                    f"moved {info['displacement'] * 100:.1f} cm ({info['outcome']})\nrolled: {info['rolled']}",
+                    f"moved {info['displacement'] * 100:.1f} cm ({info['outcome']})\nrolled: {info['rolled']}"
+                    + (f"\nheld: {info['success']}" if "success" in info else ""),
                     fontsize=12)
     for ax in axes.flat[:10]:
         ax.set_xticks([])

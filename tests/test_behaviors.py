@@ -81,8 +81,8 @@ def test_bad_actions(action, match):
 
 
 def test_unknown_behavior_lists_valid_ones():
-    with pytest.raises(ValueError, match="tap, tap_back, push"):
-        get_behavior("grasp")
+    with pytest.raises(ValueError, match="tap, tap_back, push, grasp"):
+        get_behavior("pinch")
 
 
 def test_success_rules():
