@@ -46,6 +46,12 @@ class _Missing(Exception):
     """The results lack what a rule needs."""
 
 
+def _outcome_words(results: Mapping[str, Any]) -> tuple[str, str]:
+    """How a success and a failure read, from the results' config ("success" / "fail" when it does not say)."""
+    config = results.get("config", {})
+    return config.get("success_label", "success"), config.get("fail_label", "fail")
+
+
 def _mean(per_k: Mapping[str, Mapping[str, Any]], k: int | str) -> float:
     entry = per_k.get(str(k))
     if entry is None or entry.get("mean") is None:
@@ -208,10 +214,11 @@ def _two_cluster_sizes(results: Mapping[str, Any]) -> tuple[str, bool]:
 
 def _four_cluster_split(results: Mapping[str, Any]) -> tuple[str, bool]:
     clusters = _case(results, 4)
-    success = sum(c["rolled"] > c["not_rolled"] for c in clusters)
-    fail = sum(c["not_rolled"] > c["rolled"] for c in clusters)
+    success_label, fail_label = _outcome_words(results)
+    success = sum(c["success"] > c["fail"] for c in clusters)
+    fail = sum(c["fail"] > c["success"] for c in clusters)
     text = "; ".join(
-        f"cluster {c['cluster']}: {c['rolled']} rolled / {c['not_rolled']} not" for c in clusters
+        f"cluster {c['cluster']}: {c['success']} {success_label} / {c['fail']} {fail_label}" for c in clusters
     )
     return f"{text} -> {success} success and {fail} fail clusters", success == 2 and fail == 2
 
@@ -320,7 +327,7 @@ _CLAIMS: tuple[tuple[str, str, str, Callable[[Mapping[str, Any]], tuple[str, boo
     (
         "1 x 4 map: success/fail",
         "Two of the four clusters are success clusters, the other two fail clusters.",
-        "exactly 2 clusters with more rolled than not rolled and 2 with more not rolled (first trial)",
+        "exactly 2 clusters with more successes (rolled) than failures and 2 with more failures (first trial)",
         _four_cluster_split,
     ),
     (
@@ -391,10 +398,11 @@ def _table_rk(section: Mapping[str, Mapping[str, Any]], scale: float, digits: in
 
 def _case_tables(results: Mapping[str, Any]) -> list[str]:
     lines: list[str] = []
+    success_label, fail_label = _outcome_words(results)
     for k, clusters in sorted(results.get("case_studies", {}).items(), key=lambda item: int(item[0])):
         types = list(dict.fromkeys(t for c in clusters for t in c["types"]))
         lines += [f"### 1 x {k} map (first trial)", ""]
-        lines.append("| cluster | rolled | not rolled | " + " | ".join(types) + " | sizes [cm] |")
+        lines.append(f"| cluster | {success_label} | {fail_label} | " + " | ".join(types) + " | sizes [cm] |")
         lines.append("|---" * (4 + len(types)) + "|")
         for c in clusters:
             sizes = np.asarray(c["sizes"], dtype=float) * 100
@@ -402,7 +410,7 @@ def _case_tables(results: Mapping[str, Any]) -> list[str]:
                 f"{sizes.min():.1f}-{sizes.max():.1f} (median {np.median(sizes):.1f})" if sizes.size else "-"
             )
             counts = " | ".join(str(c["types"].get(t, 0)) for t in types)
-            lines.append(f"| {c['cluster']} | {c['rolled']} | {c['not_rolled']} | {counts} | {spread} |")
+            lines.append(f"| {c['cluster']} | {c['success']} | {c['fail']} | {counts} | {spread} |")
         lines.append("")
     return lines
 
@@ -420,6 +428,7 @@ def _effects_section(results: Mapping[str, Any], figures: Sequence[str]) -> list
     effects = results.get("effects")
     if not effects:
         return []
+    success_label, _ = _outcome_words(results)
     lines = [
         "## What the effects contain",
         "",
@@ -427,20 +436,21 @@ def _effects_section(results: Mapping[str, Any], figures: Sequence[str]) -> list
         "object where it stopped; an object that left the table or the view has the documented not-visible "
         "features (zeros), so its effect is just minus its initial features.",
         "",
-        f"- Rolled objects seen in the final snapshot: **{_pct(effects.get('rolled_visible'))}** "
-        f"(at rest and seen: {_pct(effects.get('rolled_rest_visible'))}); rolled objects whose effect is minus "
-        f"their initial features (they vanished): {_pct(effects.get('rolled_effect_is_minus_initial'))}.",
+        f"- Successes ({success_label}) whose object is seen in the final snapshot: "
+        f"**{_pct(effects.get('success_visible'))}** (at rest and seen: "
+        f"{_pct(effects.get('success_rest_visible'))}); successes whose effect is minus their initial features "
+        f"(the object vanished): {_pct(effects.get('success_effect_is_minus_initial'))}.",
         f"- Spearman correlation of the true travel with the 3-D motion seen (norm of the effect on mean_x, "
         f"mean_y, mean_z), over the objects seen at the end: "
         f"**{_num(effects.get('travel_vs_seen_motion'), digits=2)}**.",
         "",
-        "| type | n | rolled | at rest | seen at the end | left the table | travel [cm] | motion seen [cm] | "
+        f"| type | n | {success_label} | at rest | seen at the end | left the table | travel [cm] | motion seen [cm] | "
         "pixel count change | normal histogram change |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for t, row in effects.get("by_type", {}).items():
         lines.append(
-            f"| {t.replace('_', ' ')} | {row['n']} | {_pct(row['rolled'])} | {_pct(row['rest'])} | "
+            f"| {t.replace('_', ' ')} | {row['n']} | {_pct(row['success'])} | {_pct(row['rest'])} | "
             f"{_pct(row['visible_final'])} | {_pct(row['off_table'])} | {_num(row['displacement'], 100)} | "
             f"{_num(row['seen_motion'], 100)} | {_num(row['pixel_count_change'], 1, 0)} | "
             f"{_num(row['shape_change'], 1, 3)} |"
@@ -453,17 +463,46 @@ def _effects_section(results: Mapping[str, Any], figures: Sequence[str]) -> list
     return lines
 
 
+def _size_section(results: Mapping[str, Any]) -> list[str]:
+    """How success depends on object size, and the critical size where a logistic fit crosses 50 %."""
+    section = results.get("size_success")
+    if not section:
+        return []
+    success_label, _ = _outcome_words(results)
+    fit, critical = section.get("logistic"), section.get("critical_size")
+    if fit is None:
+        found = "Only one outcome: no logistic fit, no critical size."
+    elif critical is None:
+        found = (f"A logistic fit of success on size (slope {fit['slope'] / 100:+.2f} per cm of logit) does not "
+                 "cross 50 % within the sizes seen: no critical size.")
+    else:
+        found = (f"A logistic fit of success on size crosses 50 % at **{100 * critical:.1f} cm** (slope "
+                 f"{fit['slope'] / 100:+.2f} per cm of logit: success "
+                 f"{'falls' if fit['slope'] < 0 else 'rises'} with size).")
+    lines = ["## Success by object size", "", found, "",
+             "| size [cm] | " + " | ".join(f"{100 * b['low']:.1f}-{100 * b['high']:.1f}" for b in section["bins"])
+             + " |", "|---" * (len(section["bins"]) + 1) + "|",
+             "| interactions | " + " | ".join(str(b["n"]) for b in section["bins"]) + " |",
+             f"| {success_label} | " + " | ".join(_pct(b["success"]) for b in section["bins"]) + " |", "",
+             "![size_success](size_success.png)", ""]  # drawn by write_figures from the same results
+    return lines
+
+
 def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> str:
     """The Markdown text of the report (see :func:`write_report`)."""
     claims = evaluate_claims(results)
     tally = {v: sum(c.verdict == v for c in claims) for v in (AGREES, DISAGREES, NOT_COMPUTABLE)}
     config = results.get("config", {})
+    behavior = config.get("behavior", "tap")
+    success_label, fail_label = _outcome_words(results)
     lines = [
-        "# Reproduction of Akgun et al. 2009, tapping: our numbers beside the paper's",
+        f"# Reproduction of Akgun et al. 2009, {behavior}: our numbers beside the paper's",
         "",
         f"{config.get('n_rows', '?')} interactions, {config.get('n_trials', '?')} trials, "
         f"k = {config.get('ks', '?')}, r = {config.get('relevancies', '?')}, "
-        f"seed {config.get('random_state', '?')}.",
+        f"seed {config.get('random_state', '?')}. Success/fail labels: {success_label} / {fail_label} "
+        f"(the {config.get('label', 'success')!r} column); {_pct(config.get('success_fraction'))} of the "
+        "interactions succeeded.",
         "",
         f"**{tally[AGREES]} of {len(claims)} claims agree**, {tally[DISAGREES]} disagree, "
         f"{tally[NOT_COMPUTABLE]} could not be computed. Each verdict follows the rule beside it, applied to "
@@ -474,7 +513,7 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
     ]
     for c in claims:
         lines.append(f"| {c.topic} | {c.paper} | {c.rule} | {c.ours} | **{c.verdict}** |")
-    lines += [""] + _effects_section(results, figures)
+    lines += [""] + _effects_section(results, figures) + _size_section(results)
     lines += ["## Effect clusters", ""]
     lines += _table_k(
         results,
@@ -488,6 +527,7 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
     lines += [""] + _case_tables(results)
     for key, title, scale, digits in (
         ("shape_fraction", "Shape share of the selected features [%]", 100.0, 0),
+        ("size_fraction", "Size share of the selected features [%]", 100.0, 0),
         ("n_selected", "Number of selected features", 1.0, 1),
         ("svm_accuracy", "SVM accuracy on held-out interactions [%]", 100.0, 1),
     ):
@@ -496,7 +536,9 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
     if "svm_baseline" in results:
         lines += ["Always answering the most common training category:", ""]
         lines += _table_k(results, [("svm_baseline", "baseline accuracy [%]", 100.0, 1)]) + [""]
-    shown = [f for f in figures if Path(f).name != "prototypes.png" or "effects" not in results]  # shown above
+    above = {"prototypes.png"} if "effects" in results else set()
+    above |= {"size_success.png"} if results.get("size_success") else set()
+    shown = [f for f in figures if Path(f).name not in above]  # shown above
     if shown:
         lines += ["## Figures", ""] + [f"![{Path(f).stem}]({Path(f).name})" for f in shown] + [""]
     if config:

@@ -105,9 +105,12 @@ def summary(results: dict, report: Path) -> str:
     claims = evaluate_claims(results)
     ks = sorted(uniformity)
     lines = [f"Report: {report} (figures and results.json beside it)"]
-    if effects.get("rolled_visible") is not None:
-        lines.append(f"  rolled objects seen where they stopped: {100 * effects['rolled_visible']:.0f} %; true travel "
-                     f"vs motion seen, Spearman {effects['travel_vs_seen_motion']:.2f}")
+    if effects.get("success_visible") is not None:
+        label = results.get("config", {}).get("success_label", "success")
+        correlation = effects.get("travel_vs_seen_motion")
+        lines.append(f"  successes ({label}) whose object is seen where it stopped: "
+                     f"{100 * effects['success_visible']:.0f} %"
+                     + ("" if correlation is None else f"; true travel vs motion seen, Spearman {correlation:.2f}"))
     lines.append(f"  uniformity: {uniformity[ks[0]]:.1f} % (k = {ks[0]}) to {uniformity[ks[-1]]:.1f} % "
                  f"(k = {ks[-1]}), mean {np.mean(list(uniformity.values())):.1f} % (paper: above 80 %)")
     lines.append(f"  SVM accuracy at r = 0.4: {100 * acc[min(acc)]:.1f} % (k = {min(acc)}) to "

@@ -39,7 +39,7 @@ def test_reproduce_writes_results_figures_and_report(tmp_path, capsys):
     # progress bars for each stage, and the headline numbers at the end
     assert all(stage in printed.err for stage in ("dataset", "learning trials", "figures"))
     assert f"Report: {out / 'REPORT.md'}" in printed.out and "uniformity:" in printed.out
-    assert "the paper's claims:" in printed.out and "rolled objects seen where they stopped" in printed.out
+    assert "the paper's claims:" in printed.out and "successes (rolled) whose object is seen" in printed.out
     # a second run reuses the dataset instead of collecting again: its chunk files are not rewritten
     chunks = {p: p.stat().st_mtime_ns for p in (out / "dataset").glob("chunk-*.parquet")}
     assert main(["reproduce", "--episodes", "40", "--trials", "1", "--workers", "1", "--out", str(out)]) == 0

@@ -43,6 +43,7 @@ def test_synthetic_frame_has_the_dataset_schema(frame: pd.DataFrame) -> None:
     )
     assert set(frame["type"]) == {"sphere", "box", "horizontal_cylinder", "vertical_cylinder"}
     assert frame["rolled"].dtype == bool and frame["size"].between(0.04, 0.10).all()
+    assert frame["success"].equals(frame["rolled"]) and set(frame["behavior"]) == {"tap"}
     assert feature_groups(names).count("shape") == 24
 
 
@@ -50,7 +51,7 @@ def test_results_follow_the_schema(results: dict, frame: pd.DataFrame) -> None:
     k_keys = [str(k) for k in KS]
     r_keys = ["0.0", "0.4"]
     assert list(results["uniformity"]) == k_keys
-    for key in ("svm_accuracy", "shape_fraction", "n_selected"):
+    for key in ("svm_accuracy", "shape_fraction", "size_fraction", "n_selected"):
         assert list(results[key]) == r_keys
         for r in r_keys:
             assert list(results[key][r]) == k_keys
@@ -60,16 +61,24 @@ def test_results_follow_the_schema(results: dict, frame: pd.DataFrame) -> None:
     assert all(0.0 <= v["mean"] <= 100.0 for v in results["uniformity"].values())
     assert all(0.0 <= v["mean"] <= 1.0 for r in r_keys for v in results["svm_accuracy"][r].values())
     assert all(1 <= v["mean"] <= 49 for r in r_keys for v in results["n_selected"][r].values())
-    assert list(results["case_studies"]) == ["2", "4"]
+    assert list(results["case_studies"]) == ["2", "3", "4"]
     for k, clusters in results["case_studies"].items():
         assert [c["cluster"] for c in clusters] == list(range(int(k)))
-        assert all(set(c) == {"cluster", "rolled", "not_rolled", "types", "sizes"} for c in clusters)
-        assert sum(c["rolled"] + c["not_rolled"] for c in clusters) == len(frame)
+        assert all(set(c) == {"cluster", "success", "fail", "types", "sizes"} for c in clusters)
+        assert sum(c["success"] + c["fail"] for c in clusters) == len(frame)
+        assert sum(c["success"] for c in clusters) == frame["success"].sum()
         assert sum(len(c["sizes"]) for c in clusters) == len(frame)
         assert sum(sum(c["types"].values()) for c in clusters) == len(frame)
     config = results["config"]
     assert config["n_trials"] == 3 and config["ks"] == list(KS) and config["relevancies"] == list(RS)
     assert config["feature_groups"] == {"shape": 24, "size": 18, "relation": 7}
+    assert config["behavior"] == "tap" and config["label"] == "success"
+    assert (config["success_label"], config["fail_label"]) == ("rolled", "did not roll")
+    assert config["success_fraction"] == pytest.approx(frame["success"].mean())
+    assert config["case_study_ks"] == [2, 3, 4]
+    assert set(results["size_success"]) == {"bins", "logistic", "critical_size"}
+    assert sum(b["n"] for b in results["size_success"]["bins"]) == len(frame)
+    assert set(results["effects"]["by_type"]["sphere"]) >= {"success", "visible_final"}
     assert json.loads(json.dumps(results, allow_nan=False)) == results
 
 
@@ -79,10 +88,12 @@ def test_protocol_finds_the_papers_structure_in_synthetic_taps(results: dict) ->
     assert results["shape_fraction"]["0.4"]["3"]["mean"] > 0.8
     assert results["n_selected"]["0.4"]["2"]["mean"] < results["n_selected"]["0.0"]["2"]["mean"]
     assert results["svm_accuracy"]["0.4"]["2"]["mean"] > results["svm_baseline"]["2"]["mean"]
-    # the share counts shape features only: never more of them than the 24 there are
+    # the shares count shape (size) features only: never more of them than the 24 (18) there are
     for r, per_k in results["shape_fraction"].items():
         for k, share in per_k.items():
+            size = results["size_fraction"][r][k]["mean"]
             assert share["mean"] * results["n_selected"][r][k]["mean"] <= 24.5, (r, k)
+            assert size * results["n_selected"][r][k]["mean"] <= 18.5 and share["mean"] + size <= 1.0 + 1e-9
 
 
 def test_results_do_not_depend_on_n_jobs(frame: pd.DataFrame, results: dict) -> None:
@@ -112,16 +123,52 @@ def test_protocol_refuses_bad_arguments(frame: pd.DataFrame, kwargs: dict, match
 
 
 def test_protocol_refuses_bad_frames(frame: pd.DataFrame) -> None:
-    with pytest.raises(ValueError, match="'rolled'"):
-        run_protocol(frame.drop(columns="rolled"))
+    with pytest.raises(ValueError, match="no 'success' column .nor 'rolled'"):
+        run_protocol(frame.drop(columns=["success", "rolled"]))
     with pytest.raises(ValueError, match="no initial_"):
-        run_protocol(frame[["type", "size", "rolled"]])
+        run_protocol(frame[["type", "size", "success"]])
+    with pytest.raises(ValueError, match="no 'behavior' column; pass the behaviour"):
+        run_protocol(frame.drop(columns="behavior"))
+    mixed = frame.assign(behavior=np.where(np.arange(len(frame)) % 2, "tap", "grasp"))
+    with pytest.raises(ValueError, match=r"mixes the behaviours \['grasp', 'tap'\]"):
+        run_protocol(mixed)
+    with pytest.raises(ValueError, match="holds 'tap' interactions, not 'grasp'"):
+        run_protocol(frame, behavior="grasp")
     broken = frame.copy()
     broken.loc[5, "effect_mean_x"] = np.nan
     with pytest.raises(ValueError, match="row 5, column effect_mean_x"):
         run_protocol(broken)
     with pytest.raises(ValueError, match="expected at least 2 of each"):
         run_protocol(frame.iloc[:5], test_size=0.1)
+
+
+def test_the_label_is_success_or_else_rolled(frame: pd.DataFrame) -> None:
+    # a label that differs from rolled: uniformity and the case study follow success, not rolled
+    flipped = frame.assign(success=~frame["rolled"], behavior="push")
+    kwargs = {"ks": (2, 3), "relevancies": (0.4,), "n_trials": 1, "som_iterations": 200}
+    ours = run_protocol(flipped, **kwargs)
+    assert ours["config"]["label"] == "success" and ours["config"]["behavior"] == "push"
+    assert (ours["config"]["success_label"], ours["config"]["fail_label"]) == ("moved", "did not move")
+    assert sum(c["success"] for c in ours["case_studies"]["2"]) == (~frame["rolled"]).sum()
+    # a frame without success (made before the label existed) is evaluated against rolled, and says so
+    old = run_protocol(frame.drop(columns=["success", "behavior"]), behavior="tap", **kwargs)
+    assert old["config"]["label"] == "rolled" and old["config"]["success_label"] == "rolled"
+    assert sum(c["success"] for c in old["case_studies"]["2"]) == frame["rolled"].sum()
+    assert old["uniformity"] == ours["uniformity"]  # |S - F| is the same with the labels swapped
+
+
+def test_synthetic_grasps_have_a_critical_size() -> None:
+    grasps = make_synthetic_frame(400, random_state=3, behavior="grasp")
+    assert set(grasps["behavior"]) == {"grasp"} and grasps["size"].between(0.03, 0.09).all()
+    results = run_protocol(grasps, ks=(2, 3, 4), relevancies=(0.4,), n_trials=1, som_iterations=300)
+    config = results["config"]
+    assert config["behavior"] == "grasp"
+    assert (config["success_label"], config["fail_label"]) == ("lifted and held", "not held")
+    assert results["size_success"]["critical_size"] == pytest.approx(0.06, abs=0.004)
+    assert results["size_success"]["logistic"]["slope"] < 0
+    assert results["size_fraction"]["0.4"]["2"]["mean"] > 0.5  # held or not is decided by size
+    with pytest.raises(ValueError, match="behavior must be one of"):
+        make_synthetic_frame(40, behavior="juggle")
 
 
 def test_a_frame_too_small_to_stratify_gets_a_random_split(frame: pd.DataFrame) -> None:
@@ -153,9 +200,11 @@ def test_figures_and_report_are_written(results: dict, tmp_path: Path) -> None:
         "uniformity.png",
         "selected_features.png",
         "case_study_k2.png",
+        "case_study_k3.png",
         "case_study_k4.png",
         "svm_accuracy.png",
         "prototypes.png",
+        "size_success.png",
     } <= names
     for path in paths:
         data = path.read_bytes()
@@ -164,6 +213,8 @@ def test_figures_and_report_are_written(results: dict, tmp_path: Path) -> None:
     text = report.read_text()
     assert report.name == "REPORT.md"
     assert "uniformity.png" in text and "| Uniformity on average |" in text
+    assert "# Reproduction of Akgun et al. 2009, tap:" in text and "| cluster | rolled | did not roll |" in text
+    assert "## Success by object size" in text and "![size_success](size_success.png)" in text
     assert text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**") == 14
     again = write_report(json.loads(json.dumps(results)), tmp_path / "again").read_text()
     assert again.split("## Configuration")[0] == text.split("## Figures")[0]  # same numbers from the JSON
@@ -189,21 +240,21 @@ def _paper_like(results: dict) -> dict:
         "2": [
             {
                 "cluster": 0,
-                "rolled": 480,
-                "not_rolled": 20,
+                "success": 480,
+                "fail": 20,
                 "types": {"sphere": 250, "horizontal_cylinder": 240, "box": 5, "vertical_cylinder": 5},
                 "sizes": sizes,
             },
             {
                 "cluster": 1,
-                "rolled": 10,
-                "not_rolled": 490,
+                "success": 10,
+                "fail": 490,
                 "types": {"sphere": 0, "horizontal_cylinder": 10, "box": 245, "vertical_cylinder": 245},
                 "sizes": sizes,
             },
         ],
         "4": [
-            {"cluster": c, "rolled": r, "not_rolled": n, "types": {}, "sizes": sizes}
+            {"cluster": c, "success": r, "fail": n, "types": {}, "sizes": sizes}
             for c, (r, n) in enumerate([(240, 5), (230, 20), (5, 245), (10, 245)])
         ],
     }
@@ -238,7 +289,7 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
     rising = {2: 0.6, 3: 0.65, 4: 0.55, 5: 0.7, 6: 0.72, 7: 0.75, 8: 0.78, 9: 0.8, 10: 0.82}
     worse["svm_accuracy"] = {r: {str(k): {"mean": a, "std": 0.0} for k, a in rising.items()} for r in rs}
     worse["case_studies"]["2"][0]["sizes"], worse["case_studies"]["2"][1]["sizes"] = [0.04, 0.05], [0.09, 0.1]
-    worse["case_studies"]["4"][2]["rolled"], worse["case_studies"]["4"][2]["not_rolled"] = 200, 5
+    worse["case_studies"]["4"][2]["success"], worse["case_studies"]["4"][2]["fail"] = 200, 5
     verdicts = {c.topic: c.verdict for c in evaluate_claims(worse)}
     for topic in (
         "Shape features dominate",

@@ -30,6 +30,7 @@ from affordance_learning import (
 )
 from affordance_learning import default_model as default_model_module
 from affordance_learning.experiment import make_synthetic_frame
+from affordance_learning.metrics import size_success
 
 # --------------------------------------------------------------------------------------------- fixtures
 
@@ -87,6 +88,25 @@ def test_purity_rand_and_cross_validated_svm() -> None:
     assert svm_cv_accuracy(X[:, [2, 7]], classes) > 0.9
     with pytest.raises(ValueError, match="at least 2 classes"):
         svm_cv_accuracy(X, np.zeros(300))
+
+
+def test_size_success_finds_where_success_turns_to_failure() -> None:
+    rng = np.random.default_rng(0)
+    sizes = rng.uniform(0.03, 0.09, 2000)
+    held = rng.random(2000) < 1 / (1 + np.exp((sizes - 0.055) / 0.004))
+    found = size_success(sizes, held, n_bins=6)
+    assert found["critical_size"] == pytest.approx(0.055, abs=0.002) and found["logistic"]["slope"] < 0
+    assert [b["n"] for b in found["bins"]] and sum(b["n"] for b in found["bins"]) == 2000
+    assert found["bins"][0]["success"] > 0.95 and found["bins"][-1]["success"] < 0.05
+    # success independent of size (90 % everywhere): a fit, but no crossing of 50 % among the sizes seen
+    coin = size_success(sizes, rng.random(2000) < 0.9)
+    assert coin["logistic"] is not None and coin["critical_size"] is None
+    # one outcome only: nothing to fit
+    always = size_success(sizes, np.ones(2000, dtype=bool))
+    assert always["logistic"] is None and always["critical_size"] is None
+    assert all(b["success"] == 1.0 for b in always["bins"])
+    with pytest.raises(ValueError, match="same length"):
+        size_success(sizes, held[:5])
 
 
 # -------------------------------------------------------------------------------------------------- SOM
