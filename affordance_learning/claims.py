@@ -4,6 +4,14 @@ Each statement of Akgun et al. 2009 (section V) becomes a :class:`Claim` with a 
 verdict is "agrees" or "disagrees" by that rule, or "not computable" when the results lack what the rule
 needs (for example k = 4 was not run). The rules are judgement calls written in the report beside each
 verdict, so a reader can disagree with a rule without having to trust prose.
+
+The paper reports two behaviours, and the claims are chosen by the behaviour of the results
+(``results["config"]["behavior"]``, see :func:`claims_for`):
+
+- ``tap``: its 14 statements on tapping (uniformity, selected features, the 1 x 2 and 1 x 4 maps, the SVM).
+- ``grasp``: its statements on grasping (average uniformity, the fall at k = 3, the critical size, the 1 x 3
+  category that straddles it, size deciding the grasp) with those on the method that hold for any behaviour.
+- any other behaviour: only the statements on the method.
 """
 
 from __future__ import annotations
@@ -123,14 +131,22 @@ def _by_r(results: Mapping[str, Any], key: str) -> dict[float, tuple[list[int], 
     return {float(r): _curve(per_k) for r, per_k in section.items()}
 
 
-def _shape_dominates(results: Mapping[str, Any]) -> tuple[str, bool]:
-    curves = _by_r(results, "shape_fraction")
+def _group_dominates(results: Mapping[str, Any], group: str) -> tuple[str, bool]:
+    curves = _by_r(results, f"{group}_fraction")
     means = {r: 100.0 * v.mean() for r, (_, v) in sorted(curves.items())}
     positive = {r: m for r, m in means.items() if r > 0}
     if not positive:
         raise _Missing("no relevancy r > 0")
-    text = "mean shape share over k: " + ", ".join(f"r = {r}: {m:.0f} %" for r, m in means.items())
+    text = f"mean {group} share over k: " + ", ".join(f"r = {r}: {m:.0f} %" for r, m in means.items())
     return text, all(m > 50.0 for m in positive.values())
+
+
+def _shape_dominates(results: Mapping[str, Any]) -> tuple[str, bool]:
+    return _group_dominates(results, "shape")
+
+
+def _size_dominates(results: Mapping[str, Any]) -> tuple[str, bool]:
+    return _group_dominates(results, "size")
 
 
 def _shape_share_falls_with_lower_r(results: Mapping[str, Any]) -> tuple[str, bool]:
@@ -266,25 +282,160 @@ def _best_r(results: Mapping[str, Any]) -> tuple[str, bool]:
     return f"{text}; fewest features within 1 point of the best accuracy: r = {choice}", choice == 0.4
 
 
-_CLAIMS: tuple[tuple[str, str, str, Callable[[Mapping[str, Any]], tuple[str, bool]]], ...] = (
+# --- the grasp ----------------------------------------------------------------------------------------------
+#: The grasp's average uniformity: above the paper's 70 % and not above the tap's 80 %, which it sets apart.
+GRASP_UNIFORMITY = (70.0, 80.0)
+#: A 1 x 3 category straddles the critical size when at least this share of its objects lies on each side
+#: of it, and at least this share of its members has its less common outcome.
+STRADDLE_SHARE = 0.2
+#: The critical size decides the grasp when successes are this much more common below it than above it.
+CRITICAL_SIZE_CONTRAST = 0.5
+
+
+def _grasp_uniformity_average(results: Mapping[str, Any]) -> tuple[str, bool]:
+    ks, u = _curve(_section(results, "uniformity"))
+    low, high = GRASP_UNIFORMITY
+    return f"mean over k = {ks[0]}..{ks[-1]}: {u.mean():.1f} % (per k: {_fmt(u)})", bool(low < u.mean() <= high)
+
+
+def _fall_at_three(results: Mapping[str, Any]) -> tuple[str, bool]:
+    section = _section(results, "uniformity")
+    u2, u3, u4 = (_mean(section, k) for k in (2, 3, 4))
+    return f"mean uniformity at k = 2, 3, 4: {u2:.1f}, {u3:.1f}, {u4:.1f} %", u3 < u2 and u3 < u4
+
+
+def _critical_size(results: Mapping[str, Any]) -> tuple[str, bool]:
+    section = _section(results, "size_success")
+    fit, critical = section.get("logistic"), section.get("critical_size")
+    if fit is None:
+        return "one outcome only: no size separates success from failure", False
+    if critical is None:
+        return (f"the logistic fit (slope {fit['slope'] / 100:+.2f} per cm of logit) does not cross 50 % within "
+                "the sizes seen", False)
+    below, above = section["below"], section["above"]
+    if below["success"] is None or above["success"] is None:
+        raise _Missing("no object on one side of the critical size")
+    contrast = below["success"] - above["success"]
+    text = (f"the fit crosses 50 % at {100 * critical:.1f} cm (slope {fit['slope'] / 100:+.2f} per cm of logit); "
+            f"successes below it {100 * below['success']:.0f} % of {below['n']}, above it "
+            f"{100 * above['success']:.0f} % of {above['n']}")
+    return text, bool(fit["slope"] < 0 and contrast >= CRITICAL_SIZE_CONTRAST)
+
+
+def _straddling_cluster(results: Mapping[str, Any]) -> tuple[str, bool]:
+    critical = _section(results, "size_success").get("critical_size")
+    if critical is None:
+        raise _Missing("no critical size: the fit of success on size does not cross 50 % within the sizes seen")
+    success_label, fail_label = _outcome_words(results)
+    parts, straddling = [], []
+    for c in _case(results, 3):
+        sizes = np.asarray(c["sizes"], dtype=float)
+        if sizes.size == 0:
+            parts.append(f"cluster {c['cluster']}: empty")
+            continue
+        below = float(np.mean(sizes < critical))
+        minority = min(c["success"], c["fail"]) / max(c["success"] + c["fail"], 1)
+        if min(below, 1.0 - below) >= STRADDLE_SHARE and minority >= STRADDLE_SHARE:
+            straddling.append(str(c["cluster"]))
+        parts.append(f"cluster {c['cluster']}: {100 * sizes.min():.1f}-{100 * sizes.max():.1f} cm, "
+                     f"{100 * below:.0f} % below; {c['success']} {success_label} / {c['fail']} {fail_label}")
+    text = (f"critical size {100 * critical:.1f} cm; " + "; ".join(parts)
+            + f" -> straddling: {', '.join(straddling) or 'none'}")
+    return text, bool(straddling)
+
+
+_Judge = Callable[[Mapping[str, Any]], tuple[str, bool]]
+#: A claim before it is judged: topic, the paper's statement, the rule, and the function that applies it.
+_Spec = tuple[str, str, str, _Judge]
+
+_UNIFORMITY_RISES: _Spec = (
+    "Uniformity rises with k",
+    "Uniformity of clusters increases with the number of clusters.",
+    "Spearman rank correlation of k and mean uniformity >= 0.5",
+    _uniformity_rises,
+)
+_UNIFORMITY_PEAK: _Spec = (
+    "Uniformity peak",
+    "It can reach up to 95 %.",
+    "highest mean uniformity over k >= 90 %",
+    _uniformity_peak,
+)
+_FEWER_FEATURES: _Spec = (
+    "Fewer features as r rises",
+    "The number of selected features tends to be inversely proportional to r.",
+    "for every k the mean number never grows with r, and is lower at the largest r than at the smallest",
+    _count_falls_with_r,
+)
+_NUMBER_CONSTANT: _Spec = (
+    "Number constant in k",
+    "The number of selected features remains the same above some number of clusters.",
+    "for every r, the coefficient of variation over k >= 4 of the mean number <= 0.15",
+    _count_constant_in_k,
+)
+_ACCURACY_FALLS: _Spec = (
+    "SVM accuracy falls with k",
+    "SVM prediction accuracy decreases as the number of effect categories grows.",
+    "for every r, Spearman rank correlation of k and mean accuracy <= -0.5",
+    _accuracy_falls,
+)
+
+#: The paper's statements on the method, which do not depend on the behaviour.
+METHOD_CLAIMS: tuple[_Spec, ...] = (_UNIFORMITY_RISES, _FEWER_FEATURES, _NUMBER_CONSTANT, _ACCURACY_FALLS)
+
+GRASP_CLAIMS: tuple[_Spec, ...] = (
+    (
+        "Uniformity on average",
+        "The average uniformity is above ... 70 % for grasping.",
+        f"mean over k of the mean uniformity > {GRASP_UNIFORMITY[0]:.0f} % and <= {GRASP_UNIFORMITY[1]:.0f} % "
+        "(the paper sets the grasp's average apart from the tap's 'above 80 %')",
+        _grasp_uniformity_average,
+    ),
+    _UNIFORMITY_RISES,
+    _UNIFORMITY_PEAK,
+    (
+        "Fall at k = 3",
+        "There is a fall in the general trend of increase in the grasp behaviour for the 3 cluster case.",
+        "mean uniformity at k = 3 below both k = 2 and k = 4",
+        _fall_at_three,
+    ),
+    (
+        "Critical size",
+        "The grasping behaviour is affected mostly by the size of the object ... there is a critical size value "
+        "determining the graspability.",
+        "a logistic fit of success on object size crosses 50 % within the sizes seen (the critical size), "
+        "success falls with size, and the share of successes below the critical size is at least "
+        f"{100 * CRITICAL_SIZE_CONTRAST:.0f} points above that above it",
+        _critical_size,
+    ),
+    (
+        "1 x 3 map: a category straddles the critical size",
+        "One of the clusters falls near this region, stealing from both and therefore decreasing uniformity.",
+        f"a cluster of the 1 x 3 map (first trial) has >= {100 * STRADDLE_SHARE:.0f} % of its objects on each "
+        f"side of the critical size and >= {100 * STRADDLE_SHARE:.0f} % of its members with its less common "
+        "outcome",
+        _straddling_cluster,
+    ),
+    (
+        "Size features dominate",
+        "The grasping behaviour is affected mostly by the size of the object to be grasped.",
+        "for every r > 0, the mean over k of the size share of the selected features > 50 % (18 of the 49 "
+        "features are size features)",
+        _size_dominates,
+    ),
+    _FEWER_FEATURES,
+    _NUMBER_CONSTANT,
+    _ACCURACY_FALLS,
+)
+
+TAP_CLAIMS: tuple[_Spec, ...] = (
     (
         "Uniformity on average",
         "The average uniformity is above 80 % for tapping.",
         "mean over k of the mean uniformity > 80 %",
         _uniformity_average,
     ),
-    (
-        "Uniformity rises with k",
-        "Uniformity of clusters increases with the number of clusters.",
-        "Spearman rank correlation of k and mean uniformity >= 0.5",
-        _uniformity_rises,
-    ),
-    (
-        "Uniformity peak",
-        "It can reach up to 95 %.",
-        "highest mean uniformity over k >= 90 %",
-        _uniformity_peak,
-    ),
+    _UNIFORMITY_RISES,
+    _UNIFORMITY_PEAK,
     (
         "Shape features dominate",
         "Shape features dominate the selected features.",
@@ -297,18 +448,8 @@ _CLAIMS: tuple[tuple[str, str, str, Callable[[Mapping[str, Any]], tuple[str, boo
         "Spearman rank correlation of r and the mean shape share > 0",
         _shape_share_falls_with_lower_r,
     ),
-    (
-        "Fewer features as r rises",
-        "The number of selected features tends to be inversely proportional to r.",
-        "for every k the mean number never grows with r, and is lower at the largest r than at the smallest",
-        _count_falls_with_r,
-    ),
-    (
-        "Number constant in k",
-        "The number of selected features remains the same above some number of clusters.",
-        "for every r, the coefficient of variation over k >= 4 of the mean number <= 0.15",
-        _count_constant_in_k,
-    ),
+    _FEWER_FEATURES,
+    _NUMBER_CONSTANT,
     (
         "1 x 2 map: object types",
         "One cluster holds spheres and horizontal cylinders (rollable), the other boxes and "
@@ -329,12 +470,7 @@ _CLAIMS: tuple[tuple[str, str, str, Callable[[Mapping[str, Any]], tuple[str, boo
         "exactly 2 clusters with more successes (rolled) than failures and 2 with more failures (first trial)",
         _four_cluster_split,
     ),
-    (
-        "SVM accuracy falls with k",
-        "SVM prediction accuracy decreases as the number of effect categories grows.",
-        "for every r, Spearman rank correlation of k and mean accuracy <= -0.5",
-        _accuracy_falls,
-    ),
+    _ACCURACY_FALLS,
     (
         "Bump at k = 4",
         "Accuracy increases at 4 clusters against the decreasing trend (four object types).",
@@ -356,10 +492,42 @@ _CLAIMS: tuple[tuple[str, str, str, Callable[[Mapping[str, Any]], tuple[str, boo
 )
 
 
-def evaluate_claims(results: Mapping[str, Any]) -> list[Claim]:
-    """Every claim of the paper with our numbers and a verdict computed from them."""
+#: The claims of each behaviour the paper reports on; any other behaviour gets :data:`METHOD_CLAIMS`.
+CLAIM_SETS: dict[str, tuple[_Spec, ...]] = {"tap": TAP_CLAIMS, "grasp": GRASP_CLAIMS}
+
+
+def results_behavior(results: Mapping[str, Any]) -> str:
+    """The behaviour of a results dict (``config["behavior"]``); results without it, written before the
+    behaviour was recorded, are the tap's."""
+    return str(results.get("config", {}).get("behavior", "tap"))
+
+
+def claims_scope(behavior: str) -> str:
+    """Which of the paper's statements are checked for ``behavior``, as a sentence for the reports."""
+    if behavior == "tap":
+        return "The paper's statements on tapping (section V)."
+    if behavior == "grasp":
+        return ("The paper's statements on grasping (section V.B), and those on the method that hold for any "
+                "behaviour (sections V.B, V.C, V.E).")
+    return (f"The paper reports on tapping and grasping only; for {behavior} only its statements on the method, "
+            "which hold for any behaviour, are checked (sections V.B, V.C, V.E).")
+
+
+def claims_for(behavior: str) -> tuple[_Spec, ...]:
+    """The claims (topic, the paper, rule, judge) checked for ``behavior``: its own set in
+    :data:`CLAIM_SETS`, else :data:`METHOD_CLAIMS`."""
+    return CLAIM_SETS.get(behavior, METHOD_CLAIMS)
+
+
+def evaluate_claims(results: Mapping[str, Any], behavior: str | None = None) -> list[Claim]:
+    """The paper's claims on a behaviour with our numbers and a verdict computed from them.
+
+    Args:
+        results: The dict of :func:`affordance_learning.experiment.run_protocol` (or its JSON), or part of it.
+        behavior: Whose claims to check; by default the results' own (:func:`results_behavior`).
+    """
     claims = []
-    for topic, paper, rule, judge in _CLAIMS:
+    for topic, paper, rule, judge in claims_for(results_behavior(results) if behavior is None else behavior):
         try:
             ours, ok = judge(results)
             verdict = AGREES if ok else DISAGREES

@@ -149,7 +149,9 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
     Returns:
         ``{"bins": [{"low", "high" [m], "n", "success" (share, None for an empty bin)}], "logistic":
         {"intercept", "slope" [1/m]} or None (only one outcome: nothing to fit), "critical_size": [m] or None
-        (no fit, or the fit does not cross 50 % within the sizes seen)}``.
+        (no fit, or the fit does not cross 50 % within the sizes seen), "below", "above": {"n", "success"}
+        (the interactions with objects smaller, and not smaller, than the critical size, and their share of
+        successes; None without a critical size)}``.
     """
     from sklearn.linear_model import LogisticRegression
 
@@ -167,7 +169,7 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
         members = index == b
         bins.append({"low": float(edges[b]), "high": float(edges[b + 1]), "n": int(members.sum()),
                      "success": float(success[members].mean()) if members.any() else None})
-    out: dict = {"bins": bins, "logistic": None, "critical_size": None}
+    out: dict = {"bins": bins, "logistic": None, "critical_size": None, "below": None, "above": None}
     if success.all() or not success.any() or high == low:
         return out
     mean, scale = sizes.mean(), sizes.std()
@@ -176,5 +178,9 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
     intercept = float(fit.intercept_[0] - fit.coef_[0, 0] * mean / scale)
     out["logistic"] = {"intercept": intercept, "slope": slope}
     if slope != 0.0 and low <= -intercept / slope <= high:
-        out["critical_size"] = float(-intercept / slope)
+        critical = float(-intercept / slope)
+        out["critical_size"] = critical
+        for side, members in (("below", sizes < critical), ("above", sizes >= critical)):
+            out[side] = {"n": int(members.sum()),
+                         "success": float(success[members].mean()) if members.any() else None}
     return out

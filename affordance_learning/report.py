@@ -18,7 +18,9 @@ from affordance_learning.claims import (  # noqa: F401  (AGREES ... Claim: re-ex
     NOT_COMPUTABLE,
     Claim,
     _outcome_words,
+    claims_scope,
     evaluate_claims,
+    results_behavior,
 )
 
 
@@ -145,7 +147,7 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
     claims = evaluate_claims(results)
     tally = {v: sum(c.verdict == v for c in claims) for v in (AGREES, DISAGREES, NOT_COMPUTABLE)}
     config = results.get("config", {})
-    behavior = config.get("behavior", "tap")
+    behavior = results_behavior(results)
     success_label, fail_label = _outcome_words(results)
     lines = [
         f"# Reproduction of Akgun et al. 2009, {behavior}: our numbers beside the paper's",
@@ -158,7 +160,7 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
         "",
         f"**{tally[AGREES]} of {len(claims)} claims agree**, {tally[DISAGREES]} disagree, "
         f"{tally[NOT_COMPUTABLE]} could not be computed. Each verdict follows the rule beside it, applied to "
-        "the numbers below (means over trials).",
+        f"the numbers below (means over trials). {claims_scope(behavior)}",
         "",
         "| claim | the paper | rule | ours | verdict |",
         "|---|---|---|---|---|",

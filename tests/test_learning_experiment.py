@@ -76,7 +76,7 @@ def test_results_follow_the_schema(results: dict, frame: pd.DataFrame) -> None:
     assert (config["success_label"], config["fail_label"]) == ("rolled", "did not roll")
     assert config["success_fraction"] == pytest.approx(frame["success"].mean())
     assert config["case_study_ks"] == [2, 3, 4]
-    assert set(results["size_success"]) == {"bins", "logistic", "critical_size"}
+    assert set(results["size_success"]) == {"bins", "logistic", "critical_size", "below", "above"}
     assert sum(b["n"] for b in results["size_success"]["bins"]) == len(frame)
     assert set(results["effects"]["by_type"]["sphere"]) >= {"success", "visible_final"}
     assert json.loads(json.dumps(results, allow_nan=False)) == results
@@ -305,3 +305,86 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
     partial = {"uniformity": good["uniformity"]}
     verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
     assert verdicts["Uniformity on average"] == AGREES and verdicts["Bump at k = 4"] == NOT_COMPUTABLE
+
+
+def _grasp_like(results: dict) -> dict:
+    """The results edited to say what the paper says of the grasp, claim by claim."""
+    good = _paper_like(results)
+    good["config"] = {**good["config"], "behavior": "grasp", "success_label": "lifted and held",
+                      "fail_label": "not held"}
+    u = {2: 66.0, 3: 60.0, 4: 70.0, 5: 72.0, 6: 75.0, 7: 78.0, 8: 80.0, 9: 84.0, 10: 90.0}  # mean 75
+    good["uniformity"] = {str(k): {"mean": v, "std": 1.0} for k, v in u.items()}
+    good["size_fraction"] = {r: {k: {"mean": 0.7, "std": 0.0} for k in per_k}
+                             for r, per_k in good["shape_fraction"].items()}
+    good["size_success"] = {
+        "bins": [{"low": 0.03, "high": 0.06, "n": 500, "success": 0.9}, {"low": 0.06, "high": 0.09, "n": 500,
+                                                                          "success": 0.1}],
+        "logistic": {"intercept": 18.0, "slope": -300.0}, "critical_size": 0.06,
+        "below": {"n": 500, "success": 0.9}, "above": {"n": 500, "success": 0.1},
+    }
+    good["case_studies"]["3"] = [
+        {"cluster": 0, "success": 400, "fail": 20, "types": {}, "sizes": [0.03, 0.04, 0.05]},
+        {"cluster": 1, "success": 60, "fail": 40, "types": {}, "sizes": [0.05, 0.055, 0.062, 0.068]},
+        {"cluster": 2, "success": 20, "fail": 460, "types": {}, "sizes": [0.07, 0.08, 0.09]},
+    ]
+    return good
+
+
+GRASP_TOPICS = ("Uniformity on average", "Fall at k = 3", "Critical size",
+                "1 x 3 map: a category straddles the critical size", "Size features dominate")
+
+
+def test_grasp_claims_are_computed_from_the_numbers(results: dict) -> None:
+    good = _grasp_like(results)
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(good)}
+    assert list(verdicts) == [
+        "Uniformity on average", "Uniformity rises with k", "Uniformity peak", "Fall at k = 3", "Critical size",
+        "1 x 3 map: a category straddles the critical size", "Size features dominate",
+        "Fewer features as r rises", "Number constant in k", "SVM accuracy falls with k"]
+    assert set(verdicts.values()) == {AGREES}, verdicts
+    bad = copy.deepcopy(good)
+    bad["uniformity"] = {k: {"mean": 84.0 + int(k), "std": 1.0} for k in good["uniformity"]}  # no fall, >80
+    bad["size_fraction"] = {r: {k: {"mean": 0.3, "std": 0.0} for k in per_k}
+                            for r, per_k in good["size_fraction"].items()}
+    bad["size_success"]["below"]["success"], bad["size_success"]["above"]["success"] = 0.6, 0.4  # too soft
+    bad["case_studies"]["3"][1]["success"], bad["case_studies"]["3"][1]["fail"] = 95, 5  # nearly all held
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(bad)}
+    for topic in GRASP_TOPICS:
+        assert verdicts[topic] == DISAGREES, topic
+    # the average must be above 70 %, and not above the tap's 80 %
+    low = copy.deepcopy(good)
+    low["uniformity"] = {k: {"mean": v["mean"] - 10.0, "std": 1.0} for k, v in good["uniformity"].items()}
+    assert {c.topic: c.verdict for c in evaluate_claims(low)}["Uniformity on average"] == DISAGREES
+    # the straddling cluster must hold objects on both sides of the critical size, not just both outcomes
+    one_side = copy.deepcopy(good)
+    one_side["case_studies"]["3"][1]["sizes"] = [0.061, 0.065, 0.068, 0.07]
+    assert {c.topic: c.verdict for c in evaluate_claims(one_side)}[GRASP_TOPICS[3]] == DISAGREES
+    # success rising with size is not the grasp's critical size
+    rising = copy.deepcopy(good)
+    rising["size_success"]["logistic"]["slope"] = 300.0
+    assert {c.topic: c.verdict for c in evaluate_claims(rising)}["Critical size"] == DISAGREES
+    # no crossing within the sizes seen: the critical size disagrees, the straddling cannot be computed
+    none = copy.deepcopy(good)
+    none["size_success"].update(critical_size=None, below=None, above=None)
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(none)}
+    assert verdicts["Critical size"] == DISAGREES and verdicts[GRASP_TOPICS[3]] == NOT_COMPUTABLE
+    single = copy.deepcopy(none)
+    single["size_success"]["logistic"] = None
+    assert {c.topic: c.verdict for c in evaluate_claims(single)}["Critical size"] == DISAGREES
+    partial = {"uniformity": good["uniformity"], "config": {"behavior": "grasp"}}
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
+    assert verdicts["Fall at k = 3"] == AGREES and verdicts["Critical size"] == NOT_COMPUTABLE
+
+
+def test_each_behaviour_gets_its_own_claims(results: dict, tmp_path: Path) -> None:
+    tap = [c.topic for c in evaluate_claims(results)]
+    assert len(tap) == 14 and not set(GRASP_TOPICS[1:]) & set(tap)
+    assert [c.topic for c in evaluate_claims(results, behavior="grasp")][:4] == [
+        "Uniformity on average", "Uniformity rises with k", "Uniformity peak", "Fall at k = 3"]
+    push = copy.deepcopy(results)
+    push["config"]["behavior"] = "push"
+    assert [c.topic for c in evaluate_claims(push)] == [
+        "Uniformity rises with k", "Fewer features as r rises", "Number constant in k", "SVM accuracy falls with k"]
+    text = write_report(push, tmp_path).read_text()
+    assert "# Reproduction of Akgun et al. 2009, push:" in text and "tapping and grasping only" in text
+    assert text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**") == 4

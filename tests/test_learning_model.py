@@ -98,9 +98,11 @@ def test_size_success_finds_where_success_turns_to_failure() -> None:
     assert found["critical_size"] == pytest.approx(0.055, abs=0.002) and found["logistic"]["slope"] < 0
     assert [b["n"] for b in found["bins"]] and sum(b["n"] for b in found["bins"]) == 2000
     assert found["bins"][0]["success"] > 0.95 and found["bins"][-1]["success"] < 0.05
+    below, above = found["below"], found["above"]
+    assert below["n"] + above["n"] == 2000 and below["success"] > 0.8 and above["success"] < 0.2
     # success independent of size (90 % everywhere): a fit, but no crossing of 50 % among the sizes seen
     coin = size_success(sizes, rng.random(2000) < 0.9)
-    assert coin["logistic"] is not None and coin["critical_size"] is None
+    assert coin["logistic"] is not None and coin["critical_size"] is None and coin["below"] is None
     # one outcome only: nothing to fit
     always = size_success(sizes, np.ones(2000, dtype=bool))
     assert always["logistic"] is None and always["critical_size"] is None
