@@ -10,11 +10,11 @@ from __future__ import annotations
 #: Per behaviour, how its success and its failure read: ``(success, failure)``.
 OUTCOME_WORDS: dict[str, tuple[str, str]] = {
     "tap": ("rolled", "did not roll"),
+    "grasp": ("lifted and held", "not held"),
     "tap_back": ("rolled", "did not roll"),
     "push": ("moved", "did not move"),
-    "grasp": ("lifted and held", "not held"),
 }
-#: The behaviours of the environment, in the order reports list them.
+#: The behaviours of the environment, in the order reports list them: the paper's two, then the others.
 BEHAVIORS: tuple[str, ...] = tuple(OUTCOME_WORDS)
 #: How the ``rolled`` label reads: the label of a frame that has no ``success`` column.
 ROLLED_WORDS = ("rolled", "did not roll")

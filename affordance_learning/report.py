@@ -218,3 +218,86 @@ def write_report(results: Mapping[str, Any], out_dir: str | Path) -> Path:
     path = out / "REPORT.md"
     path.write_text(render_report(results, figures))
     return path
+
+
+def _headline(results: Mapping[str, Any]) -> dict[str, str]:
+    """One behaviour's headline numbers as short texts, for the overview."""
+    config = results.get("config", {})
+    success_label, _ = _outcome_words(results)
+    uniformity = {int(k): v["mean"] for k, v in results.get("uniformity", {}).items() if v.get("mean") is not None}
+    section = results.get("svm_accuracy", {})
+    accuracy = section.get("0.4") or next(iter(section.values()), {})
+    acc = {int(k): v["mean"] for k, v in accuracy.items() if v.get("mean") is not None}
+    best = max(uniformity, key=uniformity.get) if uniformity else None
+    sizes = results.get("size_success", {})
+    critical = sizes.get("critical_size")
+    return {
+        "interactions": str(config.get("n_rows", "?")),
+        "success": f"{_pct(config.get('success_fraction'))} {success_label}",
+        "uniformity": f"{np.mean(list(uniformity.values())):.1f} %" if uniformity else "-",
+        "peak": f"{uniformity[best]:.1f} % (k = {best})" if best is not None else "-",
+        "accuracy": (f"{100 * acc[min(acc)]:.1f} % (k = {min(acc)}) to {100 * acc[max(acc)]:.1f} % "
+                     f"(k = {max(acc)})" if acc else "-"),
+        "critical": "-" if critical is None else (f"{100 * critical:.1f} cm ({_pct(sizes['below']['success'])} "
+                                                  f"below, {_pct(sizes['above']['success'])} above)"),
+    }
+
+
+def render_overview(runs: Mapping[str, Mapping[str, Any]],
+                    figures: Mapping[str, Sequence[str]] | None = None) -> str:
+    """The Markdown text of the overview over behaviours (see :func:`write_overview`); ``figures``: the PNG
+    file names in each behaviour's directory."""
+    names, figures = list(runs), figures or {}
+    lines = [
+        f"# Reproduction of Akgun et al. 2009: {', '.join(names)}",
+        "",
+        "One model per behaviour, as the paper proposes (\"a separate SOM and SVM for each behavior\"): each "
+        "behaviour's interactions are collected, clustered by their effects, weighed and learned on their own, "
+        "and set beside what the paper says of that behaviour. Means over trials; the full numbers, tables and "
+        "figures are in each behaviour's report.",
+        "",
+        "| behaviour | interactions | successes | uniformity, mean over k | highest uniformity | "
+        "SVM accuracy at r = 0.4 | critical size (success crosses 50 %) | claims that agree |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    claims = {b: evaluate_claims(results) for b, results in runs.items()}
+    for behavior, results in runs.items():
+        h = _headline(results)
+        agree = sum(c.verdict == AGREES for c in claims[behavior])
+        lines.append(f"| [{behavior}]({behavior}/REPORT.md) | {h['interactions']} | {h['success']} | "
+                     f"{h['uniformity']} | {h['peak']} | {h['accuracy']} | {h['critical']} | "
+                     f"{agree} of {len(claims[behavior])} |")
+    lines.append("")
+    for behavior, found in claims.items():
+        tally = {v: sum(c.verdict == v for c in found) for v in (AGREES, DISAGREES, NOT_COMPUTABLE)}
+        shown = sorted(Path(f).name for f in figures.get(behavior, ()))
+        lines += [f"## {behavior}", "", f"[Full report]({behavior}/REPORT.md)"
+                  + (" · figures: " + ", ".join(f"[{Path(f).stem}]({behavior}/{f})" for f in shown) if shown else ""),
+                  "", f"**{tally[AGREES]} of {len(found)} claims agree**, {tally[DISAGREES]} disagree, "
+                  f"{tally[NOT_COMPUTABLE]} could not be computed. {claims_scope(behavior)}", "",
+                  "| claim | the paper | rule | ours | verdict |", "|---|---|---|---|---|"]
+        lines += [f"| {c.topic} | {c.paper} | {c.rule} | {c.ours} | **{c.verdict}** |" for c in found]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def write_overview(runs: Mapping[str, Mapping[str, Any]], out_dir: str | Path) -> Path:
+    """Write ``REPORT.md`` into ``out_dir`` over several behaviours: for each, its headline numbers, its claims
+    with their verdicts, and links to its report and figures in ``out_dir/<behavior>/``.
+
+    Args:
+        runs: The results dict of each behaviour (:func:`affordance_learning.experiment.run_protocol`), by
+            behaviour, in the order to show them.
+        out_dir: Output directory, holding one directory per behaviour.
+
+    Returns:
+        The path of ``REPORT.md``.
+    """
+    if not runs or not all(isinstance(r, Mapping) and "uniformity" in r for r in runs.values()):
+        raise ValueError("runs must map each behaviour to the dict returned by run_protocol.")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    figures = {b: sorted(p.name for p in (out / b).glob("*.png")) for b in runs}
+    path = out / "REPORT.md"
+    path.write_text(render_overview(runs, figures))
+    return path

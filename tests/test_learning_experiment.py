@@ -12,7 +12,7 @@ import pytest
 
 from affordance_learning import run_protocol, write_figures, write_report
 from affordance_learning.experiment import feature_groups, feature_names, make_synthetic_frame
-from affordance_learning.report import AGREES, DISAGREES, NOT_COMPUTABLE, evaluate_claims
+from affordance_learning.report import AGREES, DISAGREES, NOT_COMPUTABLE, evaluate_claims, write_overview
 
 KS = (2, 3, 4)
 RS = (0.0, 0.4)
@@ -388,3 +388,19 @@ def test_each_behaviour_gets_its_own_claims(results: dict, tmp_path: Path) -> No
     text = write_report(push, tmp_path).read_text()
     assert "# Reproduction of Akgun et al. 2009, push:" in text and "tapping and grasping only" in text
     assert text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**") == 4
+
+
+def test_the_overview_sets_the_behaviours_side_by_side(results: dict, tmp_path: Path) -> None:
+    grasp = _grasp_like(results)
+    (tmp_path / "grasp").mkdir()
+    (tmp_path / "grasp" / "uniformity.png").write_bytes(PNG_MAGIC)
+    text = write_overview({"tap": results, "grasp": grasp}, tmp_path).read_text()
+    assert text.startswith("# Reproduction of Akgun et al. 2009: tap, grasp")
+    assert "| [tap](tap/REPORT.md) | 240 |" in text and "| [grasp](grasp/REPORT.md) |" in text
+    assert "6.0 cm (90 % below, 10 % above)" in text  # the grasp's critical size in the headline table
+    assert "[uniformity](grasp/uniformity.png)" in text and "## tap" in text and "## grasp" in text
+    assert "| Fall at k = 3 |" in text and "| 1 x 2 map: object types |" in text
+    verdicts = text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**")
+    assert verdicts == 14 + 10
+    with pytest.raises(ValueError, match="runs must map each behaviour"):
+        write_overview({}, tmp_path)
