@@ -7,6 +7,8 @@ and SVM for each behavior"), so every result, report and default model belongs t
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 #: Per behaviour, how its success and its failure read: ``(success, failure)``.
 OUTCOME_WORDS: dict[str, tuple[str, str]] = {
     "tap": ("rolled", "did not roll"),
@@ -20,6 +22,36 @@ BEHAVIORS: tuple[str, ...] = tuple(OUTCOME_WORDS)
 ROLLED_WORDS = ("rolled", "did not roll")
 #: How the success/fail label of a behaviour this module does not know reads.
 GENERIC_WORDS = ("success", "fail")
+
+
+def check_behavior(behavior: str) -> str:
+    """``behavior`` if it is one of :data:`BEHAVIORS`; raises ValueError naming the valid ones otherwise."""
+    if behavior not in BEHAVIORS:
+        raise ValueError(f"Unknown behavior {behavior!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
+    return behavior
+
+
+def check_env_offers(behaviors: Iterable[str], hint: str = "") -> list[str]:
+    """The behaviours, each checked to be offered by the installed environment (whose interactions can then be
+    collected); raises ValueError otherwise, before any work, with ``hint`` appended to the message.
+
+    The environment's behaviours are read from ``affordance_env.behaviors.BEHAVIORS`` when called.
+    """
+    import affordance_env.behaviors as env_behaviors
+
+    behaviors = list(behaviors)
+    if not behaviors or any(not isinstance(b, str) for b in behaviors):
+        raise ValueError(f"behaviors must be one or more behaviour names, got {behaviors!r}.")
+    if len(set(behaviors)) != len(behaviors):
+        raise ValueError(f"behaviors must not repeat a name, got {behaviors!r}.")
+    offered = list(env_behaviors.BEHAVIORS)
+    for behavior in behaviors:
+        if behavior not in offered:
+            raise ValueError(
+                f"the environment has no {behavior!r} behaviour (it offers {', '.join(offered)}), so its "
+                f"interactions cannot be collected: install an affordance_env that has it{hint}."
+            )
+    return behaviors
 
 
 def outcome_words(behavior: str, label: str = "success") -> tuple[str, str]:

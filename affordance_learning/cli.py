@@ -67,13 +67,23 @@ def _reproduce(args: argparse.Namespace) -> int:
 
 
 def _train_default(args: argparse.Namespace) -> int:
-    from affordance_env.dataset import collect, load_dataset
-    from affordance_learning.default_model import DEFAULT_MODEL_PATH, train_default_model
+    from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
+    from affordance_learning.behaviors import check_behavior, check_env_offers
+    from affordance_learning.default_model import model_path, train_default_model
 
-    dataset = collect(args.dataset, 1000, seed=0, workers=args.workers)
-    model = train_default_model(load_dataset(dataset), args.out or DEFAULT_MODEL_PATH)
-    print(f"default tap model ({model.n_clusters} categories, {len(model.selected_features_)} features selected: "
-          f"{', '.join(model.selected_feature_names_)}) written to {args.out or DEFAULT_MODEL_PATH}")
+    behavior = check_behavior(args.behavior)
+    dataset = args.dataset or Path("default-taps" if behavior == "tap" else f"default-{behavior}")
+    if (dataset / MANIFEST).exists():  # say so plainly, before the collection refuses its other settings
+        found = read_manifest(dataset)["settings"]["env_options"].get("behavior", "tap")
+        if found != behavior:
+            raise ValueError(f"{dataset} holds {found!r} interactions, not {behavior!r} ones: give --dataset a "
+                             f"dataset of {behavior} interactions, or a new directory to collect them into.")
+    check_env_offers([behavior])
+    collect(dataset, 1000, seed=0, workers=args.workers, env_options={"behavior": behavior})
+    out = args.out or model_path(behavior)
+    model = train_default_model(load_dataset(dataset), out, behavior=behavior)
+    print(f"default {behavior} model ({model.n_clusters} categories, {len(model.selected_features_)} features "
+          f"selected: {', '.join(model.selected_feature_names_)}) written to {out}")
     return 0
 
 
@@ -116,9 +126,12 @@ def build_parser() -> argparse.ArgumentParser:
                            help="collect with the range camera's depth noise model (default: exact ranges)")
     reproduce.set_defaults(func=_reproduce)
 
-    train = sub.add_parser("train-default", help="rebuild the default tap model behind predict_effect")
-    train.add_argument("--dataset", type=Path, default=Path("default-taps"),
-                       help="where the 1000 canonical taps (seed 0) are collected (default ./default-taps)")
+    train = sub.add_parser("train-default", help="rebuild a behaviour's default model behind predict_effect")
+    train.add_argument("--behavior", default="tap", metavar="NAME",
+                       help="whose model: tap (default, shipped), grasp, tap_back or push")
+    train.add_argument("--dataset", type=Path, default=None,
+                       help="where the behaviour's 1000 canonical interactions (seed 0) are collected, or reused "
+                       "(default ./default-taps for the tap, ./default-BEHAVIOR otherwise)")
     train.add_argument("--workers", type=int, default=2)
     train.add_argument("--out", type=Path, default=None, help="model file (default: the package's own)")
     train.set_defaults(func=_train_default)

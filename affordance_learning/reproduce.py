@@ -51,31 +51,6 @@ def _shown_path(path: Path, out: Path) -> str:
         return str(path)
 
 
-def check_behaviors(behaviors: Iterable[str]) -> list[str]:
-    """The behaviours to run, each checked to be offered by the environment; raises ValueError otherwise.
-
-    The environment's behaviours are read from ``affordance_env.behaviors.BEHAVIORS`` when called.
-    """
-    import affordance_env.behaviors as env_behaviors
-
-    behaviors = list(behaviors)
-    if not behaviors or any(not isinstance(b, str) for b in behaviors):
-        raise ValueError(f"behaviors must be one or more behaviour names, got {behaviors!r}.")
-    if len(set(behaviors)) != len(behaviors):
-        raise ValueError(f"behaviors must not repeat a name, got {behaviors!r}.")
-    offered = list(env_behaviors.BEHAVIORS)
-    for behavior in behaviors:
-        if behavior not in offered:
-            others = [b for b in behaviors if b in offered]
-            hint = f" --behavior {' --behavior '.join(others)}" if others else " --behavior tap"
-            raise ValueError(
-                f"the environment has no {behavior!r} behaviour (it offers {', '.join(offered)}), so its "
-                f"interactions cannot be collected: install an affordance_env that has it, or run only the "
-                f"behaviours it offers (affordance reproduce{hint})."
-            )
-    return behaviors
-
-
 def reproduce(
     out: Path,
     *,
@@ -104,10 +79,14 @@ def reproduce(
     Returns:
         The results dict of each behaviour run, by behaviour.
     """
-    from affordance_learning.behaviors import BEHAVIORS
+    import affordance_env.behaviors as env_behaviors
+    from affordance_learning.behaviors import BEHAVIORS, check_env_offers
     from affordance_learning.report import write_overview
 
-    behaviors = check_behaviors(behaviors)
+    behaviors = list(behaviors)
+    runnable = [b for b in behaviors if isinstance(b, str) and b in env_behaviors.BEHAVIORS] or ["tap"]
+    behaviors = check_env_offers(behaviors, hint=", or run only the behaviours it offers (affordance reproduce "
+                                 f"--behavior {' --behavior '.join(runnable)})")
     datasets = {b: Path(p) for b, p in (datasets or {}).items()}
     unknown = sorted(set(datasets) - set(behaviors))
     if unknown:

@@ -86,3 +86,24 @@ def test_collect_command(tmp_path, capsys):
     assert "6 interactions" in capsys.readouterr().out
     assert main([*args[:5], "--seed", "9", *args[5:]]) == 2  # other settings: refused, not mixed in
     assert "other settings" in capsys.readouterr().err
+
+
+def test_train_default_checks_the_behaviour_before_collecting(tmp_path, capsys, monkeypatch):
+    import json
+
+    import affordance_env.behaviors as env_behaviors
+    from affordance_env.dataset.format import FORMAT, MANIFEST, SCHEMA_VERSION
+
+    assert main(["train-default", "--behavior", "juggle", "--dataset", str(tmp_path / "d")]) == 2
+    assert "Unknown behavior 'juggle'. Valid behaviors: tap, grasp" in capsys.readouterr().err
+    taps = tmp_path / "taps"
+    taps.mkdir()
+    (taps / MANIFEST).write_text(json.dumps({"format": FORMAT, "schema_version": SCHEMA_VERSION, "episodes": 6,
+                                             "settings": {"chunk_size": 3, "env_options": {"behavior": "tap"}}}))
+    assert main(["train-default", "--behavior", "grasp", "--dataset", str(taps), "--out", str(tmp_path / "m")]) == 2
+    assert "holds 'tap' interactions, not 'grasp' ones" in capsys.readouterr().err
+    monkeypatch.setattr(env_behaviors, "BEHAVIORS", {n: b for n, b in env_behaviors.BEHAVIORS.items() if n != "grasp"})
+    new = tmp_path / "grasps"
+    assert main(["train-default", "--behavior", "grasp", "--dataset", str(new), "--out", str(tmp_path / "m")]) == 2
+    assert "the environment has no 'grasp' behaviour" in capsys.readouterr().err
+    assert not new.exists() and not (tmp_path / "m").exists()

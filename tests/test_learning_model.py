@@ -470,10 +470,53 @@ def test_default_model_refuses_missing_corrupt_and_stale_files(stored_model: tup
     ):
         load_default_model(stale)
     joblib.dump({"model": "something else"}, stale)
-    with pytest.raises(DefaultModelError, match="not a tap model bundle"):
+    with pytest.raises(DefaultModelError, match="not a default model bundle"):
         load_default_model(stale)
 
 
 def test_default_model_path_is_in_the_package() -> None:
     assert default_model_module.DEFAULT_MODEL_PATH.parent.name == "data"
     assert default_model_module.DEFAULT_MODEL_PATH.parent.parent.name == "affordance_learning"
+    assert default_model_module.model_path() == default_model_module.DEFAULT_MODEL_PATH
+    assert default_model_module.model_path("grasp") == default_model_module.MODEL_DIR / "grasp_model.joblib"
+
+
+def test_each_behaviour_has_its_own_default_model(tmp_path: object, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(default_model_module, "MODEL_DIR", tmp_path)  # the package's data directory, elsewhere
+    grasps = make_synthetic_frame(160, random_state=5, behavior="grasp")
+    features = grasps[[c for c in grasps.columns if c.startswith("initial_")]].to_numpy()
+    # not built yet: the error says how to build it
+    with pytest.raises(DefaultModelMissingError, match=r"grasp model .* missing.*affordance train-default "
+                                                        r"--behavior grasp.*1000 canonical grasp interactions"):
+        predict_effect(features[:2], "grasp")
+    model = train_default_model(grasps, behavior="grasp")  # into the behaviour's file
+    assert (tmp_path / "grasp_model.joblib").exists() and joblib.load(tmp_path / "grasp_model.joblib")[
+        "behavior"] == "grasp"
+    prediction = predict_effect(features[:5], "grasp")
+    np.testing.assert_array_equal(
+        prediction.category, model.predict(pd.DataFrame(features[:5], columns=model.feature_names_in_)))
+    assert load_default_model(behavior="grasp") is load_default_model(tmp_path / "grasp_model.joblib",
+                                                                      behavior="grasp")
+    # a model is used only for its own behaviour
+    with pytest.raises(DefaultModelError, match="holds a 'grasp' model, not a 'tap' one.*affordance train-default"):
+        predict_effect(features[:2], path=tmp_path / "grasp_model.joblib")
+    # a bundle stored before the behaviour was recorded is the tap's
+    bundle = joblib.load(tmp_path / "grasp_model.joblib")
+    del bundle["behavior"]
+    joblib.dump(bundle, tmp_path / "old.joblib")
+    assert predict_effect(features[:2], path=tmp_path / "old.joblib").category.shape == (2,)
+    with pytest.raises(DefaultModelError, match="holds a 'tap' model, not a 'grasp' one"):
+        load_default_model(tmp_path / "old.joblib", behavior="grasp")
+
+
+def test_default_models_refuse_unknown_behaviours_and_other_behaviours_data(tmp_path: object) -> None:
+    with pytest.raises(ValueError, match="Unknown behavior 'juggle'. Valid behaviors: tap, grasp, tap_back, push"):
+        predict_effect(np.zeros(49), "juggle")
+    with pytest.raises(ValueError, match="Unknown behavior 'juggle'"):
+        load_default_model(behavior="juggle")
+    taps = make_synthetic_frame(40, random_state=5)
+    with pytest.raises(ValueError, match="holds 'tap' interactions, not 'grasp' ones"):
+        train_default_model(taps, tmp_path / "m.joblib", behavior="grasp")
+    with pytest.raises(ValueError, match="Unknown behavior 'juggle'"):
+        train_default_model(taps, tmp_path / "m.joblib", behavior="juggle")
+    assert not (tmp_path / "m.joblib").exists()
