@@ -288,6 +288,8 @@ GRASP_UNIFORMITY = (70.0, 80.0)
 #: A 1 x 3 category straddles the critical size when at least this share of its objects lies on each side
 #: of it, and at least this share of its members has its less common outcome.
 STRADDLE_SHARE = 0.2
+#: ... and it is a category, not a handful of outliers: it holds at least this share of all interactions.
+STRADDLE_MIN_SIZE = 0.1
 #: The critical size decides the grasp when successes are this much more common below it than above it.
 CRITICAL_SIZE_CONTRAST = 0.5
 
@@ -328,17 +330,22 @@ def _straddling_cluster(results: Mapping[str, Any]) -> tuple[str, bool]:
         raise _Missing("no critical size: the fit of success on size does not cross 50 % within the sizes seen")
     success_label, fail_label = _outcome_words(results)
     parts, straddling = [], []
-    for c in _case(results, 3):
+    clusters = _case(results, 3)
+    total = sum(c["success"] + c["fail"] for c in clusters)
+    for c in clusters:
         sizes = np.asarray(c["sizes"], dtype=float)
         if sizes.size == 0:
             parts.append(f"cluster {c['cluster']}: empty")
             continue
+        n = c["success"] + c["fail"]
         below = float(np.mean(sizes < critical))
-        minority = min(c["success"], c["fail"]) / max(c["success"] + c["fail"], 1)
-        if min(below, 1.0 - below) >= STRADDLE_SHARE and minority >= STRADDLE_SHARE:
+        minority = min(c["success"], c["fail"]) / max(n, 1)
+        if (min(below, 1.0 - below) >= STRADDLE_SHARE and minority >= STRADDLE_SHARE
+                and n >= STRADDLE_MIN_SIZE * total):
             straddling.append(str(c["cluster"]))
-        parts.append(f"cluster {c['cluster']}: {100 * sizes.min():.1f}-{100 * sizes.max():.1f} cm, "
-                     f"{100 * below:.0f} % below; {c['success']} {success_label} / {c['fail']} {fail_label}")
+        parts.append(f"cluster {c['cluster']} ({100 * n / max(total, 1):.0f} % of the interactions): "
+                     f"{100 * sizes.min():.1f}-{100 * sizes.max():.1f} cm, {100 * below:.0f} % below; "
+                     f"{c['success']} {success_label} / {c['fail']} {fail_label}")
     text = (f"critical size {100 * critical:.1f} cm; " + "; ".join(parts)
             + f" -> straddling: {', '.join(straddling) or 'none'}")
     return text, bool(straddling)
@@ -410,9 +417,9 @@ GRASP_CLAIMS: tuple[_Spec, ...] = (
     (
         "1 x 3 map: a category straddles the critical size",
         "One of the clusters falls near this region, stealing from both and therefore decreasing uniformity.",
-        f"a cluster of the 1 x 3 map (first trial) has >= {100 * STRADDLE_SHARE:.0f} % of its objects on each "
-        f"side of the critical size and >= {100 * STRADDLE_SHARE:.0f} % of its members with its less common "
-        "outcome",
+        f"a cluster of the 1 x 3 map (first trial) with >= {100 * STRADDLE_MIN_SIZE:.0f} % of the interactions "
+        f"has >= {100 * STRADDLE_SHARE:.0f} % of its objects on each side of the critical size and "
+        f">= {100 * STRADDLE_SHARE:.0f} % of its members with its less common outcome",
         _straddling_cluster,
     ),
     (

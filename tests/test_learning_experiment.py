@@ -324,7 +324,7 @@ def _grasp_like(results: dict) -> dict:
     }
     good["case_studies"]["3"] = [
         {"cluster": 0, "success": 400, "fail": 20, "types": {}, "sizes": [0.03, 0.04, 0.05]},
-        {"cluster": 1, "success": 60, "fail": 40, "types": {}, "sizes": [0.05, 0.055, 0.062, 0.068]},
+        {"cluster": 1, "success": 120, "fail": 80, "types": {}, "sizes": [0.05, 0.055, 0.062, 0.068]},
         {"cluster": 2, "success": 20, "fail": 460, "types": {}, "sizes": [0.07, 0.08, 0.09]},
     ]
     return good
@@ -359,6 +359,10 @@ def test_grasp_claims_are_computed_from_the_numbers(results: dict) -> None:
     one_side = copy.deepcopy(good)
     one_side["case_studies"]["3"][1]["sizes"] = [0.061, 0.065, 0.068, 0.07]
     assert {c.topic: c.verdict for c in evaluate_claims(one_side)}[GRASP_TOPICS[3]] == DISAGREES
+    # ... and be a category, not a handful of objects (here 5 of 905 interactions)
+    handful = copy.deepcopy(good)
+    handful["case_studies"]["3"][1].update(success=3, fail=2)
+    assert {c.topic: c.verdict for c in evaluate_claims(handful)}[GRASP_TOPICS[3]] == DISAGREES
     # success rising with size is not the grasp's critical size
     rising = copy.deepcopy(good)
     rising["size_success"]["logistic"]["slope"] = 300.0
