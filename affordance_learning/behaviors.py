@@ -20,6 +20,8 @@ OUTCOME_WORDS: dict[str, tuple[str, str]] = {
 BEHAVIORS: tuple[str, ...] = tuple(OUTCOME_WORDS)
 #: How the ``rolled`` label reads: the label of a frame that has no ``success`` column.
 ROLLED_WORDS = ("rolled", "did not roll")
+#: The behaviours whose success is ``rolled``: only their frames may stand in ``rolled`` for a missing ``success``.
+ROLLED_IS_SUCCESS = ("tap", "tap_back")
 #: How the success/fail label of a behaviour this module does not know reads.
 GENERIC_WORDS = ("success", "fail")
 

@@ -4,9 +4,9 @@ Akgun et al. 2009, section V, on a pandas DataFrame in the project's dataset sch
 (``affordance_env.features.FEATURE_NAMES``) the columns ``initial_<name>``, ``final_<name>`` and
 ``effect_<name>``, the ``behavior`` and the ground truth ``type`` (sphere | box | horizontal_cylinder |
 vertical_cylinder), ``size`` [m], ``success`` (bool, the paper's hand label of the behaviour: the tap rolled the
-object, the grasp lifted and held it, ...; a frame without it is evaluated against ``rolled``) and
-``displacement`` [m]. The ground truth is used only to evaluate, never to learn. One frame holds one
-behaviour's interactions: the paper learns "a separate SOM and SVM for each behavior".
+object, the grasp lifted and held it, ...; a tap or tap_back frame without it is evaluated against ``rolled``,
+their success) and ``displacement`` [m]. The ground truth is used only to evaluate, never to learn. One frame
+holds one behaviour's interactions: the paper learns "a separate SOM and SVM for each behavior".
 :func:`run_protocol` repeats, for every trial t and every number of clusters k:
 
 1. A 1 x k self-organising map, seeded from ``(random_state, t, k)``, clusters the standardised effects of
@@ -51,7 +51,7 @@ from joblib import Parallel, delayed
 from sklearn.model_selection import train_test_split
 from sklearn.preprocessing import StandardScaler
 
-from affordance_learning.behaviors import outcome_words
+from affordance_learning.behaviors import ROLLED_IS_SUCCESS, outcome_words
 from affordance_learning.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
 from affordance_learning.model import _check_int, select_features
 from affordance_learning.relieff import MULTICLASS_THRESHOLD, ReliefFScorer
@@ -419,6 +419,12 @@ def run_protocol(
     case_study_ks = [k for k in case_study_ks if k in ks]
     data = _frame_data(df)
     behavior = frame_behavior(df, behavior)
+    if data.label == "rolled" and behavior not in ROLLED_IS_SUCCESS:
+        raise ValueError(
+            f"the frame has no 'success' column, and the success of {behavior!r} is not 'rolled' (that stands in "
+            f"only for {', '.join(ROLLED_IS_SUCCESS)}): load the dataset with an affordance_env that stores or "
+            "derives 'success' (dataset schema 4)."
+        )
     success_label, fail_label = outcome_words(behavior, data.label)
     type_counts = pd.Series(data.types).value_counts()
     n_test = int(np.ceil(test_size * len(data.X)))

@@ -155,6 +155,10 @@ def test_the_label_is_success_or_else_rolled(frame: pd.DataFrame) -> None:
     assert old["config"]["label"] == "rolled" and old["config"]["success_label"] == "rolled"
     assert sum(c["success"] for c in old["case_studies"]["2"]) == frame["rolled"].sum()
     assert old["uniformity"] == ours["uniformity"]  # |S - F| is the same with the labels swapped
+    # but rolled is not the success of a grasp or a push: no silent stand-in
+    for behavior in ("grasp", "push"):
+        with pytest.raises(ValueError, match=f"no 'success' column, and the success of '{behavior}' is not"):
+            run_protocol(frame.drop(columns=["success"]).assign(behavior=behavior), **kwargs)
 
 
 def test_synthetic_grasps_have_a_critical_size() -> None:
