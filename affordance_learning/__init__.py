@@ -5,9 +5,10 @@
 - :class:`SOMClustering`: a 1 x k self-organising map (minisom) as a scikit-learn clusterer.
 - :func:`relieff_weights`: ReliefF feature weights equal to skrebate's, vectorised.
 - :func:`uniformity`, :func:`cluster_purity`, :func:`adjusted_rand`, :func:`svm_cv_accuracy`: the metrics.
-- :func:`predict_effect`: the effect of a tap predicted from an object's 49 features by the default model.
-- :func:`run_protocol`, :func:`write_figures`, :func:`write_report`: the paper's experiment and its outputs
-  (``affordance reproduce`` runs them end to end).
+- :func:`predict_effect`: the effect of a behaviour's interaction predicted from an object's 49 features by
+  that behaviour's default model (the tap's is shipped; ``affordance train-default --behavior`` builds others).
+- :func:`run_protocol`, :func:`write_figures`, :func:`write_report`: the paper's experiment on one behaviour
+  and its outputs (``affordance reproduce`` runs them end to end for the tap and the grasp).
 """
 
 __version__ = "0.2.0"

@@ -38,22 +38,52 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
-def _reproduce(args: argparse.Namespace) -> int:
-    from affordance_learning.reproduce import reproduce
+def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
+    """``--dataset`` values, ``BEHAVIOR=PATH`` or (with one behaviour) ``PATH``, as a directory per behaviour."""
+    from affordance_learning.behaviors import BEHAVIORS
 
-    reproduce(args.out, episodes=args.episodes, trials=args.trials, seed=args.seed, workers=args.workers,
-              dataset=args.dataset, range_noise=args.range_noise, progress=args.progress)
+    datasets: dict[str, Path] = {}
+    for item in items:
+        name, _, path = item.partition("=")
+        if not path or name not in {*behaviors, *BEHAVIORS}:  # a bare path (which may hold "=" itself)
+            if len(behaviors) != 1:
+                raise ValueError(f"--dataset {item}: say whose dataset it is, as BEHAVIOR=PATH with BEHAVIOR one "
+                                 f"of {', '.join(behaviors)} (a bare PATH is for a single --behavior).")
+            name, path = behaviors[0], item
+        if name in datasets:
+            raise ValueError(f"--dataset given twice for {name!r}.")
+        datasets[name] = Path(path)
+    return datasets
+
+
+def _reproduce(args: argparse.Namespace) -> int:
+    from affordance_learning.reproduce import DEFAULT_BEHAVIORS, reproduce
+
+    behaviors = args.behavior or list(DEFAULT_BEHAVIORS)
+    reproduce(args.out, behaviors=behaviors, episodes=args.episodes, trials=args.trials, seed=args.seed,
+              workers=args.workers, datasets=_datasets(args.dataset, behaviors), range_noise=args.range_noise,
+              progress=args.progress)
     return 0
 
 
 def _train_default(args: argparse.Namespace) -> int:
-    from affordance_env.dataset import collect, load_dataset
-    from affordance_learning.default_model import DEFAULT_MODEL_PATH, train_default_model
+    from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
+    from affordance_learning.behaviors import check_behavior, check_env_offers
+    from affordance_learning.default_model import model_path, train_default_model
 
-    dataset = collect(args.dataset, 1000, seed=0, workers=args.workers)
-    model = train_default_model(load_dataset(dataset), args.out or DEFAULT_MODEL_PATH)
-    print(f"default tap model ({model.n_clusters} categories, {len(model.selected_features_)} features selected: "
-          f"{', '.join(model.selected_feature_names_)}) written to {args.out or DEFAULT_MODEL_PATH}")
+    behavior = check_behavior(args.behavior)
+    dataset = args.dataset or Path("default-taps" if behavior == "tap" else f"default-{behavior}")
+    if (dataset / MANIFEST).exists():  # say so plainly, before the collection refuses its other settings
+        found = read_manifest(dataset)["settings"]["env_options"].get("behavior", "tap")
+        if found != behavior:
+            raise ValueError(f"{dataset} holds {found!r} interactions, not {behavior!r} ones: give --dataset a "
+                             f"dataset of {behavior} interactions, or a new directory to collect them into.")
+    check_env_offers([behavior])
+    collect(dataset, 1000, seed=0, workers=args.workers, env_options={"behavior": behavior})
+    out = args.out or model_path(behavior)
+    model = train_default_model(load_dataset(dataset), out, behavior=behavior)
+    print(f"default {behavior} model ({model.n_clusters} categories, {len(model.selected_features_)} features "
+          f"selected: {', '.join(model.selected_feature_names_)}) written to {out}")
     return 0
 
 
@@ -73,13 +103,22 @@ def build_parser() -> argparse.ArgumentParser:
     add_export_parser(sub)
 
     reproduce = sub.add_parser(
-        "reproduce", help="the paper's experiment: collect taps, learn, write results.json, figures and a report"
+        "reproduce", help="the paper's experiment per behaviour (tap and grasp): collect, learn, write "
+        "results.json, figures and a report for each, and a report over all of them",
+        description="For each behaviour: collect (or reuse) its canonical interactions into OUT/BEHAVIOR/dataset, "
+        "run the learning protocol, write OUT/BEHAVIOR/results.json, figures and REPORT.md; then OUT/REPORT.md "
+        "over the behaviours.",
     )
-    reproduce.add_argument("--episodes", type=int, default=1000, help="tap interactions (default 1000)")
+    reproduce.add_argument("--behavior", action="append", default=None, metavar="NAME",
+                           help="run this behaviour; repeat for several (default: tap and grasp, the paper's)")
+    reproduce.add_argument("--episodes", type=int, default=1000,
+                           help="interactions per behaviour (default 1000)")
     reproduce.add_argument("--trials", type=int, default=20, help="learning trials per setting (default 20)")
     reproduce.add_argument("--seed", type=int, default=0, help="seed of the dataset and the trials (default 0)")
     reproduce.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
-    reproduce.add_argument("--dataset", type=Path, default=None, help="dataset directory (default OUT/dataset)")
+    reproduce.add_argument("--dataset", action="append", default=[], metavar="[BEHAVIOR=]PATH",
+                           help="a behaviour's dataset directory, collected there or reused (default "
+                           "OUT/BEHAVIOR/dataset); repeatable; a bare PATH when one behaviour runs")
     reproduce.add_argument("--out", type=Path, default=Path("reproduction"), help="output directory")
     reproduce.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                            help="progress bars (default: on a terminal, unless CI is set)")
@@ -87,9 +126,12 @@ def build_parser() -> argparse.ArgumentParser:
                            help="collect with the range camera's depth noise model (default: exact ranges)")
     reproduce.set_defaults(func=_reproduce)
 
-    train = sub.add_parser("train-default", help="rebuild the default tap model behind predict_effect")
-    train.add_argument("--dataset", type=Path, default=Path("default-taps"),
-                       help="where the 1000 canonical taps (seed 0) are collected (default ./default-taps)")
+    train = sub.add_parser("train-default", help="rebuild a behaviour's default model behind predict_effect")
+    train.add_argument("--behavior", default="tap", metavar="NAME",
+                       help="whose model: tap (default, shipped), grasp, tap_back or push")
+    train.add_argument("--dataset", type=Path, default=None,
+                       help="where the behaviour's 1000 canonical interactions (seed 0) are collected, or reused "
+                       "(default ./default-taps for the tap, ./default-BEHAVIOR otherwise)")
     train.add_argument("--workers", type=int, default=2)
     train.add_argument("--out", type=Path, default=None, help="model file (default: the package's own)")
     train.set_defaults(func=_train_default)

@@ -1,14 +1,17 @@
-"""``predict_effect(features)``: the effect of a tap predicted by the package's default tap model.
+"""``predict_effect(features, behavior)``: the effect of a behaviour predicted by the package's default model.
 
-The default model is an :class:`AffordanceModel` (1 x 4 map, r = 0.4: the paper's case-study setting and
-its best relevancy) trained by :func:`train_default_model` on a dataset of canonical taps (the command
-``affordance train-default`` builds it) and stored at ``affordance_learning/data/tap_model.joblib`` with the
-bundle format, this package's version, scikit-learn's version and NumPy's major version.
+One default model per behaviour, as the paper proposes ("a separate SOM and SVM for each behavior"). Each is
+an :class:`AffordanceModel` (1 x 4 map, r = 0.4: the paper's case-study setting and its best relevancy)
+trained by :func:`train_default_model` on a dataset of that behaviour's canonical interactions (the command
+``affordance train-default --behavior NAME`` builds it) and stored at
+``affordance_learning/data/<behavior>_model.joblib`` (:func:`model_path`) with the behaviour, the bundle
+format, this package's version, scikit-learn's version and NumPy's major version. The package ships the tap's;
+bundles stored before the behaviour was recorded are the tap's.
 
 :func:`load_default_model` refuses a file that is missing (:class:`DefaultModelMissingError`, a
-``FileNotFoundError``), unreadable, not a bundle of the current :data:`FORMAT`, or stored under other
-versions (:class:`DefaultModelError`, a ``RuntimeError``), with a message that says how to rebuild it; it
-never uses a model it could not check. :data:`FORMAT` is raised whenever the fitted layout of
+``FileNotFoundError``), unreadable, not a bundle of the current :data:`FORMAT`, a model of another behaviour,
+or stored under other versions (:class:`DefaultModelError`, a ``RuntimeError``), with a message that says how
+to rebuild it; it never uses a model it could not check. :data:`FORMAT` is raised whenever the fitted layout of
 :class:`AffordanceModel` changes, so that an older file is refused rather than half-used. A good load is
 cached, keyed by the file's path, size and modification time, so a rebuilt file is used at the next call.
 """
@@ -25,27 +28,41 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike
 
+from affordance_learning.behaviors import check_behavior
 from affordance_learning.model import AffordanceModel, EffectPrediction
 from affordance_learning.validation import first_non_finite
 
+#: Where the default models are stored, one file per behaviour.
+MODEL_DIR = Path(__file__).resolve().parent / "data"
 #: Where the default tap model is stored.
-DEFAULT_MODEL_PATH = Path(__file__).resolve().parent / "data" / "tap_model.joblib"
+DEFAULT_MODEL_PATH = MODEL_DIR / "tap_model.joblib"
 #: Map size and relevancy threshold of the default model.
 DEFAULT_N_CLUSTERS = 4
 DEFAULT_RELEVANCY = 0.4
 #: Layout of the stored bundle and of AffordanceModel's fitted attributes; raise it when either changes.
 FORMAT = 2
-#: The command that rebuilds the default model.
+#: The command that rebuilds the default tap model (see :func:`rebuild_command` for the others).
 REBUILD_COMMAND = "affordance train-default"
 _N_FEATURES = 49
 
 
 class DefaultModelError(RuntimeError):
-    """The default tap model is unusable: unreadable, of another format, or of other library versions."""
+    """A default model is unusable: unreadable, of another format or behaviour, or of other library versions."""
 
 
 class DefaultModelMissingError(DefaultModelError, FileNotFoundError):
-    """The default tap model file does not exist."""
+    """A default model file does not exist."""
+
+
+def model_path(behavior: str = "tap") -> Path:
+    """Where the package's default model of ``behavior`` is stored; raises ValueError for an unknown
+    behaviour, naming the valid ones."""
+    return MODEL_DIR / f"{check_behavior(behavior)}_model.joblib"
+
+
+def rebuild_command(behavior: str = "tap") -> str:
+    """The command that rebuilds the default model of ``behavior``."""
+    return REBUILD_COMMAND if behavior == "tap" else f"{REBUILD_COMMAND} --behavior {behavior}"
 
 
 def _feature_names() -> list[str]:
@@ -75,26 +92,37 @@ def library_versions() -> dict[str, str]:
 
 def train_default_model(
     df: pd.DataFrame,
-    path: str | Path = DEFAULT_MODEL_PATH,
+    path: str | Path | None = None,
     *,
+    behavior: str = "tap",
     n_clusters: int = DEFAULT_N_CLUSTERS,
     relevancy: float = DEFAULT_RELEVANCY,
     random_state: int = 0,
 ) -> AffordanceModel:
-    """Fit the default tap model on a dataset frame and store it with the library versions.
+    """Fit the default model of a behaviour on a dataset frame and store it with the library versions.
 
     Args:
-        df: Interactions in the dataset schema: ``initial_<name>`` and ``effect_<name>`` for each of the 49
-            feature names (``affordance_env.features.FEATURE_NAMES``).
-        path: Where to write the model (the directory is created); written to a temporary file first and
-            moved into place, so a reader never sees half a file.
+        df: Interactions of ``behavior`` in the dataset schema: ``initial_<name>`` and ``effect_<name>`` for
+            each of the 49 feature names (``affordance_env.features.FEATURE_NAMES``); its ``behavior`` column,
+            if it has one, must name ``behavior`` only.
+        path: Where to write the model (the directory is created; default: the package's file of the
+            behaviour, :func:`model_path`); written to a temporary file first and moved into place, so a
+            reader never sees half a file.
+        behavior: The behaviour of the interactions, one of :data:`affordance_learning.behaviors.BEHAVIORS`.
         n_clusters: Effect categories (map size), in [2, 10].
         relevancy: Relevancy threshold of the feature selection, in [0, 1].
         random_state: Seed of the map.
 
     Returns:
         The fitted model.
+
+    Raises:
+        ValueError: An unknown behaviour, a frame of another behaviour or of several, or missing columns.
     """
+    from affordance_learning.experiment import frame_behavior
+
+    path = model_path(behavior) if path is None else path
+    frame_behavior(df, check_behavior(behavior))
     names = _feature_names()
     missing = [c for n in names for c in (f"initial_{n}", f"effect_{n}") if c not in df.columns]
     if missing:
@@ -107,6 +135,7 @@ def train_default_model(
     model = AffordanceModel(n_clusters=n_clusters, relevancy=relevancy, random_state=random_state).fit(X, E)
     bundle = {
         "format": FORMAT,
+        "behavior": behavior,
         "model": model,
         "versions": library_versions(),
         "feature_names": names,
@@ -121,79 +150,99 @@ def train_default_model(
     return model
 
 
-def _problem(path: Path | str, problem: str) -> str:
+def _problem(path: Path | str, problem: str, behavior: str) -> str:
+    what = "taps" if behavior == "tap" else f"{behavior} interactions"
     return (
-        f"The default tap model {path} {problem}. Rebuild it with `{REBUILD_COMMAND}` (it collects or reuses "
-        "1000 canonical taps, trains the model and stores it there)."
+        f"The default {behavior} model {path} {problem}. Rebuild it with `{rebuild_command(behavior)}` (it "
+        f"collects or reuses 1000 canonical {what}, trains the model and stores it there)."
     )
 
 
 @functools.lru_cache(maxsize=4)
-def _load(path: str, size: int, mtime_ns: int) -> tuple[AffordanceModel, tuple[str, ...]]:
-    """Load and check a stored model; ``size`` and ``mtime_ns`` only key the cache."""
+def _load(path: str, size: int, mtime_ns: int, behavior: str) -> tuple[AffordanceModel, tuple[str, ...]]:
+    """Load and check a stored model of ``behavior``; ``size`` and ``mtime_ns`` only key the cache."""
     try:
         bundle: Any = joblib.load(path)
     except Exception as exc:  # unpickling a damaged file can raise almost anything
-        raise DefaultModelError(_problem(path, f"could not be read ({type(exc).__name__}: {exc})")) from exc
+        raise DefaultModelError(
+            _problem(path, f"could not be read ({type(exc).__name__}: {exc})", behavior)) from exc
     if not isinstance(bundle, dict) or bundle.get("format") != FORMAT:
         found = bundle.get("format") if isinstance(bundle, dict) else type(bundle).__name__
         raise DefaultModelError(
-            _problem(path, f"is not a tap model bundle of format {FORMAT} (found {found!r})")
+            _problem(path, f"is not a default model bundle of format {FORMAT} (found {found!r})", behavior)
         )
+    stored_behavior = bundle.get("behavior", "tap")  # bundles stored before the behaviour was recorded: taps
+    if stored_behavior != behavior:
+        raise DefaultModelError(_problem(path, f"holds a {stored_behavior!r} model, not a {behavior!r} one",
+                                         behavior))
     model = bundle.get("model")
     names = bundle.get("feature_names")
     if not isinstance(model, AffordanceModel) or not isinstance(names, list) or len(names) != _N_FEATURES:
-        raise DefaultModelError(_problem(path, "does not hold an AffordanceModel over the 49 features"))
+        raise DefaultModelError(_problem(path, "does not hold an AffordanceModel over the 49 features", behavior))
     stored, installed = bundle.get("versions", {}), library_versions()
     changed = [
         f"{k} {stored.get(k)} (model) vs {v} (installed)" for k, v in installed.items() if stored.get(k) != v
     ]
     if changed:
         raise DefaultModelError(
-            _problem(path, "was stored under other library versions: " + "; ".join(changed))
+            _problem(path, "was stored under other library versions: " + "; ".join(changed), behavior)
         )
     return model, tuple(names)
 
 
-def _load_checked(path: Path) -> tuple[AffordanceModel, tuple[str, ...]]:
+def _load_checked(path: Path, behavior: str) -> tuple[AffordanceModel, tuple[str, ...]]:
     try:
         stat = path.stat()
     except OSError as exc:
-        raise DefaultModelMissingError(_problem(path, f"is missing ({exc.strerror})")) from exc
-    return _load(str(path.resolve()), stat.st_size, stat.st_mtime_ns)
+        raise DefaultModelMissingError(_problem(path, f"is missing ({exc.strerror})", behavior)) from exc
+    return _load(str(path.resolve()), stat.st_size, stat.st_mtime_ns, behavior)
 
 
-def load_default_model(path: str | Path = DEFAULT_MODEL_PATH) -> AffordanceModel:
-    """The default tap model, checked against the installed library versions (cached).
+def load_default_model(path: str | Path | None = None, *, behavior: str = "tap") -> AffordanceModel:
+    """The default model of a behaviour, checked against the installed library versions (cached).
+
+    Args:
+        path: The stored model (default: the package's file of the behaviour, :func:`model_path`).
+        behavior: The behaviour the model must be of, one of :data:`affordance_learning.behaviors.BEHAVIORS`.
 
     Raises:
-        DefaultModelMissingError: The file does not exist (a ``FileNotFoundError``).
-        DefaultModelError: The file is unreadable, not a tap model bundle of the current format, or was
-            stored under other versions (a ``RuntimeError``).
+        ValueError: An unknown behaviour.
+        DefaultModelMissingError: The file does not exist (a ``FileNotFoundError``); the message gives the
+            command that builds it.
+        DefaultModelError: The file is unreadable, not a model bundle of the current format, a model of
+            another behaviour, or was stored under other versions (a ``RuntimeError``).
     """
-    return _load_checked(Path(path))[0]
+    path = model_path(behavior) if path is None else Path(path)
+    return _load_checked(path, check_behavior(behavior))[0]
 
 
 def predict_effect(
-    features: ArrayLike | pd.DataFrame, *, path: str | Path = DEFAULT_MODEL_PATH
+    features: ArrayLike | pd.DataFrame, behavior: str = "tap", *, path: str | Path | None = None
 ) -> EffectPrediction:
-    """Predict the effect category of a canonical tap, and what the effect looks like, from the 49 features.
+    """Predict the effect category of a behaviour's canonical interaction with objects, and what the effect
+    looks like, from their 49 features.
 
     Args:
-        features: One (49,) or many (n, 49) feature vectors of objects before the tap, in the order of
-            ``affordance_env.features.FEATURE_NAMES`` (``obs["features"]`` of ``TapAffordance-v0``), or a
+        features: One (49,) or many (n, 49) feature vectors of objects before the interaction, in the order
+            of ``affordance_env.features.FEATURE_NAMES`` (``obs["features"]`` of ``TapAffordance-v0``), or a
             DataFrame with those columns (in any order; other columns are ignored); finite.
-        path: The stored model (default: the package's).
+        behavior: Whose default model predicts: ``"tap"`` (shipped), ``"grasp"``, ``"tap_back"`` or
+            ``"push"`` (built by ``affordance train-default --behavior NAME``).
+        path: The stored model (default: the package's file of the behaviour, :func:`model_path`).
 
     Returns:
         ``category`` (n,) int and ``effect`` (n, 49) float: the category's prototype effect (final minus
         initial features, in each feature's unit). One (49,) vector gives n = 1.
 
     Raises:
-        ValueError: ``features`` has another shape or lacks feature columns, or holds NaN or inf.
-        DefaultModelError: The default model is missing, broken or stale (rebuild it with
-            ``affordance train-default``).
+        ValueError: An unknown behaviour, or ``features`` has another shape or lacks feature columns, or holds
+            NaN or inf.
+        DefaultModelMissingError: The behaviour's default model was not built (the message gives the command).
+        DefaultModelError: The default model is broken, of another behaviour or stale (rebuild it with
+            ``affordance train-default --behavior NAME``).
     """
+    path = model_path(behavior) if path is None else Path(path)
+    check_behavior(behavior)
     if isinstance(features, pd.DataFrame):
         names = _feature_names()
         missing = [n for n in names if n not in features.columns]
@@ -215,5 +264,5 @@ def predict_effect(
     if found:
         count, row, col, value = found
         raise ValueError(f"features must be finite; row {row}, feature {col} is {value} ({count} non-finite value(s)).")
-    model, names = _load_checked(Path(path))
+    model, names = _load_checked(path, behavior)
     return model.predict_effect(pd.DataFrame(X, columns=list(names)))

@@ -2,13 +2,17 @@
 
 Akgun et al. 2009, section V, on a pandas DataFrame in the project's dataset schema: for each feature name
 (``affordance_env.features.FEATURE_NAMES``) the columns ``initial_<name>``, ``final_<name>`` and
-``effect_<name>``, and the ground truth ``type`` (sphere | box | horizontal_cylinder | vertical_cylinder),
-``size`` [m], ``rolled`` (bool) and ``displacement`` [m]. The ground truth is used only to evaluate, never to
-learn. :func:`run_protocol` repeats, for every trial t and every number of clusters k:
+``effect_<name>``, the ``behavior`` and the ground truth ``type`` (sphere | box | horizontal_cylinder |
+vertical_cylinder), ``size`` [m], ``success`` (bool, the paper's hand label of the behaviour: the tap rolled the
+object, the grasp lifted and held it, ...; a tap or tap_back frame without it is evaluated against ``rolled``,
+their success) and ``displacement`` [m]. The ground truth is used only to evaluate, never to learn. One frame
+holds one behaviour's interactions: the paper learns "a separate SOM and SVM for each behavior".
+:func:`run_protocol` repeats, for every trial t and every number of clusters k:
 
 1. A 1 x k self-organising map, seeded from ``(random_state, t, k)``, clusters the standardised effects of
    all interactions (the categories are the robot's, over all its experience). Measured against the ground
-   truth: uniformity against ``rolled`` (the paper's metric), purity and adjusted Rand index against ``type``.
+   truth: uniformity against ``success`` (the paper's metric), purity and adjusted Rand index against
+   ``type``.
 2. The interactions are split once per trial into training and test rows (``test_size``, 30 % by default),
    stratified by object type and seeded from ``(random_state, t)``; every k and r of a trial use the same
    split, so differences across k and r are not split noise. (Stratifying by cluster is not possible for
@@ -17,8 +21,8 @@ learn. :func:`run_protocol` repeats, for every trial t and every number of clust
 3. ReliefF weighs the standardised initial features of the training rows against their categories, once per
    (t, k): the weights do not depend on the relevancy threshold. The test rows take no part in it.
 4. For every relevancy threshold r the model keeps the features whose weight exceeds r x the largest weight
-   (:func:`affordance_learning.model.select_features`); recorded are their number and the share of them that
-   are shape features; the SVM (standardisation + RBF ``SVC``) is trained on the training rows and its
+   (:func:`affordance_learning.model.select_features`); recorded are their number and the shares of them that
+   are shape and size features; the SVM (standardisation + RBF ``SVC``) is trained on the training rows and its
    accuracy measured on the test rows, next to the accuracy of always answering the training rows' most
    common category (``svm_baseline``).
 
@@ -26,8 +30,12 @@ Trials run in parallel with joblib; a trial's seeds come from ``(random_state, t
 over fewer k gives the same numbers for those k), and the results are gathered in trial order, so they do
 not depend on ``n_jobs``. Means and standard deviations (population, ddof = 0) are over trials.
 
+Besides, once over all rows: how success depends on object size (:func:`affordance_learning.metrics.size_success`,
+the grasp's critical size) and what the effects contain (:func:`effect_summary`).
+
 :func:`make_synthetic_frame` builds a frame in the same schema without the simulator (for tests, benchmarks
-and demonstrations): spheres and lying cylinders roll, boxes and standing cylinders do not.
+and demonstrations): taps, where spheres and lying cylinders roll and boxes and standing cylinders do not, or
+grasps, where objects smaller than a critical size are held and larger ones are not.
 """
 
 from __future__ import annotations
@@ -43,7 +51,8 @@ from joblib import Parallel, delayed
 from sklearn.model_selection import train_test_split
 from sklearn.preprocessing import StandardScaler
 
-from affordance_learning.metrics import adjusted_rand, cluster_purity, make_svm, uniformity
+from affordance_learning.behaviors import ROLLED_IS_SUCCESS, outcome_words
+from affordance_learning.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
 from affordance_learning.model import _check_int, select_features
 from affordance_learning.relieff import MULTICLASS_THRESHOLD, ReliefFScorer
 from affordance_learning.som import SOMClustering
@@ -55,7 +64,10 @@ OBJECT_TYPES = ("sphere", "horizontal_cylinder", "box", "vertical_cylinder")
 GROUP_SIZES = (("shape", 24), ("size", 18), ("relation", 7))
 DEFAULT_KS = tuple(range(2, 11))
 DEFAULT_RELEVANCIES = (0.0, 0.2, 0.4, 0.6, 0.8)
-CASE_STUDY_KS = (2, 4)
+#: Map sizes whose clusters are described: the paper's tap case studies (k = 2, 4) and the grasp's k = 3.
+CASE_STUDY_KS = (2, 3, 4)
+#: Columns a frame's success/fail label can come from, in order of preference.
+LABEL_COLUMNS = ("success", "rolled")
 
 
 def feature_names(frame: pd.DataFrame) -> list[str]:
@@ -113,24 +125,70 @@ class _Data:
     """The arrays of a dataset frame that the protocol uses."""
 
     names: list[str]
-    shape: np.ndarray  # (d,) bool: shape feature
+    groups: np.ndarray  # (d,) str: group of each feature (shape, size, relation)
     X: np.ndarray  # (n, d) initial features
     Z: np.ndarray  # (n, d) standardised effects
-    rolled: np.ndarray  # (n,) bool
+    label: str  # the column the success/fail labels come from ("success" or "rolled")
+    success: np.ndarray  # (n,) bool
     types: np.ndarray  # (n,) str
     sizes: np.ndarray  # (n,) float [m]
     effect_mean: np.ndarray  # (d,) the standardisation of the effects, to turn prototypes back into units
     effect_scale: np.ndarray  # (d,)
 
 
+def label_column(frame: pd.DataFrame) -> str:
+    """The column of a frame that holds its success/fail labels: ``success``, else ``rolled`` (frames made
+    before the label existed); raises ValueError when it has neither."""
+    for column in LABEL_COLUMNS:
+        if column in frame.columns:
+            return column
+    raise ValueError(
+        "the frame has no 'success' column (nor 'rolled', the tap's label in frames without it): the "
+        "success/fail labels the protocol evaluates against."
+    )
+
+
+def frame_behavior(frame: pd.DataFrame, behavior: str | None = None) -> str:
+    """The one behaviour of a frame's interactions, from its ``behavior`` column.
+
+    Args:
+        frame: A dataset frame.
+        behavior: The behaviour the caller expects; needed when the frame has no ``behavior`` column, and
+            checked against it when it has one.
+
+    Raises:
+        ValueError: The frame mixes behaviours, holds another behaviour than ``behavior``, or has no
+            ``behavior`` column and ``behavior`` is None.
+    """
+    if behavior is not None and (not isinstance(behavior, str) or not behavior):
+        raise ValueError(f"behavior must be a behaviour name such as 'tap', got {behavior!r}.")
+    if "behavior" not in frame.columns:
+        if behavior is None:
+            raise ValueError(
+                "the frame has no 'behavior' column; pass the behaviour of its interactions (behavior='tap', "
+                "'grasp', ...)."
+            )
+        return behavior
+    found = sorted(pd.unique(frame["behavior"].astype(str)).tolist())
+    if len(found) != 1:
+        raise ValueError(
+            f"the frame mixes the behaviours {found}; the model learns one behaviour at a time (a separate "
+            "map and SVM per behaviour): select one, e.g. frame[frame['behavior'] == 'tap']."
+        )
+    if behavior is not None and found[0] != behavior:
+        raise ValueError(f"the frame holds {found[0]!r} interactions, not {behavior!r} ones.")
+    return found[0]
+
+
 def _frame_data(frame: pd.DataFrame) -> _Data:
     if not isinstance(frame, pd.DataFrame):
         raise ValueError(f"expected a pandas DataFrame in the dataset schema, got {type(frame).__name__}.")
-    for column in ("type", "size", "rolled"):
+    for column in ("type", "size"):
         if column not in frame.columns:
             raise ValueError(
                 f"the frame has no {column!r} column (ground truth the protocol evaluates against)."
             )
+    label = label_column(frame)
     names = feature_names(frame)
     X = frame[[f"initial_{n}" for n in names]].to_numpy(dtype=np.float64)
     E = frame[[f"effect_{n}" for n in names]].to_numpy(dtype=np.float64)
@@ -142,21 +200,22 @@ def _frame_data(frame: pd.DataFrame) -> _Data:
                 f"{count} non-finite value(s) in the {prefix} columns, the first in row {row}, "
                 f"column {prefix}{names[col]}: {value}; expected finite features."
             )
-    rolled = frame["rolled"].to_numpy()
-    if rolled.dtype != bool:
-        if not set(pd.unique(rolled).tolist()) <= {0, 1}:
-            raise ValueError(f"'rolled' must be boolean, got values {pd.unique(rolled).tolist()[:5]}.")
-        rolled = rolled.astype(bool)
+    success = frame[label].to_numpy()
+    if success.dtype != bool:
+        if not set(pd.unique(success).tolist()) <= {0, 1}:
+            raise ValueError(f"{label!r} must be boolean, got values {pd.unique(success).tolist()[:5]}.")
+        success = success.astype(bool)
     sizes = frame["size"].to_numpy(dtype=np.float64)
     if not np.all(np.isfinite(sizes)):
         raise ValueError("'size' must be finite [m] for every row.")
     scaler = StandardScaler().fit(E)
     return _Data(
         names=names,
-        shape=np.array([g == "shape" for g in feature_groups(names)]),
+        groups=np.array(feature_groups(names)),
         X=X,
         Z=scaler.transform(E),
-        rolled=rolled,
+        label=label,
+        success=success,
         types=frame["type"].astype(str).to_numpy(),
         sizes=sizes,
         effect_mean=scaler.mean_,
@@ -165,15 +224,15 @@ def _frame_data(frame: pd.DataFrame) -> _Data:
 
 
 def _case_study(labels: np.ndarray, k: int, data: _Data, types: Sequence[str]) -> list[dict[str, Any]]:
-    """Per map node: rolled and not-rolled counts, object type counts, object sizes [m] (sorted)."""
+    """Per map node: success and fail counts, object type counts, object sizes [m] (sorted)."""
     clusters = []
     for c in range(k):
         members = labels == c
         clusters.append(
             {
                 "cluster": c,
-                "rolled": int(np.sum(data.rolled[members])),
-                "not_rolled": int(np.sum(~data.rolled[members])),
+                "success": int(np.sum(data.success[members])),
+                "fail": int(np.sum(~data.success[members])),
                 "types": {t: int(np.sum(data.types[members] == t)) for t in types},
                 "sizes": [round(float(s), 6) for s in np.sort(data.sizes[members])],
             }
@@ -208,12 +267,19 @@ def _run_trial(
         key: {} for key in ("uniformity", "purity", "ari", "n_categories", "baseline", "weights", "cases",
                             "prototypes")
     }
-    out.update({key: {} for key in ("accuracy", "shape_fraction", "n_selected")})
+    out.update({key: {} for key in ("accuracy", "shape_fraction", "size_fraction", "n_selected")})
+    shape, size = data.groups == "shape", data.groups == "size"
+
+    def record_selection(r: float, k: int, selected: np.ndarray) -> None:
+        out["shape_fraction"][r, k] = float(np.mean(shape[selected]))
+        out["size_fraction"][r, k] = float(np.mean(size[selected]))
+        out["n_selected"][r, k] = int(selected.size)
+
     for k in ks:
         seed = np.random.SeedSequence([random_state, trial, k]).generate_state(1)[0]
         som = SOMClustering(n_clusters=k, n_iterations=som_iterations, random_state=int(seed)).fit(data.Z)
         labels = som.labels_
-        out["uniformity"][k] = uniformity(labels, data.rolled)
+        out["uniformity"][k] = uniformity(labels, data.success)
         out["purity"][k] = cluster_purity(labels, data.types)
         out["ari"][k] = adjusted_rand(labels, data.types)
         out["n_categories"][k] = int(np.unique(labels).size)
@@ -232,8 +298,7 @@ def _run_trial(
             for r in relevancies:
                 selected = select_features(out["weights"][k], r)
                 out["accuracy"][r, k] = out["baseline"][k]
-                out["shape_fraction"][r, k] = float(np.mean(data.shape[selected]))
-                out["n_selected"][r, k] = int(selected.size)
+                record_selection(r, k, selected)
             continue
         if scorer is None:
             scorer = ReliefFScorer(StandardScaler().fit_transform(X_train))
@@ -247,8 +312,7 @@ def _run_trial(
                 svm = make_svm(svm_C, svm_gamma).fit(X_train[:, selected], y_train)
                 accuracy[key] = float(svm.score(X_test[:, selected], y_test))
             out["accuracy"][r, k] = accuracy[key]
-            out["shape_fraction"][r, k] = float(np.mean(data.shape[selected]))
-            out["n_selected"][r, k] = int(selected.size)
+            record_selection(r, k, selected)
     return out
 
 
@@ -313,12 +377,13 @@ def run_protocol(
     svm_gamma: float | str = "scale",
     case_study_ks: Iterable[int] = CASE_STUDY_KS,
     progress: bool = False,
+    behavior: str | None = None,
 ) -> dict[str, Any]:
     """Run the paper's protocol (module docstring) on a dataset frame; returns a JSON-ready results dict.
 
     Args:
-        df: Interactions in the dataset schema (at least the initial_ and effect_ columns, type, size,
-            rolled).
+        df: One behaviour's interactions in the dataset schema (at least the initial_ and effect_ columns,
+            type, size, and success or rolled).
         ks: Map sizes k (numbers of effect categories), each in [2, 10].
         relevancies: Relevancy thresholds r, each in [0, 1].
         n_trials: Repetitions with different map seeds and train/test splits.
@@ -331,21 +396,36 @@ def run_protocol(
         svm_gamma: SVM RBF coefficient.
         case_study_ks: Map sizes whose clusters of the first trial are described in ``case_studies``.
         progress: Draw a progress bar over the trials.
+        behavior: The behaviour of the interactions; by default the frame's ``behavior`` column says it (and
+            when given, it must agree with that column); needed for a frame without the column.
 
     Returns:
-        ``{"uniformity": {"<k>": {"mean", "std"}}`` [%], ``"svm_accuracy": {"<r>": {"<k>": {"mean", "std"}}}``
-        [0, 1], ``"shape_fraction"`` (same keys) [0, 1], ``"n_selected"`` (same keys), ``"case_studies":
-        {"<k>": [{"cluster", "rolled", "not_rolled", "types": {type: count}, "sizes": [m, ...]}]}``,
-        ``"purity"``, ``"adjusted_rand"`` (against the object type), ``"n_categories"`` (non-empty clusters),
-        ``"svm_baseline"`` (majority-category accuracy), all ``{"<k>": {"mean", "std"}}``,
-        ``"feature_weights": {"<k>": {name: mean ReliefF weight}}``, and ``"config"``. r is written as
-        ``str(float(r))`` ("0.0", "0.2", ...), k as ``str(k)``. A mean over no finite value is None.
+        ``{"uniformity": {"<k>": {"mean", "std"}}`` [%] (against the success/fail labels),
+        ``"svm_accuracy": {"<r>": {"<k>": {"mean", "std"}}}`` [0, 1], ``"shape_fraction"`` and
+        ``"size_fraction"`` (same keys; shares of shape and size features among the selected ones) [0, 1],
+        ``"n_selected"`` (same keys), ``"case_studies": {"<k>": [{"cluster", "success", "fail", "types":
+        {type: count}, "sizes": [m, ...]}]}``, ``"prototypes": {"<k>": [[effect per feature], ...]}``,
+        ``"feature_names"``, ``"effects"`` (:func:`effect_summary`), ``"size_success"``
+        (:func:`affordance_learning.metrics.size_success`), ``"purity"``, ``"adjusted_rand"`` (against the
+        object type), ``"n_categories"`` (non-empty clusters), ``"svm_baseline"`` (majority-category
+        accuracy), all ``{"<k>": {"mean", "std"}}``, ``"feature_weights": {"<k>": {name: mean ReliefF
+        weight}}``, and ``"config"``, which names the ``behavior``, the ``label`` column and how a success and
+        a failure read (``success_label``, ``fail_label``). r is written as ``str(float(r))`` ("0.0", "0.2",
+        ...), k as ``str(k)``. The schema is the same for every behaviour. A mean over no finite value is None.
     """
     ks, relevancies = _check_protocol_args(
         ks, relevancies, n_trials, random_state, test_size, n_neighbors, som_iterations
     )
     case_study_ks = [k for k in case_study_ks if k in ks]
     data = _frame_data(df)
+    behavior = frame_behavior(df, behavior)
+    if data.label == "rolled" and behavior not in ROLLED_IS_SUCCESS:
+        raise ValueError(
+            f"the frame has no 'success' column, and the success of {behavior!r} is not 'rolled' (that stands in "
+            f"only for {', '.join(ROLLED_IS_SUCCESS)}): load the dataset with an affordance_env that stores or "
+            "derives 'success' (dataset schema 4)."
+        )
+    success_label, fail_label = outcome_words(behavior, data.label)
     type_counts = pd.Series(data.types).value_counts()
     n_test = int(np.ceil(test_size * len(data.X)))
     if min(n_test, len(data.X) - n_test) < 2:
@@ -401,11 +481,13 @@ def run_protocol(
         "uniformity": per_k("uniformity"),
         "svm_accuracy": per_rk("accuracy"),
         "shape_fraction": per_rk("shape_fraction"),
+        "size_fraction": per_rk("size_fraction"),
         "n_selected": per_rk("n_selected"),
         "case_studies": {str(k): trials[0]["cases"][k] for k in case_study_ks},
         "prototypes": {str(k): trials[0]["prototypes"][k] for k in case_study_ks},
         "feature_names": list(data.names),
         "effects": effect_summary(df),
+        "size_success": size_success(data.sizes, data.success),
         "purity": per_k("purity"),
         "adjusted_rand": per_k("ari"),
         "n_categories": per_k("n_categories"),
@@ -421,6 +503,10 @@ def run_protocol(
             for k in ks
         },
         "config": {
+            "behavior": behavior,
+            "label": data.label,
+            "success_label": success_label,
+            "fail_label": fail_label,
             "ks": ks,
             "relevancies": relevancies,
             "n_trials": int(n_trials),
@@ -429,7 +515,7 @@ def run_protocol(
             "n_features": len(data.names),
             "feature_groups": {g: groups.count(g) for g in dict.fromkeys(groups)},
             "type_counts": {t: int(type_counts[t]) for t in type_order},
-            "rolled_fraction": float(np.mean(data.rolled)),
+            "success_fraction": float(np.mean(data.success)),
             "test_size": float(test_size),
             "split": f"train/test split per trial, {split}, shared by every k and r",
             "clustering": "1 x k minisom map of the standardised effects of all rows, seeded per (trial, k)",
@@ -437,6 +523,7 @@ def run_protocol(
             "n_neighbors": int(n_neighbors),
             "som_iterations": int(som_iterations),
             "svm": {"kernel": "rbf", "C": float(svm_C), "gamma": svm_gamma, "scaling": "standard"},
+            "case_study_ks": list(case_study_ks),
             "case_study_trial": 0,
             "std": "population standard deviation over trials (ddof=0)",
         },
@@ -446,14 +533,16 @@ def run_protocol(
 def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:
     """What the effects of a dataset contain, for a reader to check before any verdict.
 
-    Per object type (``by_type``): interactions, the shares rolled, at rest and seen in the final snapshot
-    (``visible_final``), and left the table (``outcome == "off_table"``); the median travel (``displacement``)
-    [m], the median 3-D motion seen, ``|effect of (mean_x, mean_y, mean_z)|`` [m], over the objects seen at
-    the end, the median ``|effect of pixel_count|`` [pixels] and the median change of the normal histograms
-    (sum of ``|effect|`` over the 24 shape features). Overall: the share of rolled objects seen at the end
-    (``rolled_visible``), the share of rolled objects whose effect is just minus their initial features
-    (``rolled_effect_is_minus_initial``: they vanished), and the Spearman correlation of the travel with the
-    3-D motion seen (``travel_vs_seen_motion``). Columns the frame lacks give None.
+    Per object type (``by_type``): interactions, the shares of successes (the ``success`` label, or
+    ``rolled`` for a frame without it), at rest and seen in the final snapshot (``visible_final``), and left
+    the table (``outcome == "off_table"``); the median travel (``displacement``) [m], the median 3-D motion
+    seen, ``|effect of (mean_x, mean_y, mean_z)|`` [m], over the objects seen at the end, the median
+    ``|effect of pixel_count|`` [pixels] and the median change of the normal histograms (sum of ``|effect|``
+    over the 24 shape features). Overall: the share of successes whose object is seen at the end
+    (``success_visible``; at rest and seen: ``success_rest_visible``), the share of successes whose effect is
+    just minus their initial features (``success_effect_is_minus_initial``: the object vanished), and the
+    Spearman correlation of the travel with the 3-D motion seen (``travel_vs_seen_motion``). Columns the frame
+    lacks give None.
     """
     names = feature_names(frame)
     groups = feature_groups(names)
@@ -468,7 +557,7 @@ def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:
     visible = frame["visible_final"].to_numpy(dtype=bool) if "visible_final" in frame else None
     outcome = frame["outcome"].astype(str).to_numpy() if "outcome" in frame else None
     travel = frame["displacement"].to_numpy(dtype=np.float64) if "displacement" in frame else None
-    rolled = frame["rolled"].to_numpy(dtype=bool)
+    success = frame[label_column(frame)].to_numpy(dtype=bool)
     pixels = (np.abs(frame["effect_pixel_count"].to_numpy(dtype=np.float64)) if "pixel_count" in names
               else np.full(len(frame), np.nan))
 
@@ -488,7 +577,7 @@ def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:
         seen = rows & visible if visible is not None else rows
         by_type[t] = {
             "n": int(rows.sum()),
-            "rolled": share(rolled, rows),
+            "success": share(success, rows),
             "rest": share(None if outcome is None else outcome == "rest", rows),
             "visible_final": share(visible, rows),
             "off_table": share(None if outcome is None else outcome == "off_table", rows),
@@ -504,32 +593,49 @@ def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:
         correlation = float(spearmanr(travel[visible], seen_motion[visible]).statistic)
     return {
         "by_type": by_type,
-        "rolled_visible": share(visible, rolled),
-        "rolled_rest_visible": None if visible is None or outcome is None else share(
-            visible & (outcome == "rest"), rolled),
-        "rolled_effect_is_minus_initial": share(vanished, rolled),
+        "success_visible": share(visible, success),
+        "success_rest_visible": None if visible is None or outcome is None else share(
+            visible & (outcome == "rest"), success),
+        "success_effect_is_minus_initial": share(vanished, success),
         "travel_vs_seen_motion": correlation,
     }
 
 
-def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0) -> pd.DataFrame:
-    """A dataset frame in the project's schema with tapping-like structure, made without the simulator.
+#: Behaviours :func:`make_synthetic_frame` can imitate, with their object size ranges [m].
+SYNTHETIC_SIZE_RANGES = {"tap": (0.04, 0.10), "grasp": (0.03, 0.09)}
+#: Size [m] at which a synthetic grasp holds the object half of the time, and the width of the transition [m].
+SYNTHETIC_CRITICAL_SIZE, SYNTHETIC_GRASP_SPREAD = 0.06, 0.003
 
-    Objects of the four types, sizes uniform in [0.04, 0.10] m. Spheres and lying cylinders roll (95 %),
-    boxes and standing cylinders do not (97 %). Shape features (normal histograms, fractions) depend on the
-    type, size features on the size, relation features are jitter. As on the simulated table, a rolled object
-    travels 5-22 cm and is seen where it stops: its effect moves its position, range, pixel count and image
-    offsets by its travel; 3 % of the rolled objects leave the table instead (``outcome == "off_table"``,
-    ``visible_final`` False, final features all zeros, so their effect is minus their initial features); a
-    resting object slides about 1.5 cm. Feature names are ``affordance_env.features.FEATURE_NAMES`` when
-    available, else ``f00`` ... ``f48``.
+
+def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: str = "tap") -> pd.DataFrame:
+    """A dataset frame in the project's schema with tapping- or grasping-like structure, made without the
+    simulator.
+
+    Objects of the four types. Shape features (normal histograms, fractions) depend on the type, size features
+    on the size, relation features are jitter.
+
+    - ``"tap"``: sizes uniform in [0.04, 0.10] m. Spheres and lying cylinders roll (95 %), boxes and standing
+      cylinders do not (97 %); ``success`` is ``rolled``. As on the simulated table, a rolled object travels
+      5-22 cm and is seen where it stops: its effect moves its position, range, pixel count and image offsets
+      by its travel; 3 % of the rolled objects leave the table instead (``outcome == "off_table"``,
+      ``visible_final`` False, final features all zeros, so their effect is minus their initial features); a
+      resting object slides about 1.5 cm.
+    - ``"grasp"``: sizes uniform in [0.03, 0.09] m. Whatever its type, an object is held with probability
+      ``1 / (1 + exp((size - 0.06 m) / 3 mm))``: the critical size is 6 cm. A held object is put down about
+      6 cm from where it stood; one not held is nudged by about half a centimetre. Nothing rolls.
+
+    Feature names are ``affordance_env.features.FEATURE_NAMES`` when available, else ``f00`` ... ``f48``.
 
     Args:
         n_rows: Interactions, >= 8.
         random_state: Seed.
+        behavior: ``"tap"`` or ``"grasp"`` (the ``behavior`` column).
     """
     if isinstance(n_rows, bool) or not isinstance(n_rows, numbers.Integral) or n_rows < 8:
         raise ValueError(f"n_rows must be an integer >= 8, got {n_rows!r}.")
+    if behavior not in SYNTHETIC_SIZE_RANGES:
+        raise ValueError(f"behavior must be one of {tuple(SYNTHETIC_SIZE_RANGES)}, got {behavior!r}.")
+    grasp = behavior == "grasp"
     try:
         from affordance_env.features import FEATURE_NAMES
 
@@ -540,9 +646,13 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0) -> pd.DataFr
     types = np.array(OBJECT_TYPES)[np.arange(n_rows) % 4]
     rng.shuffle(types)
     kind = np.searchsorted(np.array(sorted(OBJECT_TYPES)), types)  # 0 box, 1 horizontal, 2 sphere, 3 vertical
-    size = rng.uniform(0.04, 0.10, n_rows)
-    rollable = np.isin(types, ("sphere", "horizontal_cylinder"))
-    rolled = np.where(rollable, rng.random(n_rows) < 0.95, rng.random(n_rows) < 0.03)
+    size = rng.uniform(*SYNTHETIC_SIZE_RANGES[behavior], n_rows)
+    if grasp:
+        held = rng.random(n_rows) < 1.0 / (1.0 + np.exp((size - SYNTHETIC_CRITICAL_SIZE) / SYNTHETIC_GRASP_SPREAD))
+        rolled = np.zeros(n_rows, dtype=bool)
+    else:
+        rollable = np.isin(types, ("sphere", "horizontal_cylinder"))
+        rolled = np.where(rollable, rng.random(n_rows) < 0.95, rng.random(n_rows) < 0.03)
 
     # Shape: a latitude and a longitude histogram per type, 12 bins each, perturbed and renormalised.
     bins = np.arange(12)
@@ -584,10 +694,13 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0) -> pd.DataFr
     relation = rng.normal(0.0, 1.0, (n_rows, 7)) * np.array([5, 5, 7, 0.02, 0.02, 0.02, 0.03])
     initial = np.hstack([shape, size_features, relation])
 
-    # Effects: travel along the tap direction for rolling objects, a 1.5 cm slide otherwise.
-    roll = np.where(types == "sphere", rng.uniform(0.10, 0.22, n_rows), rng.uniform(0.05, 0.20, n_rows))
-    travel = np.where(rolled, roll, rng.normal(0.015, 0.003, n_rows))
-    off_table = rolled & (rng.random(n_rows) < 0.03)
+    if grasp:  # Effects: put down 6 cm away when held, nudged by half a centimetre otherwise.
+        travel = np.where(held, rng.normal(0.06, 0.004, n_rows), np.abs(rng.normal(0.005, 0.003, n_rows)))
+        off_table = np.zeros(n_rows, dtype=bool)
+    else:  # Effects: travel along the tap direction for rolling objects, a 1.5 cm slide otherwise.
+        roll = np.where(types == "sphere", rng.uniform(0.10, 0.22, n_rows), rng.uniform(0.05, 0.20, n_rows))
+        travel = np.where(rolled, roll, rng.normal(0.015, 0.003, n_rows))
+        off_table = rolled & (rng.random(n_rows) < 0.03)
     effect = rng.normal(0.0, 1.0, initial.shape) * 0.01 * (np.abs(initial).mean(axis=0) + 1e-3)
     effect[:, 24] += 0.1 * travel  # mean_x
     effect[:, 25] += travel  # mean_y
@@ -605,7 +718,8 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0) -> pd.DataFr
     columns: dict[str, Any] = {}
     for prefix, values in (("initial_", initial), ("final_", final), ("effect_", effect)):
         columns.update({f"{prefix}{n}": values[:, j] for j, n in enumerate(names)})
-    columns.update({"type": types, "size": size, "rolled": rolled, "displacement": np.abs(travel),
+    columns.update({"behavior": np.full(n_rows, behavior), "type": types, "size": size, "rolled": rolled,
+                    "success": held if grasp else rolled, "displacement": np.abs(travel),
                     "rolling_distance": np.where(rolled, np.abs(travel), 0.0), "visible_final": ~off_table,
                     "outcome": np.where(off_table, "off_table", "rest")})
     return pd.DataFrame(columns)

@@ -2,11 +2,15 @@
 
 Drawn with matplotlib's object API on the Agg canvas (no pyplot, no display, no global backend setting):
 
-- ``uniformity.png`` (Fig. 7): uniformity against rolled/not rolled versus k, mean and standard deviation.
-- ``selected_features.png`` (Fig. 8): share of shape features among the selected ones, and their number,
-  versus k, one line per relevancy threshold r.
-- ``case_study_k2.png``, ``case_study_k4.png`` (Figs. 9, 10): per cluster of the 1 x 2 and 1 x 4 maps, the
-  rolled/not-rolled counts, the object types and the spread of object sizes.
+- ``uniformity.png`` (Fig. 7): uniformity against the behaviour's success/fail labels versus k, mean and
+  standard deviation, beside what the paper states for the tap or the grasp.
+- ``selected_features.png`` (Fig. 8): shares of shape and of size features among the selected ones, and their
+  number, versus k, one line per relevancy threshold r.
+- ``case_study_k2.png``, ``case_study_k3.png``, ``case_study_k4.png`` (Figs. 9, 10; k = 3 for the grasp): per
+  cluster of the 1 x k maps, the success/fail counts, the object types and the spread of object sizes, with
+  the critical size of the grasp when there is one.
+- ``size_success.png`` (not in the paper): the share of successes per object size, with the logistic fit and
+  the critical size where it crosses 50 %.
 - ``svm_accuracy.png`` (Fig. 11): SVM accuracy on held-out interactions versus k, one line per r, with the
   accuracy of always answering the most common category.
 - ``clusters_vs_type.png`` (not in the paper): purity and adjusted Rand index of the clusters against the
@@ -26,7 +30,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-_REQUIRED = ("uniformity", "svm_accuracy", "shape_fraction", "n_selected", "case_studies")
+_REQUIRED = ("uniformity", "svm_accuracy", "shape_fraction", "size_fraction", "n_selected", "case_studies")
 _TYPE_COLOURS = {
     "sphere": "tab:red",
     "horizontal_cylinder": "tab:orange",
@@ -34,6 +38,15 @@ _TYPE_COLOURS = {
     "vertical_cylinder": "tab:cyan",
 }
 _DPI = 120
+#: What the paper states about the mean uniformity over k, per behaviour, and its highest value [%].
+_PAPER_UNIFORMITY = {"tap": (80.0, 95.0), "grasp": (70.0, 95.0)}
+
+
+def _words(results: Mapping[str, Any]) -> tuple[str, str, str]:
+    """The behaviour and how its success and failure read, from the results' config."""
+    config = results.get("config", {})
+    return (config.get("behavior", "tap"), config.get("success_label", "success"),
+            config.get("fail_label", "fail"))
 
 
 def _series(per_k: Mapping[str, Mapping[str, float | None]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -58,14 +71,18 @@ def _save(fig: Figure, path: Path) -> Path:
 
 def _uniformity(results: Mapping[str, Any], path: Path) -> Path:
     fig, (ax,) = _new_figure(5.5, 3.8)
+    behavior, success, fail = _words(results)
     k, mean, std = _series(results["uniformity"])
     ax.errorbar(k, mean, yerr=std, marker="o", capsize=3, label="ours (mean ± std over trials)")
-    ax.axhline(80.0, color="grey", linestyle="--", linewidth=1, label="paper: above 80 % on average")
-    ax.axhline(95.0, color="grey", linestyle=":", linewidth=1, label="paper: up to 95 %")
+    if behavior in _PAPER_UNIFORMITY:
+        average, peak = _PAPER_UNIFORMITY[behavior]
+        ax.axhline(average, color="grey", linestyle="--", linewidth=1,
+                   label=f"paper ({behavior}): above {average:.0f} % on average")
+        ax.axhline(peak, color="grey", linestyle=":", linewidth=1, label=f"paper: up to {peak:.0f} %")
     ax.set(
         xlabel="number of clusters k",
-        ylabel="uniformity [%]",
-        title="Uniformity of effect clusters (cf. Fig. 7)",
+        ylabel=f"uniformity vs {success} / {fail} [%]",
+        title=f"Uniformity of {behavior} effect clusters (cf. Fig. 7)",
     )
     ax.set_xticks(k)
     ax.set_ylim(0, 102)
@@ -83,12 +100,14 @@ def _per_r(ax: Any, per_rk: Mapping[str, Mapping[str, Any]], scale: float = 1.0)
 
 
 def _selected_features(results: Mapping[str, Any], path: Path) -> Path:
-    fig, (top, bottom) = _new_figure(6.0, 6.5, nrows=2)
+    fig, (top, middle, bottom) = _new_figure(6.0, 9.0, nrows=3)
     _per_r(top, results["shape_fraction"], 100.0)
     top.set(
         ylabel="shape features [%]", ylim=(0, 102), title="Shape share of the selected features (cf. Fig. 8a)"
     )
     top.legend(fontsize="small", ncols=3)
+    _per_r(middle, results["size_fraction"], 100.0)
+    middle.set(ylabel="size features [%]", ylim=(0, 102), title="Size share of the selected features")
     _per_r(bottom, results["n_selected"])
     bottom.set(
         xlabel="number of clusters k",
@@ -99,15 +118,17 @@ def _selected_features(results: Mapping[str, Any], path: Path) -> Path:
     return _save(fig, path)
 
 
-def _case_study(clusters: list[Mapping[str, Any]], k: str, path: Path) -> Path:
-    fig, (ax_roll, ax_type, ax_size) = _new_figure(12.0, 3.8, ncols=3)
+def _case_study(results: Mapping[str, Any], k: str, path: Path) -> Path:
+    clusters = results["case_studies"][k]
+    behavior, success_label, fail_label = _words(results)
+    fig, (ax_label, ax_type, ax_size) = _new_figure(12.0, 3.8, ncols=3)
     index = np.array([c["cluster"] for c in clusters])
-    rolled = np.array([c["rolled"] for c in clusters])
-    not_rolled = np.array([c["not_rolled"] for c in clusters])
-    ax_roll.bar(index, rolled, color="tab:green", label="rolled (success)")
-    ax_roll.bar(index, not_rolled, bottom=rolled, color="tab:gray", label="not rolled (fail)")
-    ax_roll.set(xlabel="cluster", ylabel="interactions", title="(a) hand labels")
-    ax_roll.legend(fontsize="small")
+    success = np.array([c["success"] for c in clusters])
+    fail = np.array([c["fail"] for c in clusters])
+    ax_label.bar(index, success, color="tab:green", label=f"{success_label} (success)")
+    ax_label.bar(index, fail, bottom=success, color="tab:gray", label=f"{fail_label} (fail)")
+    ax_label.set(xlabel="cluster", ylabel="interactions", title="(a) hand labels")
+    ax_label.legend(fontsize="small")
 
     types = list(dict.fromkeys(t for c in clusters for t in c["types"]))
     width = 0.8 / max(len(types), 1)
@@ -127,11 +148,40 @@ def _case_study(clusters: list[Mapping[str, Any]], k: str, path: Path) -> Path:
     filled = [i for i, s in enumerate(sizes) if s.size]
     if filled:
         ax_size.boxplot([sizes[i] for i in filled], positions=index[filled], widths=0.6)
+    critical = results.get("size_success", {}).get("critical_size")
+    if critical is not None:
+        ax_size.axhline(100.0 * critical, color="tab:red", linestyle="--", linewidth=1,
+                        label=f"critical size {100.0 * critical:.1f} cm")
+        ax_size.legend(fontsize="small")
     ax_size.set(xlabel="cluster", ylabel="object size [cm]", title="(c) object sizes")
-    for ax in (ax_roll, ax_type, ax_size):
+    for ax in (ax_label, ax_type, ax_size):
         ax.set_xticks(index)
         ax.grid(alpha=0.3, axis="y")
-    fig.suptitle(f"1 x {k} map, first trial (cf. Figs. 9, 10)")
+    fig.suptitle(f"{behavior}: 1 x {k} map, first trial (cf. Figs. 9, 10)")
+    return _save(fig, path)
+
+
+def _size_success(results: Mapping[str, Any], path: Path) -> Path:
+    section = results["size_success"]
+    behavior, success_label, _ = _words(results)
+    fig, (ax,) = _new_figure(5.5, 3.8)
+    bins = [b for b in section["bins"] if b["success"] is not None]
+    centres = np.array([50.0 * (b["low"] + b["high"]) for b in bins])
+    widths = np.array([100.0 * (b["high"] - b["low"]) for b in bins])
+    ax.bar(centres, [100.0 * b["success"] for b in bins], width=0.9 * widths if widths.size else 0.8,
+           color="tab:green", alpha=0.5, label="share per size bin")
+    if section.get("logistic") and bins:
+        fit = section["logistic"]
+        sizes = np.linspace(section["bins"][0]["low"], section["bins"][-1]["high"], 200)
+        ax.plot(100.0 * sizes, 100.0 / (1.0 + np.exp(-(fit["intercept"] + fit["slope"] * sizes))),
+                color="black", label="logistic fit")
+    if section.get("critical_size") is not None:
+        ax.axvline(100.0 * section["critical_size"], color="tab:red", linestyle="--", linewidth=1,
+                   label=f"crosses 50 % at {100.0 * section['critical_size']:.1f} cm")
+    ax.set(xlabel="object size [cm]", ylabel=f"{success_label} [%]", ylim=(0, 102),
+           title=f"{behavior}: success by object size")
+    ax.legend(fontsize="small")
+    ax.grid(alpha=0.3)
     return _save(fig, path)
 
 
@@ -167,6 +217,7 @@ def _clusters_vs_type(results: Mapping[str, Any], path: Path) -> Path:
 def _prototypes(results: Mapping[str, Any], path: Path) -> Path:
     maps = sorted(results["prototypes"].items(), key=lambda item: int(item[0]))
     names = list(results["feature_names"])
+    _, success, fail = _words(results)
     fig, axes = _new_figure(14.0, 3.2 * len(maps), ncols=4, nrows=len(maps))
     axes = axes.reshape(len(maps), 4)
     index = {n: i for i, n in enumerate(names)}
@@ -176,7 +227,7 @@ def _prototypes(results: Mapping[str, Any], path: Path) -> Path:
     for row, (k, prototypes) in enumerate(maps):
         P = np.asarray(prototypes, dtype=float)
         clusters = results.get("case_studies", {}).get(k, [])
-        labels = [f"{c} ({cl['rolled']} rolled / {cl['not_rolled']} not)" if (cl := _cluster(clusters, c))
+        labels = [f"{c} ({cl['success']} {success} / {cl['fail']} {fail})" if (cl := _cluster(clusters, c))
                   else str(c) for c in range(len(P))]
         ax_move, ax_pix, ax_lat, ax_lon = axes[row]
         if None not in xyz:
@@ -227,9 +278,11 @@ def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: boo
         (_uniformity, results, out / "uniformity.png"),
         (_selected_features, results, out / "selected_features.png"),
     ]
-    for k, clusters in sorted(results["case_studies"].items(), key=lambda item: int(item[0])):
-        drawings.append((lambda c, p, k=k: _case_study(c, k, p), clusters, out / f"case_study_k{k}.png"))
+    for k in sorted(results["case_studies"], key=int):
+        drawings.append((lambda r, p, k=k: _case_study(r, k, p), results, out / f"case_study_k{k}.png"))
     drawings.append((_svm_accuracy, results, out / "svm_accuracy.png"))
+    if results.get("size_success"):
+        drawings.append((_size_success, results, out / "size_success.png"))
     if "purity" in results and "adjusted_rand" in results:
         drawings.append((_clusters_vs_type, results, out / "clusters_vs_type.png"))
     if results.get("prototypes") and "feature_names" in results:

@@ -131,3 +131,56 @@ def svm_cv_accuracy(
         )
     folds = StratifiedKFold(n_splits=n_splits, shuffle=True, random_state=random_state)
     return float(np.mean(cross_val_score(make_svm(C, gamma), X, y, cv=folds)))
+
+
+def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
+    """How success depends on object size: the share of successes per size bin, and a logistic fit.
+
+    A behaviour whose outcome is decided by size (the paper's grasp: small objects are held, large ones are not)
+    has a critical size where the chance of success crosses 50 %. It is estimated by a logistic regression of
+    success on size (practically unregularised: ``C = 1e6`` on the standardised sizes), ``P(success) =
+    1 / (1 + exp(-(intercept + slope x size)))``, as ``-intercept / slope``.
+
+    Args:
+        sizes: Object size of each interaction [m], (n,), finite.
+        success: Success of each interaction, (n,), boolean or 0/1.
+        n_bins: Equal-width bins over the sizes seen.
+
+    Returns:
+        ``{"bins": [{"low", "high" [m], "n", "success" (share, None for an empty bin)}], "logistic":
+        {"intercept", "slope" [1/m]} or None (only one outcome: nothing to fit), "critical_size": [m] or None
+        (no fit, or the fit does not cross 50 % within the sizes seen), "below", "above": {"n", "success"}
+        (the interactions with objects smaller, and not smaller, than the critical size, and their share of
+        successes; None without a critical size)}``.
+    """
+    from sklearn.linear_model import LogisticRegression
+
+    sizes, success = _paired(np.asarray(sizes, dtype=np.float64), success, "success")
+    success = _as_success(success)
+    if not np.all(np.isfinite(sizes)):
+        raise ValueError("sizes must be finite [m].")
+    if isinstance(n_bins, bool) or not isinstance(n_bins, int | np.integer) or n_bins < 1:
+        raise ValueError(f"n_bins must be an integer >= 1, got {n_bins!r}.")
+    low, high = float(sizes.min()), float(sizes.max())
+    edges = np.linspace(low, high, n_bins + 1) if high > low else np.array([low, high])
+    index = np.clip(np.searchsorted(edges, sizes, side="right") - 1, 0, edges.size - 2)
+    bins = []
+    for b in range(edges.size - 1):
+        members = index == b
+        bins.append({"low": float(edges[b]), "high": float(edges[b + 1]), "n": int(members.sum()),
+                     "success": float(success[members].mean()) if members.any() else None})
+    out: dict = {"bins": bins, "logistic": None, "critical_size": None, "below": None, "above": None}
+    if success.all() or not success.any() or high == low:
+        return out
+    mean, scale = sizes.mean(), sizes.std()
+    fit = LogisticRegression(C=1e6, max_iter=1000).fit(((sizes - mean) / scale)[:, None], success)
+    slope = float(fit.coef_[0, 0] / scale)
+    intercept = float(fit.intercept_[0] - fit.coef_[0, 0] * mean / scale)
+    out["logistic"] = {"intercept": intercept, "slope": slope}
+    if slope != 0.0 and low <= -intercept / slope <= high:
+        critical = float(-intercept / slope)
+        out["critical_size"] = critical
+        for side, members in (("below", sizes < critical), ("above", sizes >= critical)):
+            out[side] = {"n": int(members.sum()),
+                         "success": float(success[members].mean()) if members.any() else None}
+    return out

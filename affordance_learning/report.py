@@ -1,366 +1,27 @@
 """REPORT.md: our numbers beside the paper's statements, with a verdict per claim computed from the numbers.
 
-Each statement of Akgun et al. 2009 (section V) becomes a :class:`Claim` with a stated, numeric rule. The
-verdict is "agrees" or "disagrees" by that rule, or "not computable" when the results lack what the rule
-needs (for example k = 4 was not run). The rules are judgement calls written in the report beside each
-verdict, so a reader can disagree with a rule without having to trust prose.
+The claims, their rules and verdicts are :mod:`affordance_learning.claims`; this module sets them out with
+the tables of the numbers they are computed from.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-AGREES = "agrees"
-DISAGREES = "disagrees"
-NOT_COMPUTABLE = "not computable"
-
-_ROLLING = ("sphere", "horizontal_cylinder")
-_RESTING = ("box", "vertical_cylinder")
-
-
-@dataclass(frozen=True)
-class Claim:
-    """One statement of the paper set beside our numbers.
-
-    Attributes:
-        topic: Short name of the statement.
-        paper: What the paper says.
-        rule: The numeric rule our verdict follows.
-        ours: Our numbers, as text.
-        verdict: "agrees", "disagrees" or "not computable".
-    """
-
-    topic: str
-    paper: str
-    rule: str
-    ours: str
-    verdict: str
-
-
-class _Missing(Exception):
-    """The results lack what a rule needs."""
-
-
-def _mean(per_k: Mapping[str, Mapping[str, Any]], k: int | str) -> float:
-    entry = per_k.get(str(k))
-    if entry is None or entry.get("mean") is None:
-        raise _Missing(f"no value for k = {k}")
-    return float(entry["mean"])
-
-
-def _curve(per_k: Mapping[str, Mapping[str, Any]]) -> tuple[list[int], np.ndarray]:
-    ks = sorted(int(k) for k in per_k)
-    if not ks:
-        raise _Missing("no k")
-    return ks, np.array([_mean(per_k, k) for k in ks])
-
-
-def _section(results: Mapping[str, Any], key: str) -> Any:
-    if key not in results:
-        raise _Missing(f"results have no {key!r}")
-    return results[key]
-
-
-def _ranks(values: Sequence[float]) -> np.ndarray:
-    """Ranks 1..n, ties sharing their mean rank."""
-    values = np.asarray(values, dtype=float)
-    ranks = np.empty(values.size)
-    ranks[np.argsort(values, kind="stable")] = np.arange(1, values.size + 1)
-    for v in np.unique(values):
-        ranks[values == v] = ranks[values == v].mean()
-    return ranks
-
-
-def _rho(x: Sequence[float], y: Sequence[float]) -> float:
-    """Spearman rank correlation of x and y; 0 when y is constant (no trend either way)."""
-    if len(x) < 3 or np.ptp(np.asarray(x, dtype=float)) == 0:
-        raise _Missing("fewer than 3 distinct values: no trend to measure")
-    if np.ptp(np.asarray(y, dtype=float)) == 0:
-        return 0.0
-    return float(np.corrcoef(_ranks(x), _ranks(y))[0, 1])
-
-
-def _fmt(values: Sequence[float], digits: int = 1) -> str:
-    return ", ".join(f"{v:.{digits}f}" for v in values)
-
-
-def _uniformity_average(results: Mapping[str, Any]) -> tuple[str, bool]:
-    ks, u = _curve(_section(results, "uniformity"))
-    return f"mean over k = {ks[0]}..{ks[-1]}: {u.mean():.1f} % (per k: {_fmt(u)})", bool(u.mean() > 80.0)
-
-
-def _uniformity_rises(results: Mapping[str, Any]) -> tuple[str, bool]:
-    ks, u = _curve(_section(results, "uniformity"))
-    rho = _rho(ks, u)
-    if np.ptp(u) == 0:
-        return f"U is {u[0]:.1f} % for every k: no rise (rho taken as 0)", False
-    return (
-        f"Spearman rho(k, U) = {rho:+.2f}; U from {u[0]:.1f} % (k = {ks[0]}) to {u[-1]:.1f} % (k = {ks[-1]})",
-        rho >= 0.5,
-    )
-
-
-def _uniformity_peak(results: Mapping[str, Any]) -> tuple[str, bool]:
-    ks, u = _curve(_section(results, "uniformity"))
-    best = int(np.argmax(u))
-    return f"highest mean uniformity {u[best]:.1f} % at k = {ks[best]}", bool(u[best] >= 90.0)
-
-
-def _by_r(results: Mapping[str, Any], key: str) -> dict[float, tuple[list[int], np.ndarray]]:
-    section = _section(results, key)
-    if not section:
-        raise _Missing(f"{key!r} is empty")
-    return {float(r): _curve(per_k) for r, per_k in section.items()}
-
-
-def _shape_dominates(results: Mapping[str, Any]) -> tuple[str, bool]:
-    curves = _by_r(results, "shape_fraction")
-    means = {r: 100.0 * v.mean() for r, (_, v) in sorted(curves.items())}
-    positive = {r: m for r, m in means.items() if r > 0}
-    if not positive:
-        raise _Missing("no relevancy r > 0")
-    text = "mean shape share over k: " + ", ".join(f"r = {r}: {m:.0f} %" for r, m in means.items())
-    return text, all(m > 50.0 for m in positive.values())
-
-
-def _shape_share_falls_with_lower_r(results: Mapping[str, Any]) -> tuple[str, bool]:
-    curves = _by_r(results, "shape_fraction")
-    rs = sorted(curves)
-    means = [curves[r][1].mean() for r in rs]
-    rho = _rho(rs, means)
-    return f"Spearman rho(r, mean shape share) = {rho:+.2f}", rho > 0
-
-
-def _count_falls_with_r(results: Mapping[str, Any]) -> tuple[str, bool]:
-    curves = _by_r(results, "n_selected")
-    rs = sorted(curves)
-    if len(rs) < 2:
-        raise _Missing("fewer than 2 relevancy values")
-    table = np.array([curves[r][1] for r in rs])  # (r, k)
-    monotone = bool(np.all(np.diff(table, axis=0) <= 1e-9) and np.all(table[-1] < table[0]))
-    means = table.mean(axis=1)
-    text = "mean number over k: " + ", ".join(f"r = {r}: {m:.1f}" for r, m in zip(rs, means, strict=True))
-    return text, monotone
-
-
-def _count_constant_in_k(results: Mapping[str, Any]) -> tuple[str, bool]:
-    curves = _by_r(results, "n_selected")
-    parts, ok = [], True
-    for r, (ks, values) in sorted(curves.items()):
-        upper = np.array([v for k, v in zip(ks, values, strict=True) if k >= 4])
-        if upper.size < 2:
-            raise _Missing("fewer than 2 values of k >= 4")
-        cv = float(upper.std() / upper.mean()) if upper.mean() > 0 else 0.0
-        parts.append(f"r = {r}: {_fmt(upper)} (CV {cv:.2f})")
-        ok &= cv <= 0.15
-    return "number for k >= 4 per r: " + "; ".join(parts), ok
-
-
-def _case(results: Mapping[str, Any], k: int) -> list[Mapping[str, Any]]:
-    clusters = _section(results, "case_studies").get(str(k))
-    if not clusters:
-        raise _Missing(f"no case study for k = {k}")
-    return clusters
-
-
-def _two_cluster_types(results: Mapping[str, Any]) -> tuple[str, bool]:
-    clusters = _case(results, 2)
-    types = sorted({t for c in clusters for t in c["types"]})
-    if not set(_ROLLING + _RESTING) <= set(types):
-        raise _Missing("the case study lacks one of the four object types")
-    home, share = {}, {}
-    for t in types:
-        counts = np.array([c["types"].get(t, 0) for c in clusters])
-        home[t] = int(clusters[int(np.argmax(counts))]["cluster"])
-        share[t] = counts.max() / max(counts.sum(), 1)
-    table = "; ".join(
-        f"cluster {c['cluster']}: " + ", ".join(f"{t} {c['types'].get(t, 0)}" for t in types)
-        for c in clusters
-    )
-    rolling = {home[t] for t in _ROLLING}
-    resting = {home[t] for t in _RESTING}
-    ok = len(rolling) == 1 and len(resting) == 1 and rolling != resting
-    ok = ok and all(share[t] >= 0.75 for t in _ROLLING + _RESTING)
-    shares = ", ".join(f"{t} {100 * share[t]:.0f} %" for t in _ROLLING + _RESTING)
-    return f"{table} (share of each type in its majority cluster: {shares})", bool(ok)
-
-
-def _two_cluster_sizes(results: Mapping[str, Any]) -> tuple[str, bool]:
-    clusters = [c for c in _case(results, 2) if c["sizes"]]
-    everything = np.concatenate([np.asarray(c["sizes"], dtype=float) for c in clusters])
-    span = np.ptp(everything)
-    if span == 0:
-        raise _Missing("all objects have the same size")
-    cover = [np.ptp(np.asarray(c["sizes"], dtype=float)) / span for c in clusters]
-    text = "; ".join(
-        f"cluster {c['cluster']}: {100 * min(c['sizes']):.1f}-{100 * max(c['sizes']):.1f} cm "
-        f"({100 * f:.0f} % of "
-        "the size range)"
-        for c, f in zip(clusters, cover, strict=True)
-    )
-    return text, len(clusters) == 2 and all(f >= 0.75 for f in cover)
-
-
-def _four_cluster_split(results: Mapping[str, Any]) -> tuple[str, bool]:
-    clusters = _case(results, 4)
-    success = sum(c["rolled"] > c["not_rolled"] for c in clusters)
-    fail = sum(c["not_rolled"] > c["rolled"] for c in clusters)
-    text = "; ".join(
-        f"cluster {c['cluster']}: {c['rolled']} rolled / {c['not_rolled']} not" for c in clusters
-    )
-    return f"{text} -> {success} success and {fail} fail clusters", success == 2 and fail == 2
-
-
-def _accuracy_falls(results: Mapping[str, Any]) -> tuple[str, bool]:
-    curves = _by_r(results, "svm_accuracy")
-    rhos = {r: _rho(ks, v) for r, (ks, v) in sorted(curves.items())}
-    text = "Spearman rho(k, accuracy): " + ", ".join(f"r = {r}: {rho:+.2f}" for r, rho in rhos.items())
-    return text, all(rho <= -0.5 for rho in rhos.values())
-
-
-def _bump_at_four(results: Mapping[str, Any]) -> tuple[str, bool]:
-    section = _section(results, "svm_accuracy")
-    parts, bumps = [], 0
-    for r in sorted(section, key=float):
-        a3, a4 = _mean(section[r], 3), _mean(section[r], 4)
-        parts.append(f"r = {r}: {100 * a3:.1f} -> {100 * a4:.1f} %")
-        bumps += a4 > a3
-    return "accuracy k = 3 -> 4: " + "; ".join(parts), bumps * 2 >= len(section)
-
-
-def _accuracy_by_r(results: Mapping[str, Any]) -> dict[float, float]:
-    return {r: float(v.mean()) for r, (_, v) in _by_r(results, "svm_accuracy").items()}
-
-
-def _low_r_alike(results: Mapping[str, Any]) -> tuple[str, bool]:
-    accuracy = _accuracy_by_r(results)
-    low = {r: a for r, a in accuracy.items() if r in (0.0, 0.2, 0.4)}
-    if len(low) < 2:
-        raise _Missing("fewer than 2 of r = 0, 0.2, 0.4")
-    spread = 100 * (max(low.values()) - min(low.values()))
-    text = ", ".join(f"r = {r}: {100 * a:.1f} %" for r, a in sorted(low.items()))
-    return f"mean accuracy over k: {text} (spread {spread:.1f} points)", spread <= 2.0
-
-
-def _best_r(results: Mapping[str, Any]) -> tuple[str, bool]:
-    accuracy = _accuracy_by_r(results)
-    counts = {r: float(v.mean()) for r, (_, v) in _by_r(results, "n_selected").items()}
-    top = max(accuracy.values())
-    near = [r for r, a in accuracy.items() if a >= top - 0.01]
-    choice = max(near)
-    text = ", ".join(
-        f"r = {r}: {100 * accuracy[r]:.1f} % with {counts.get(r, float('nan')):.1f} features"
-        for r in sorted(accuracy)
-    )
-    return f"{text}; fewest features within 1 point of the best accuracy: r = {choice}", choice == 0.4
-
-
-_CLAIMS: tuple[tuple[str, str, str, Callable[[Mapping[str, Any]], tuple[str, bool]]], ...] = (
-    (
-        "Uniformity on average",
-        "The average uniformity is above 80 % for tapping.",
-        "mean over k of the mean uniformity > 80 %",
-        _uniformity_average,
-    ),
-    (
-        "Uniformity rises with k",
-        "Uniformity of clusters increases with the number of clusters.",
-        "Spearman rank correlation of k and mean uniformity >= 0.5",
-        _uniformity_rises,
-    ),
-    (
-        "Uniformity peak",
-        "It can reach up to 95 %.",
-        "highest mean uniformity over k >= 90 %",
-        _uniformity_peak,
-    ),
-    (
-        "Shape features dominate",
-        "Shape features dominate the selected features.",
-        "for every r > 0, the mean over k of the shape share of the selected features > 50 %",
-        _shape_dominates,
-    ),
-    (
-        "Shape share and r",
-        "When the relevancy threshold is decreased ... the percentage of shape features decreases.",
-        "Spearman rank correlation of r and the mean shape share > 0",
-        _shape_share_falls_with_lower_r,
-    ),
-    (
-        "Fewer features as r rises",
-        "The number of selected features tends to be inversely proportional to r.",
-        "for every k the mean number never grows with r, and is lower at the largest r than at the smallest",
-        _count_falls_with_r,
-    ),
-    (
-        "Number constant in k",
-        "The number of selected features remains the same above some number of clusters.",
-        "for every r, the coefficient of variation over k >= 4 of the mean number <= 0.15",
-        _count_constant_in_k,
-    ),
-    (
-        "1 x 2 map: object types",
-        "One cluster holds spheres and horizontal cylinders (rollable), the other boxes and "
-        "vertical cylinders.",
-        "spheres and lying cylinders share a majority cluster, boxes and standing cylinders the "
-        "other, each type with >= 75 % of its objects there (first trial)",
-        _two_cluster_types,
-    ),
-    (
-        "1 x 2 map: sizes",
-        "Both clusters have instances from the whole size range.",
-        "each of the 2 clusters spans >= 75 % of the range of object sizes (first trial)",
-        _two_cluster_sizes,
-    ),
-    (
-        "1 x 4 map: success/fail",
-        "Two of the four clusters are success clusters, the other two fail clusters.",
-        "exactly 2 clusters with more rolled than not rolled and 2 with more not rolled (first trial)",
-        _four_cluster_split,
-    ),
-    (
-        "SVM accuracy falls with k",
-        "SVM prediction accuracy decreases as the number of effect categories grows.",
-        "for every r, Spearman rank correlation of k and mean accuracy <= -0.5",
-        _accuracy_falls,
-    ),
-    (
-        "Bump at k = 4",
-        "Accuracy increases at 4 clusters against the decreasing trend (four object types).",
-        "mean accuracy at k = 4 above that at k = 3 for at least half of the r values",
-        _bump_at_four,
-    ),
-    (
-        "r = 0, 0.2, 0.4 alike",
-        "Accuracy is almost the same for relevancy values of 0 %, 20 % and 40 %.",
-        "mean accuracy over k of these r within 2 percentage points",
-        _low_r_alike,
-    ),
-    (
-        "r = 0.4 best",
-        "40 % is the best relevancy: maximum accuracy with the highest perceptual economy.",
-        "the largest r whose mean accuracy over k is within 1 point of the best r's is 0.4",
-        _best_r,
-    ),
+from affordance_learning.claims import (  # noqa: F401  (AGREES ... Claim: re-exported, the report's vocabulary)
+    AGREES,
+    DISAGREES,
+    NOT_COMPUTABLE,
+    Claim,
+    _outcome_words,
+    claims_scope,
+    evaluate_claims,
+    results_behavior,
 )
-
-
-def evaluate_claims(results: Mapping[str, Any]) -> list[Claim]:
-    """Every claim of the paper with our numbers and a verdict computed from them."""
-    claims = []
-    for topic, paper, rule, judge in _CLAIMS:
-        try:
-            ours, ok = judge(results)
-            verdict = AGREES if ok else DISAGREES
-        except _Missing as why:
-            ours, verdict = f"({why})", NOT_COMPUTABLE
-        claims.append(Claim(topic=topic, paper=paper, rule=rule, ours=ours, verdict=verdict))
-    return claims
 
 
 def _cell(entry: Mapping[str, Any] | None, scale: float, digits: int) -> str:
@@ -391,10 +52,11 @@ def _table_rk(section: Mapping[str, Mapping[str, Any]], scale: float, digits: in
 
 def _case_tables(results: Mapping[str, Any]) -> list[str]:
     lines: list[str] = []
+    success_label, fail_label = _outcome_words(results)
     for k, clusters in sorted(results.get("case_studies", {}).items(), key=lambda item: int(item[0])):
         types = list(dict.fromkeys(t for c in clusters for t in c["types"]))
         lines += [f"### 1 x {k} map (first trial)", ""]
-        lines.append("| cluster | rolled | not rolled | " + " | ".join(types) + " | sizes [cm] |")
+        lines.append(f"| cluster | {success_label} | {fail_label} | " + " | ".join(types) + " | sizes [cm] |")
         lines.append("|---" * (4 + len(types)) + "|")
         for c in clusters:
             sizes = np.asarray(c["sizes"], dtype=float) * 100
@@ -402,7 +64,7 @@ def _case_tables(results: Mapping[str, Any]) -> list[str]:
                 f"{sizes.min():.1f}-{sizes.max():.1f} (median {np.median(sizes):.1f})" if sizes.size else "-"
             )
             counts = " | ".join(str(c["types"].get(t, 0)) for t in types)
-            lines.append(f"| {c['cluster']} | {c['rolled']} | {c['not_rolled']} | {counts} | {spread} |")
+            lines.append(f"| {c['cluster']} | {c['success']} | {c['fail']} | {counts} | {spread} |")
         lines.append("")
     return lines
 
@@ -420,6 +82,7 @@ def _effects_section(results: Mapping[str, Any], figures: Sequence[str]) -> list
     effects = results.get("effects")
     if not effects:
         return []
+    success_label, _ = _outcome_words(results)
     lines = [
         "## What the effects contain",
         "",
@@ -427,20 +90,21 @@ def _effects_section(results: Mapping[str, Any], figures: Sequence[str]) -> list
         "object where it stopped; an object that left the table or the view has the documented not-visible "
         "features (zeros), so its effect is just minus its initial features.",
         "",
-        f"- Rolled objects seen in the final snapshot: **{_pct(effects.get('rolled_visible'))}** "
-        f"(at rest and seen: {_pct(effects.get('rolled_rest_visible'))}); rolled objects whose effect is minus "
-        f"their initial features (they vanished): {_pct(effects.get('rolled_effect_is_minus_initial'))}.",
+        f"- Successes ({success_label}) whose object is seen in the final snapshot: "
+        f"**{_pct(effects.get('success_visible'))}** (at rest and seen: "
+        f"{_pct(effects.get('success_rest_visible'))}); successes whose effect is minus their initial features "
+        f"(the object vanished): {_pct(effects.get('success_effect_is_minus_initial'))}.",
         f"- Spearman correlation of the true travel with the 3-D motion seen (norm of the effect on mean_x, "
         f"mean_y, mean_z), over the objects seen at the end: "
         f"**{_num(effects.get('travel_vs_seen_motion'), digits=2)}**.",
         "",
-        "| type | n | rolled | at rest | seen at the end | left the table | travel [cm] | motion seen [cm] | "
+        f"| type | n | {success_label} | at rest | seen at the end | left the table | travel [cm] | motion seen [cm] | "
         "pixel count change | normal histogram change |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for t, row in effects.get("by_type", {}).items():
         lines.append(
-            f"| {t.replace('_', ' ')} | {row['n']} | {_pct(row['rolled'])} | {_pct(row['rest'])} | "
+            f"| {t.replace('_', ' ')} | {row['n']} | {_pct(row['success'])} | {_pct(row['rest'])} | "
             f"{_pct(row['visible_final'])} | {_pct(row['off_table'])} | {_num(row['displacement'], 100)} | "
             f"{_num(row['seen_motion'], 100)} | {_num(row['pixel_count_change'], 1, 0)} | "
             f"{_num(row['shape_change'], 1, 3)} |"
@@ -453,28 +117,57 @@ def _effects_section(results: Mapping[str, Any], figures: Sequence[str]) -> list
     return lines
 
 
+def _size_section(results: Mapping[str, Any]) -> list[str]:
+    """How success depends on object size, and the critical size where a logistic fit crosses 50 %."""
+    section = results.get("size_success")
+    if not section:
+        return []
+    success_label, _ = _outcome_words(results)
+    fit, critical = section.get("logistic"), section.get("critical_size")
+    if fit is None:
+        found = "Only one outcome: no logistic fit, no critical size."
+    elif critical is None:
+        found = (f"A logistic fit of success on size (slope {fit['slope'] / 100:+.2f} per cm of logit) does not "
+                 "cross 50 % within the sizes seen: no critical size.")
+    else:
+        found = (f"A logistic fit of success on size crosses 50 % at **{100 * critical:.1f} cm** (slope "
+                 f"{fit['slope'] / 100:+.2f} per cm of logit: success "
+                 f"{'falls' if fit['slope'] < 0 else 'rises'} with size).")
+    lines = ["## Success by object size", "", found, "",
+             "| size [cm] | " + " | ".join(f"{100 * b['low']:.1f}-{100 * b['high']:.1f}" for b in section["bins"])
+             + " |", "|---" * (len(section["bins"]) + 1) + "|",
+             "| interactions | " + " | ".join(str(b["n"]) for b in section["bins"]) + " |",
+             f"| {success_label} | " + " | ".join(_pct(b["success"]) for b in section["bins"]) + " |", "",
+             "![size_success](size_success.png)", ""]  # drawn by write_figures from the same results
+    return lines
+
+
 def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> str:
     """The Markdown text of the report (see :func:`write_report`)."""
     claims = evaluate_claims(results)
     tally = {v: sum(c.verdict == v for c in claims) for v in (AGREES, DISAGREES, NOT_COMPUTABLE)}
     config = results.get("config", {})
+    behavior = results_behavior(results)
+    success_label, fail_label = _outcome_words(results)
     lines = [
-        "# Reproduction of Akgun et al. 2009, tapping: our numbers beside the paper's",
+        f"# Reproduction of Akgun et al. 2009, {behavior}: our numbers beside the paper's",
         "",
         f"{config.get('n_rows', '?')} interactions, {config.get('n_trials', '?')} trials, "
         f"k = {config.get('ks', '?')}, r = {config.get('relevancies', '?')}, "
-        f"seed {config.get('random_state', '?')}.",
+        f"seed {config.get('random_state', '?')}. Success/fail labels: {success_label} / {fail_label} "
+        f"(the {config.get('label', 'success')!r} column); {_pct(config.get('success_fraction'))} of the "
+        "interactions succeeded.",
         "",
         f"**{tally[AGREES]} of {len(claims)} claims agree**, {tally[DISAGREES]} disagree, "
         f"{tally[NOT_COMPUTABLE]} could not be computed. Each verdict follows the rule beside it, applied to "
-        "the numbers below (means over trials).",
+        f"the numbers below (means over trials). {claims_scope(behavior)}",
         "",
         "| claim | the paper | rule | ours | verdict |",
         "|---|---|---|---|---|",
     ]
     for c in claims:
         lines.append(f"| {c.topic} | {c.paper} | {c.rule} | {c.ours} | **{c.verdict}** |")
-    lines += [""] + _effects_section(results, figures)
+    lines += [""] + _effects_section(results, figures) + _size_section(results)
     lines += ["## Effect clusters", ""]
     lines += _table_k(
         results,
@@ -488,6 +181,7 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
     lines += [""] + _case_tables(results)
     for key, title, scale, digits in (
         ("shape_fraction", "Shape share of the selected features [%]", 100.0, 0),
+        ("size_fraction", "Size share of the selected features [%]", 100.0, 0),
         ("n_selected", "Number of selected features", 1.0, 1),
         ("svm_accuracy", "SVM accuracy on held-out interactions [%]", 100.0, 1),
     ):
@@ -496,7 +190,9 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
     if "svm_baseline" in results:
         lines += ["Always answering the most common training category:", ""]
         lines += _table_k(results, [("svm_baseline", "baseline accuracy [%]", 100.0, 1)]) + [""]
-    shown = [f for f in figures if Path(f).name != "prototypes.png" or "effects" not in results]  # shown above
+    above = {"prototypes.png"} if "effects" in results else set()
+    above |= {"size_success.png"} if results.get("size_success") else set()
+    shown = [f for f in figures if Path(f).name not in above]  # shown above
     if shown:
         lines += ["## Figures", ""] + [f"![{Path(f).stem}]({Path(f).name})" for f in shown] + [""]
     if config:
@@ -521,4 +217,87 @@ def write_report(results: Mapping[str, Any], out_dir: str | Path) -> Path:
     figures = sorted(p.name for p in out.glob("*.png"))
     path = out / "REPORT.md"
     path.write_text(render_report(results, figures))
+    return path
+
+
+def _headline(results: Mapping[str, Any]) -> dict[str, str]:
+    """One behaviour's headline numbers as short texts, for the overview."""
+    config = results.get("config", {})
+    success_label, _ = _outcome_words(results)
+    uniformity = {int(k): v["mean"] for k, v in results.get("uniformity", {}).items() if v.get("mean") is not None}
+    section = results.get("svm_accuracy", {})
+    accuracy = section.get("0.4") or next(iter(section.values()), {})
+    acc = {int(k): v["mean"] for k, v in accuracy.items() if v.get("mean") is not None}
+    best = max(uniformity, key=uniformity.get) if uniformity else None
+    sizes = results.get("size_success", {})
+    critical = sizes.get("critical_size")
+    return {
+        "interactions": str(config.get("n_rows", "?")),
+        "success": f"{_pct(config.get('success_fraction'))} {success_label}",
+        "uniformity": f"{np.mean(list(uniformity.values())):.1f} %" if uniformity else "-",
+        "peak": f"{uniformity[best]:.1f} % (k = {best})" if best is not None else "-",
+        "accuracy": (f"{100 * acc[min(acc)]:.1f} % (k = {min(acc)}) to {100 * acc[max(acc)]:.1f} % "
+                     f"(k = {max(acc)})" if acc else "-"),
+        "critical": "-" if critical is None else (f"{100 * critical:.1f} cm ({_pct(sizes['below']['success'])} "
+                                                  f"below, {_pct(sizes['above']['success'])} above)"),
+    }
+
+
+def render_overview(runs: Mapping[str, Mapping[str, Any]],
+                    figures: Mapping[str, Sequence[str]] | None = None) -> str:
+    """The Markdown text of the overview over behaviours (see :func:`write_overview`); ``figures``: the PNG
+    file names in each behaviour's directory."""
+    names, figures = list(runs), figures or {}
+    lines = [
+        f"# Reproduction of Akgun et al. 2009: {', '.join(names)}",
+        "",
+        "One model per behaviour, as the paper proposes (\"a separate SOM and SVM for each behavior\"): each "
+        "behaviour's interactions are collected, clustered by their effects, weighed and learned on their own, "
+        "and set beside what the paper says of that behaviour. Means over trials; the full numbers, tables and "
+        "figures are in each behaviour's report.",
+        "",
+        "| behaviour | interactions | successes | uniformity, mean over k | highest uniformity | "
+        "SVM accuracy at r = 0.4 | critical size (success crosses 50 %) | claims that agree |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    claims = {b: evaluate_claims(results) for b, results in runs.items()}
+    for behavior, results in runs.items():
+        h = _headline(results)
+        agree = sum(c.verdict == AGREES for c in claims[behavior])
+        lines.append(f"| [{behavior}]({behavior}/REPORT.md) | {h['interactions']} | {h['success']} | "
+                     f"{h['uniformity']} | {h['peak']} | {h['accuracy']} | {h['critical']} | "
+                     f"{agree} of {len(claims[behavior])} |")
+    lines.append("")
+    for behavior, found in claims.items():
+        tally = {v: sum(c.verdict == v for c in found) for v in (AGREES, DISAGREES, NOT_COMPUTABLE)}
+        shown = sorted(Path(f).name for f in figures.get(behavior, ()))
+        lines += [f"## {behavior}", "", f"[Full report]({behavior}/REPORT.md)"
+                  + (" · figures: " + ", ".join(f"[{Path(f).stem}]({behavior}/{f})" for f in shown) if shown else ""),
+                  "", f"**{tally[AGREES]} of {len(found)} claims agree**, {tally[DISAGREES]} disagree, "
+                  f"{tally[NOT_COMPUTABLE]} could not be computed. {claims_scope(behavior)}", "",
+                  "| claim | the paper | rule | ours | verdict |", "|---|---|---|---|---|"]
+        lines += [f"| {c.topic} | {c.paper} | {c.rule} | {c.ours} | **{c.verdict}** |" for c in found]
+        lines.append("")
+    return "\n".join(lines)
+
+
+def write_overview(runs: Mapping[str, Mapping[str, Any]], out_dir: str | Path) -> Path:
+    """Write ``REPORT.md`` into ``out_dir`` over several behaviours: for each, its headline numbers, its claims
+    with their verdicts, and links to its report and figures in ``out_dir/<behavior>/``.
+
+    Args:
+        runs: The results dict of each behaviour (:func:`affordance_learning.experiment.run_protocol`), by
+            behaviour, in the order to show them.
+        out_dir: Output directory, holding one directory per behaviour.
+
+    Returns:
+        The path of ``REPORT.md``.
+    """
+    if not runs or not all(isinstance(r, Mapping) and "uniformity" in r for r in runs.values()):
+        raise ValueError("runs must map each behaviour to the dict returned by run_protocol.")
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    figures = {b: sorted(p.name for p in (out / b).glob("*.png")) for b in runs}
+    path = out / "REPORT.md"
+    path.write_text(render_overview(runs, figures))
     return path

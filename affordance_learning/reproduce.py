@@ -1,19 +1,33 @@
-"""``affordance reproduce``: the paper's experiment end to end, from the simulator to the report.
+"""``affordance reproduce``: the paper's experiment end to end, from the simulator to the reports.
 
-1. Collect (or reuse) ``episodes`` canonical taps with :func:`affordance_env.dataset.collect`; the dataset is
-   resumable, so an interrupted run continues where it stopped.
+The paper learns one model per behaviour ("a separate SOM and SVM for each behavior") and reports on tapping
+and grasping. For each behaviour asked (by default :data:`DEFAULT_BEHAVIORS`), into ``out/<behavior>/``:
+
+1. Collect (or reuse) ``episodes`` canonical interactions with :func:`affordance_env.dataset.collect` into
+   ``out/<behavior>/dataset`` (or the directory given for that behaviour); the dataset is resumable, so an
+   interrupted run continues where it stopped, and a finished one is reused.
 2. Run the learning protocol (:func:`affordance_learning.experiment.run_protocol`) over k = 2..10 clusters and
    relevancy r in {0, 0.2, 0.4, 0.6, 0.8}, ``trials`` times.
-3. Write ``results.json``, the figures and ``REPORT.md`` into ``out``.
+3. Write ``results.json``, the figures and ``REPORT.md``.
+
+Then ``out/REPORT.md`` sets the behaviours side by side (:func:`affordance_learning.report.write_overview`):
+those just run, and any other whose results an earlier run left in ``out/<behavior>/``. Every behaviour is
+checked against the environment before anything is collected, so a behaviour it does not offer stops the run
+at once with a clear error.
 """
 
 from __future__ import annotations
 
 import json
 import time
+from collections.abc import Iterable, Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
+
+#: The behaviours the paper reports on, run by default.
+DEFAULT_BEHAVIORS = ("tap", "grasp")
 
 
 def _jsonable(value):
@@ -40,33 +54,84 @@ def _shown_path(path: Path, out: Path) -> str:
 def reproduce(
     out: Path,
     *,
+    behaviors: Iterable[str] = DEFAULT_BEHAVIORS,
     episodes: int = 1000,
     trials: int = 20,
     seed: int = 0,
     workers: int = 2,
-    dataset: Path | None = None,
+    datasets: Mapping[str, Path] | None = None,
     progress: bool | None = None,
     range_noise: str | None = None,
-) -> dict:
-    """Run the whole experiment and write its outputs into ``out``; returns the results dict.
+) -> dict[str, dict[str, Any]]:
+    """Run the whole experiment for each behaviour and write its outputs into ``out``.
 
-    ``range_noise`` (for example ``"kinect_v1"``) collects the taps with the range camera's noise model on.
+    Args:
+        out: Output directory: ``out/<behavior>/`` per behaviour, and ``out/REPORT.md`` over all of them.
+        behaviors: Behaviours to run, each one the environment offers.
+        episodes: Canonical interactions per behaviour, >= 20.
+        trials: Learning trials, >= 1.
+        seed: Seed of the datasets and of the trials.
+        workers: Processes for the collection and the trials.
+        datasets: Dataset directory per behaviour (default ``out/<behavior>/dataset``).
+        progress: Draw progress bars; by default on a terminal when ``CI`` is not set.
+        range_noise: Collect with the range camera's noise model on (for example ``"kinect_v1"``).
+
+    Returns:
+        The results dict of each behaviour run, by behaviour.
     """
-    from affordance_env.dataset import collect, failure_summary, load_dataset, show_progress
-    from affordance_learning.experiment import run_protocol
-    from affordance_learning.figures import write_figures
-    from affordance_learning.report import write_report
+    import affordance_env.behaviors as env_behaviors
+    from affordance_learning.behaviors import BEHAVIORS, check_env_offers
+    from affordance_learning.report import write_overview
 
+    behaviors = list(behaviors)
+    runnable = [b for b in behaviors if isinstance(b, str) and b in env_behaviors.BEHAVIORS] or ["tap"]
+    behaviors = check_env_offers(behaviors, hint=", or run only the behaviours it offers (affordance reproduce "
+                                 f"--behavior {' --behavior '.join(runnable)})")
+    datasets = {b: Path(p) for b, p in (datasets or {}).items()}
+    unknown = sorted(set(datasets) - set(behaviors))
+    if unknown:
+        raise ValueError(f"datasets given for {unknown}, which are not run (behaviors {behaviors}).")
     if episodes < 20:
         raise ValueError(f"episodes must be at least 20 for the protocol's splits, got {episodes!r}.")
     if trials < 1:
         raise ValueError(f"trials must be at least 1, got {trials!r}.")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    dataset = Path(dataset) if dataset is not None else out / "dataset"
     start = time.perf_counter()
-    print(f"[1/3] collecting {episodes} taps into {dataset} (seed {seed}, {workers} workers; reused if present)")
-    env_options = {} if range_noise is None else {"range_noise": range_noise}
+    runs: dict[str, dict[str, Any]] = {}
+    for behavior in behaviors:
+        runs[behavior] = _reproduce_one(
+            out, behavior, datasets.get(behavior), episodes=episodes, trials=trials, seed=seed, workers=workers,
+            progress=progress, range_noise=range_noise,
+        )
+    found = {**_earlier_runs(out, behaviors), **runs}
+    order = [b for b in BEHAVIORS if b in found] + sorted(set(found) - set(BEHAVIORS))
+    overview = write_overview({b: found[b] for b in order}, out)
+    print(f"total {time.perf_counter() - start:.1f} s")
+    print()
+    for behavior, results in runs.items():
+        print(summary(results, out / behavior / "REPORT.md"))
+    print(f"All behaviours side by side: {overview}")
+    return runs
+
+
+def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: int, trials: int, seed: int,
+                   workers: int, progress: bool | None, range_noise: str | None) -> dict[str, Any]:
+    """Collect, learn and report one behaviour into ``out/<behavior>``; returns its results."""
+    from affordance_env.dataset import collect, failure_summary, load_dataset, show_progress
+    from affordance_learning.experiment import run_protocol
+    from affordance_learning.figures import write_figures
+    from affordance_learning.report import write_report
+
+    where = out / behavior
+    where.mkdir(parents=True, exist_ok=True)
+    dataset = dataset if dataset is not None else where / "dataset"
+    start = time.perf_counter()
+    print(f"[{behavior} 1/3] collecting {episodes} canonical {behavior} interactions into {dataset} (seed {seed}, "
+          f"{workers} workers; reused if present)")
+    env_options: dict[str, Any] = {"behavior": behavior}
+    if range_noise is not None:
+        env_options["range_noise"] = range_noise
     collect(episodes=episodes, seed=seed, workers=workers, out=dataset, progress=progress, env_options=env_options)
     frame = load_dataset(dataset)
     collected = time.perf_counter()
@@ -74,44 +139,70 @@ def reproduce(
     print(f"      {len(frame)} interactions, {len(failures)} failed and left out"
           f"{f' ({failure_summary({str(k): v for k, v in failures.items()})})' if failures else ''} "
           f"({collected - start:.1f} s)")
-    print(f"[2/3] learning protocol: k = 2..10, r in 0.0..0.8, {trials} trials")
+    print(f"[{behavior} 2/3] learning protocol: k = 2..10, r in 0.0..0.8, {trials} trials")
     bars = show_progress(progress)
-    results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers, progress=bars)
-    results.setdefault("config", {}).update(
-        {"episodes": int(len(frame)), "dataset": _shown_path(dataset, out), "seed": seed, "trials": trials,
+    results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers, progress=bars,
+                           behavior=behavior)
+    results["config"].update(
+        {"episodes": int(len(frame)), "dataset": _shown_path(dataset, where), "seed": seed, "trials": trials,
          "range_noise": range_noise or "none"}
     )
     learned = time.perf_counter()
     print(f"      done ({learned - collected:.1f} s)")
-    print(f"[3/3] writing results.json, figures and REPORT.md into {out}")
-    (out / "results.json").write_text(json.dumps(_jsonable(results), indent=2))
-    figures = write_figures(results, out, progress=bars)
-    report = write_report(results, out)
+    print(f"[{behavior} 3/3] writing results.json, figures and REPORT.md into {where}")
+    (where / "results.json").write_text(json.dumps(_jsonable(results), indent=2))
+    figures = write_figures(results, where, progress=bars)
+    write_report(results, where)
     print(f"      results.json, {len(figures)} figures and REPORT.md ({time.perf_counter() - learned:.1f} s)")
-    print(f"total {time.perf_counter() - start:.1f} s")
-    print()
-    print(summary(results, report))
     return results
 
 
-def summary(results: dict, report: Path) -> str:
-    """The headline numbers of a reproduction, and where its report is, in a few lines."""
-    from affordance_learning.report import AGREES, evaluate_claims
+def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, dict[str, Any]]:
+    """Results an earlier run left in ``out/<behavior>/results.json`` for behaviours not run now; only those of
+    the current schema (whose config names the behaviour of their directory)."""
+    found = {}
+    for path in sorted(out.glob("*/results.json")):
+        behavior = path.parent.name
+        if behavior in skip:
+            continue
+        try:
+            results = json.loads(path.read_text())
+        except (OSError, ValueError):
+            continue
+        if isinstance(results, dict) and results.get("config", {}).get("behavior") == behavior:
+            found[behavior] = results
+    return found
 
+
+def summary(results: dict, report: Path) -> str:
+    """The headline numbers of one behaviour's reproduction, and where its report is, in a few lines."""
+    from affordance_learning.claims import AGREES, claims_scope, evaluate_claims, results_behavior
+
+    behavior = results_behavior(results)
+    config = results.get("config", {})
     effects = results.get("effects", {})
     uniformity = {int(k): v["mean"] for k, v in results["uniformity"].items() if v["mean"] is not None}
     accuracy = results["svm_accuracy"].get("0.4") or next(iter(results["svm_accuracy"].values()))
     acc = {int(k): v["mean"] for k, v in accuracy.items() if v["mean"] is not None}
     claims = evaluate_claims(results)
     ks = sorted(uniformity)
-    lines = [f"Report: {report} (figures and results.json beside it)"]
-    if effects.get("rolled_visible") is not None:
-        lines.append(f"  rolled objects seen where they stopped: {100 * effects['rolled_visible']:.0f} %; true travel "
-                     f"vs motion seen, Spearman {effects['travel_vs_seen_motion']:.2f}")
+    lines = [f"{behavior}: {report} (figures and results.json beside it)"]
+    if effects.get("success_visible") is not None:
+        label = config.get("success_label", "success")
+        correlation = effects.get("travel_vs_seen_motion")
+        lines.append(f"  successes ({label}) whose object is seen where it stopped: "
+                     f"{100 * effects['success_visible']:.0f} %"
+                     + ("" if correlation is None else f"; true travel vs motion seen, Spearman {correlation:.2f}"))
+    paper = {"tap": " (paper: above 80 %)", "grasp": " (paper: above 70 %, and a fall at k = 3)"}.get(behavior, "")
     lines.append(f"  uniformity: {uniformity[ks[0]]:.1f} % (k = {ks[0]}) to {uniformity[ks[-1]]:.1f} % "
-                 f"(k = {ks[-1]}), mean {np.mean(list(uniformity.values())):.1f} % (paper: above 80 %)")
+                 f"(k = {ks[-1]}), mean {np.mean(list(uniformity.values())):.1f} %{paper}")
+    sizes = results.get("size_success", {})
+    if sizes.get("critical_size") is not None:
+        lines.append(f"  success by object size crosses 50 % at {100 * sizes['critical_size']:.1f} cm (logistic "
+                     f"fit): {100 * sizes['below']['success']:.0f} % below, {100 * sizes['above']['success']:.0f} % "
+                     "above")
     lines.append(f"  SVM accuracy at r = 0.4: {100 * acc[min(acc)]:.1f} % (k = {min(acc)}) to "
                  f"{100 * acc[max(acc)]:.1f} % (k = {max(acc)})")
     lines.append(f"  the paper's claims: {sum(c.verdict == AGREES for c in claims)} of {len(claims)} agree "
-                 "(each verdict and its rule in the report)")
+                 f"(each verdict and its rule in the report). {claims_scope(behavior)}")
     return "\n".join(lines)

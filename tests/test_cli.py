@@ -21,30 +21,61 @@ def test_unknown_command_exits_with_usage():
         main(["fly"])
 
 
-def test_reproduce_writes_results_figures_and_report(tmp_path, capsys):
+def test_reproduce_writes_results_figures_and_a_report_per_behaviour(tmp_path, capsys):
     import json
 
     out = tmp_path / "repro"
-    assert main(["reproduce", "--episodes", "40", "--trials", "2", "--workers", "1", "--out", str(out),
-                 "--progress"]) == 0
-    results = json.loads((out / "results.json").read_text())
-    assert set(results["uniformity"]) == {str(k) for k in range(2, 11)}
-    assert set(results["svm_accuracy"]) == {"0.0", "0.2", "0.4", "0.6", "0.8"}
-    assert results["config"]["episodes"] == 40
-    for name in ("uniformity.png", "selected_features.png", "case_study_k2.png", "case_study_k4.png",
-                 "svm_accuracy.png", "REPORT.md"):
-        assert (out / name).stat().st_size > 1000
+    assert main(["reproduce", "--behavior", "tap", "--behavior", "push", "--episodes", "40", "--trials", "2",
+                 "--workers", "1", "--out", str(out), "--progress"]) == 0
+    for behavior, success in (("tap", "rolled"), ("push", "moved")):
+        results = json.loads((out / behavior / "results.json").read_text())
+        assert set(results["uniformity"]) == {str(k) for k in range(2, 11)}
+        assert set(results["svm_accuracy"]) == {"0.0", "0.2", "0.4", "0.6", "0.8"}
+        config = results["config"]
+        assert config["behavior"] == behavior and config["success_label"] == success
+        assert config["episodes"] == 40 and config["dataset"] == "dataset"
+        assert (out / behavior / "dataset" / "manifest.json").exists()
+        for name in ("uniformity.png", "selected_features.png", "case_study_k2.png", "case_study_k3.png",
+                     "case_study_k4.png", "svm_accuracy.png", "size_success.png", "REPORT.md"):
+            assert (out / behavior / name).stat().st_size > 1000, (behavior, name)
+    overview = (out / "REPORT.md").read_text()
+    assert "# Reproduction of Akgun et al. 2009: tap, push" in overview
+    for link in ("[tap](tap/REPORT.md)", "[push](push/REPORT.md)", "(tap/uniformity.png)", "(push/size_success.png)"):
+        assert link in overview, link
+    assert "## tap" in overview and "## push" in overview and "tapping and grasping only" in overview
     printed = capsys.readouterr()
-    assert "40 interactions, 0 failed" in printed.out
-    # progress bars for each stage, and the headline numbers at the end
+    assert "40 interactions, 0 failed" in printed.out and "[push 1/3] collecting 40 canonical push" in printed.out
+    # progress bars for each stage, and the headline numbers of each behaviour at the end
     assert all(stage in printed.err for stage in ("dataset", "learning trials", "figures"))
-    assert f"Report: {out / 'REPORT.md'}" in printed.out and "uniformity:" in printed.out
-    assert "the paper's claims:" in printed.out and "rolled objects seen where they stopped" in printed.out
-    # a second run reuses the dataset instead of collecting again: its chunk files are not rewritten
-    chunks = {p: p.stat().st_mtime_ns for p in (out / "dataset").glob("chunk-*.parquet")}
-    assert main(["reproduce", "--episodes", "40", "--trials", "1", "--workers", "1", "--out", str(out)]) == 0
+    assert f"tap: {out / 'tap' / 'REPORT.md'}" in printed.out and f"push: {out / 'push' / 'REPORT.md'}" in printed.out
+    assert printed.out.count("uniformity:") == 2 and printed.out.count("the paper's claims:") == 2
+    assert "successes (rolled) whose object is seen" in printed.out
+    assert f"All behaviours side by side: {out / 'REPORT.md'}" in printed.out
+    # a second run of one behaviour reuses its dataset instead of collecting again (its chunk files are not
+    # rewritten), and the overview still shows the other behaviour, from the earlier run
+    chunks = {p: p.stat().st_mtime_ns for p in (out / "tap" / "dataset").glob("chunk-*.parquet")}
+    assert main(["reproduce", "--behavior", "tap", "--episodes", "40", "--trials", "1", "--workers", "1", "--out",
+                 str(out)]) == 0
     assert "40 interactions" in capsys.readouterr().out
     assert chunks and {p: p.stat().st_mtime_ns for p in chunks} == chunks
+    overview = (out / "REPORT.md").read_text()
+    assert "# Reproduction of Akgun et al. 2009: tap, push" in overview and "[push](push/REPORT.md)" in overview
+
+
+def test_reproduce_refuses_what_it_cannot_run_before_collecting(tmp_path, capsys, monkeypatch):
+    import affordance_env.behaviors as env_behaviors
+
+    without_grasp = {name: b for name, b in env_behaviors.BEHAVIORS.items() if name != "grasp"}
+    monkeypatch.setattr(env_behaviors, "BEHAVIORS", without_grasp)
+    out = tmp_path / "repro"
+    assert main(["reproduce", "--episodes", "40", "--out", str(out)]) == 2  # by default the tap and the grasp
+    err = capsys.readouterr().err
+    assert "the environment has no 'grasp' behaviour" in err and "affordance reproduce --behavior tap" in err
+    assert not out.exists()  # refused before anything was collected
+    assert main(["reproduce", "--behavior", "tap", "--behavior", "push", "--dataset", "d", "--out", str(out)]) == 2
+    assert "as BEHAVIOR=PATH" in capsys.readouterr().err
+    assert main(["reproduce", "--behavior", "tap", "--dataset", "push=d", "--out", str(out)]) == 2
+    assert "datasets given for ['push'], which are not run" in capsys.readouterr().err and not out.exists()
 
 
 def test_collect_command(tmp_path, capsys):
@@ -55,3 +86,24 @@ def test_collect_command(tmp_path, capsys):
     assert "6 interactions" in capsys.readouterr().out
     assert main([*args[:5], "--seed", "9", *args[5:]]) == 2  # other settings: refused, not mixed in
     assert "other settings" in capsys.readouterr().err
+
+
+def test_train_default_checks_the_behaviour_before_collecting(tmp_path, capsys, monkeypatch):
+    import json
+
+    import affordance_env.behaviors as env_behaviors
+    from affordance_env.dataset.format import FORMAT, MANIFEST, SCHEMA_VERSION
+
+    assert main(["train-default", "--behavior", "juggle", "--dataset", str(tmp_path / "d")]) == 2
+    assert "Unknown behavior 'juggle'. Valid behaviors: tap, grasp" in capsys.readouterr().err
+    taps = tmp_path / "taps"
+    taps.mkdir()
+    (taps / MANIFEST).write_text(json.dumps({"format": FORMAT, "schema_version": SCHEMA_VERSION, "episodes": 6,
+                                             "settings": {"chunk_size": 3, "env_options": {"behavior": "tap"}}}))
+    assert main(["train-default", "--behavior", "grasp", "--dataset", str(taps), "--out", str(tmp_path / "m")]) == 2
+    assert "holds 'tap' interactions, not 'grasp' ones" in capsys.readouterr().err
+    monkeypatch.setattr(env_behaviors, "BEHAVIORS", {n: b for n, b in env_behaviors.BEHAVIORS.items() if n != "grasp"})
+    new = tmp_path / "grasps"
+    assert main(["train-default", "--behavior", "grasp", "--dataset", str(new), "--out", str(tmp_path / "m")]) == 2
+    assert "the environment has no 'grasp' behaviour" in capsys.readouterr().err
+    assert not new.exists() and not (tmp_path / "m").exists()

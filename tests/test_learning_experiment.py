@@ -12,7 +12,7 @@ import pytest
 
 from affordance_learning import run_protocol, write_figures, write_report
 from affordance_learning.experiment import feature_groups, feature_names, make_synthetic_frame
-from affordance_learning.report import AGREES, DISAGREES, NOT_COMPUTABLE, evaluate_claims
+from affordance_learning.report import AGREES, DISAGREES, NOT_COMPUTABLE, evaluate_claims, write_overview
 
 KS = (2, 3, 4)
 RS = (0.0, 0.4)
@@ -43,6 +43,7 @@ def test_synthetic_frame_has_the_dataset_schema(frame: pd.DataFrame) -> None:
     )
     assert set(frame["type"]) == {"sphere", "box", "horizontal_cylinder", "vertical_cylinder"}
     assert frame["rolled"].dtype == bool and frame["size"].between(0.04, 0.10).all()
+    assert frame["success"].equals(frame["rolled"]) and set(frame["behavior"]) == {"tap"}
     assert feature_groups(names).count("shape") == 24
 
 
@@ -50,7 +51,7 @@ def test_results_follow_the_schema(results: dict, frame: pd.DataFrame) -> None:
     k_keys = [str(k) for k in KS]
     r_keys = ["0.0", "0.4"]
     assert list(results["uniformity"]) == k_keys
-    for key in ("svm_accuracy", "shape_fraction", "n_selected"):
+    for key in ("svm_accuracy", "shape_fraction", "size_fraction", "n_selected"):
         assert list(results[key]) == r_keys
         for r in r_keys:
             assert list(results[key][r]) == k_keys
@@ -60,16 +61,24 @@ def test_results_follow_the_schema(results: dict, frame: pd.DataFrame) -> None:
     assert all(0.0 <= v["mean"] <= 100.0 for v in results["uniformity"].values())
     assert all(0.0 <= v["mean"] <= 1.0 for r in r_keys for v in results["svm_accuracy"][r].values())
     assert all(1 <= v["mean"] <= 49 for r in r_keys for v in results["n_selected"][r].values())
-    assert list(results["case_studies"]) == ["2", "4"]
+    assert list(results["case_studies"]) == ["2", "3", "4"]
     for k, clusters in results["case_studies"].items():
         assert [c["cluster"] for c in clusters] == list(range(int(k)))
-        assert all(set(c) == {"cluster", "rolled", "not_rolled", "types", "sizes"} for c in clusters)
-        assert sum(c["rolled"] + c["not_rolled"] for c in clusters) == len(frame)
+        assert all(set(c) == {"cluster", "success", "fail", "types", "sizes"} for c in clusters)
+        assert sum(c["success"] + c["fail"] for c in clusters) == len(frame)
+        assert sum(c["success"] for c in clusters) == frame["success"].sum()
         assert sum(len(c["sizes"]) for c in clusters) == len(frame)
         assert sum(sum(c["types"].values()) for c in clusters) == len(frame)
     config = results["config"]
     assert config["n_trials"] == 3 and config["ks"] == list(KS) and config["relevancies"] == list(RS)
     assert config["feature_groups"] == {"shape": 24, "size": 18, "relation": 7}
+    assert config["behavior"] == "tap" and config["label"] == "success"
+    assert (config["success_label"], config["fail_label"]) == ("rolled", "did not roll")
+    assert config["success_fraction"] == pytest.approx(frame["success"].mean())
+    assert config["case_study_ks"] == [2, 3, 4]
+    assert set(results["size_success"]) == {"bins", "logistic", "critical_size", "below", "above"}
+    assert sum(b["n"] for b in results["size_success"]["bins"]) == len(frame)
+    assert set(results["effects"]["by_type"]["sphere"]) >= {"success", "visible_final"}
     assert json.loads(json.dumps(results, allow_nan=False)) == results
 
 
@@ -79,10 +88,12 @@ def test_protocol_finds_the_papers_structure_in_synthetic_taps(results: dict) ->
     assert results["shape_fraction"]["0.4"]["3"]["mean"] > 0.8
     assert results["n_selected"]["0.4"]["2"]["mean"] < results["n_selected"]["0.0"]["2"]["mean"]
     assert results["svm_accuracy"]["0.4"]["2"]["mean"] > results["svm_baseline"]["2"]["mean"]
-    # the share counts shape features only: never more of them than the 24 there are
+    # the shares count shape (size) features only: never more of them than the 24 (18) there are
     for r, per_k in results["shape_fraction"].items():
         for k, share in per_k.items():
+            size = results["size_fraction"][r][k]["mean"]
             assert share["mean"] * results["n_selected"][r][k]["mean"] <= 24.5, (r, k)
+            assert size * results["n_selected"][r][k]["mean"] <= 18.5 and share["mean"] + size <= 1.0 + 1e-9
 
 
 def test_results_do_not_depend_on_n_jobs(frame: pd.DataFrame, results: dict) -> None:
@@ -112,16 +123,56 @@ def test_protocol_refuses_bad_arguments(frame: pd.DataFrame, kwargs: dict, match
 
 
 def test_protocol_refuses_bad_frames(frame: pd.DataFrame) -> None:
-    with pytest.raises(ValueError, match="'rolled'"):
-        run_protocol(frame.drop(columns="rolled"))
+    with pytest.raises(ValueError, match="no 'success' column .nor 'rolled'"):
+        run_protocol(frame.drop(columns=["success", "rolled"]))
     with pytest.raises(ValueError, match="no initial_"):
-        run_protocol(frame[["type", "size", "rolled"]])
+        run_protocol(frame[["type", "size", "success"]])
+    with pytest.raises(ValueError, match="no 'behavior' column; pass the behaviour"):
+        run_protocol(frame.drop(columns="behavior"))
+    mixed = frame.assign(behavior=np.where(np.arange(len(frame)) % 2, "tap", "grasp"))
+    with pytest.raises(ValueError, match=r"mixes the behaviours \['grasp', 'tap'\]"):
+        run_protocol(mixed)
+    with pytest.raises(ValueError, match="holds 'tap' interactions, not 'grasp'"):
+        run_protocol(frame, behavior="grasp")
     broken = frame.copy()
     broken.loc[5, "effect_mean_x"] = np.nan
     with pytest.raises(ValueError, match="row 5, column effect_mean_x"):
         run_protocol(broken)
     with pytest.raises(ValueError, match="expected at least 2 of each"):
         run_protocol(frame.iloc[:5], test_size=0.1)
+
+
+def test_the_label_is_success_or_else_rolled(frame: pd.DataFrame) -> None:
+    # a label that differs from rolled: uniformity and the case study follow success, not rolled
+    flipped = frame.assign(success=~frame["rolled"], behavior="push")
+    kwargs = {"ks": (2, 3), "relevancies": (0.4,), "n_trials": 1, "som_iterations": 200}
+    ours = run_protocol(flipped, **kwargs)
+    assert ours["config"]["label"] == "success" and ours["config"]["behavior"] == "push"
+    assert (ours["config"]["success_label"], ours["config"]["fail_label"]) == ("moved", "did not move")
+    assert sum(c["success"] for c in ours["case_studies"]["2"]) == (~frame["rolled"]).sum()
+    # a frame without success (made before the label existed) is evaluated against rolled, and says so
+    old = run_protocol(frame.drop(columns=["success", "behavior"]), behavior="tap", **kwargs)
+    assert old["config"]["label"] == "rolled" and old["config"]["success_label"] == "rolled"
+    assert sum(c["success"] for c in old["case_studies"]["2"]) == frame["rolled"].sum()
+    assert old["uniformity"] == ours["uniformity"]  # |S - F| is the same with the labels swapped
+    # but rolled is not the success of a grasp or a push: no silent stand-in
+    for behavior in ("grasp", "push"):
+        with pytest.raises(ValueError, match=f"no 'success' column, and the success of '{behavior}' is not"):
+            run_protocol(frame.drop(columns=["success"]).assign(behavior=behavior), **kwargs)
+
+
+def test_synthetic_grasps_have_a_critical_size() -> None:
+    grasps = make_synthetic_frame(400, random_state=3, behavior="grasp")
+    assert set(grasps["behavior"]) == {"grasp"} and grasps["size"].between(0.03, 0.09).all()
+    results = run_protocol(grasps, ks=(2, 3, 4), relevancies=(0.4,), n_trials=1, som_iterations=300)
+    config = results["config"]
+    assert config["behavior"] == "grasp"
+    assert (config["success_label"], config["fail_label"]) == ("lifted and held", "not held")
+    assert results["size_success"]["critical_size"] == pytest.approx(0.06, abs=0.004)
+    assert results["size_success"]["logistic"]["slope"] < 0
+    assert results["size_fraction"]["0.4"]["2"]["mean"] > 0.5  # held or not is decided by size
+    with pytest.raises(ValueError, match="behavior must be one of"):
+        make_synthetic_frame(40, behavior="juggle")
 
 
 def test_a_frame_too_small_to_stratify_gets_a_random_split(frame: pd.DataFrame) -> None:
@@ -153,9 +204,11 @@ def test_figures_and_report_are_written(results: dict, tmp_path: Path) -> None:
         "uniformity.png",
         "selected_features.png",
         "case_study_k2.png",
+        "case_study_k3.png",
         "case_study_k4.png",
         "svm_accuracy.png",
         "prototypes.png",
+        "size_success.png",
     } <= names
     for path in paths:
         data = path.read_bytes()
@@ -164,6 +217,8 @@ def test_figures_and_report_are_written(results: dict, tmp_path: Path) -> None:
     text = report.read_text()
     assert report.name == "REPORT.md"
     assert "uniformity.png" in text and "| Uniformity on average |" in text
+    assert "# Reproduction of Akgun et al. 2009, tap:" in text and "| cluster | rolled | did not roll |" in text
+    assert "## Success by object size" in text and "![size_success](size_success.png)" in text
     assert text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**") == 14
     again = write_report(json.loads(json.dumps(results)), tmp_path / "again").read_text()
     assert again.split("## Configuration")[0] == text.split("## Figures")[0]  # same numbers from the JSON
@@ -189,21 +244,21 @@ def _paper_like(results: dict) -> dict:
         "2": [
             {
                 "cluster": 0,
-                "rolled": 480,
-                "not_rolled": 20,
+                "success": 480,
+                "fail": 20,
                 "types": {"sphere": 250, "horizontal_cylinder": 240, "box": 5, "vertical_cylinder": 5},
                 "sizes": sizes,
             },
             {
                 "cluster": 1,
-                "rolled": 10,
-                "not_rolled": 490,
+                "success": 10,
+                "fail": 490,
                 "types": {"sphere": 0, "horizontal_cylinder": 10, "box": 245, "vertical_cylinder": 245},
                 "sizes": sizes,
             },
         ],
         "4": [
-            {"cluster": c, "rolled": r, "not_rolled": n, "types": {}, "sizes": sizes}
+            {"cluster": c, "success": r, "fail": n, "types": {}, "sizes": sizes}
             for c, (r, n) in enumerate([(240, 5), (230, 20), (5, 245), (10, 245)])
         ],
     }
@@ -238,7 +293,7 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
     rising = {2: 0.6, 3: 0.65, 4: 0.55, 5: 0.7, 6: 0.72, 7: 0.75, 8: 0.78, 9: 0.8, 10: 0.82}
     worse["svm_accuracy"] = {r: {str(k): {"mean": a, "std": 0.0} for k, a in rising.items()} for r in rs}
     worse["case_studies"]["2"][0]["sizes"], worse["case_studies"]["2"][1]["sizes"] = [0.04, 0.05], [0.09, 0.1]
-    worse["case_studies"]["4"][2]["rolled"], worse["case_studies"]["4"][2]["not_rolled"] = 200, 5
+    worse["case_studies"]["4"][2]["success"], worse["case_studies"]["4"][2]["fail"] = 200, 5
     verdicts = {c.topic: c.verdict for c in evaluate_claims(worse)}
     for topic in (
         "Shape features dominate",
@@ -254,3 +309,106 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
     partial = {"uniformity": good["uniformity"]}
     verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
     assert verdicts["Uniformity on average"] == AGREES and verdicts["Bump at k = 4"] == NOT_COMPUTABLE
+
+
+def _grasp_like(results: dict) -> dict:
+    """The results edited to say what the paper says of the grasp, claim by claim."""
+    good = _paper_like(results)
+    good["config"] = {**good["config"], "behavior": "grasp", "success_label": "lifted and held",
+                      "fail_label": "not held"}
+    u = {2: 66.0, 3: 60.0, 4: 70.0, 5: 72.0, 6: 75.0, 7: 78.0, 8: 80.0, 9: 84.0, 10: 90.0}  # mean 75
+    good["uniformity"] = {str(k): {"mean": v, "std": 1.0} for k, v in u.items()}
+    good["size_fraction"] = {r: {k: {"mean": 0.7, "std": 0.0} for k in per_k}
+                             for r, per_k in good["shape_fraction"].items()}
+    good["size_success"] = {
+        "bins": [{"low": 0.03, "high": 0.06, "n": 500, "success": 0.9}, {"low": 0.06, "high": 0.09, "n": 500,
+                                                                          "success": 0.1}],
+        "logistic": {"intercept": 18.0, "slope": -300.0}, "critical_size": 0.06,
+        "below": {"n": 500, "success": 0.9}, "above": {"n": 500, "success": 0.1},
+    }
+    good["case_studies"]["3"] = [
+        {"cluster": 0, "success": 400, "fail": 20, "types": {}, "sizes": [0.03, 0.04, 0.05]},
+        {"cluster": 1, "success": 120, "fail": 80, "types": {}, "sizes": [0.05, 0.055, 0.062, 0.068]},
+        {"cluster": 2, "success": 20, "fail": 460, "types": {}, "sizes": [0.07, 0.08, 0.09]},
+    ]
+    return good
+
+
+GRASP_TOPICS = ("Uniformity on average", "Fall at k = 3", "Critical size",
+                "1 x 3 map: a category straddles the critical size", "Size features dominate")
+
+
+def test_grasp_claims_are_computed_from_the_numbers(results: dict) -> None:
+    good = _grasp_like(results)
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(good)}
+    assert list(verdicts) == [
+        "Uniformity on average", "Uniformity rises with k", "Uniformity peak", "Fall at k = 3", "Critical size",
+        "1 x 3 map: a category straddles the critical size", "Size features dominate",
+        "Fewer features as r rises", "Number constant in k", "SVM accuracy falls with k"]
+    assert set(verdicts.values()) == {AGREES}, verdicts
+    bad = copy.deepcopy(good)
+    bad["uniformity"] = {k: {"mean": 84.0 + int(k), "std": 1.0} for k in good["uniformity"]}  # no fall, >80
+    bad["size_fraction"] = {r: {k: {"mean": 0.3, "std": 0.0} for k in per_k}
+                            for r, per_k in good["size_fraction"].items()}
+    bad["size_success"]["below"]["success"], bad["size_success"]["above"]["success"] = 0.6, 0.4  # too soft
+    bad["case_studies"]["3"][1]["success"], bad["case_studies"]["3"][1]["fail"] = 95, 5  # nearly all held
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(bad)}
+    for topic in GRASP_TOPICS:
+        assert verdicts[topic] == DISAGREES, topic
+    # the average must be above 70 %, and not above the tap's 80 %
+    low = copy.deepcopy(good)
+    low["uniformity"] = {k: {"mean": v["mean"] - 10.0, "std": 1.0} for k, v in good["uniformity"].items()}
+    assert {c.topic: c.verdict for c in evaluate_claims(low)}["Uniformity on average"] == DISAGREES
+    # the straddling cluster must hold objects on both sides of the critical size, not just both outcomes
+    one_side = copy.deepcopy(good)
+    one_side["case_studies"]["3"][1]["sizes"] = [0.061, 0.065, 0.068, 0.07]
+    assert {c.topic: c.verdict for c in evaluate_claims(one_side)}[GRASP_TOPICS[3]] == DISAGREES
+    # ... and be a category, not a handful of objects (here 5 of 905 interactions)
+    handful = copy.deepcopy(good)
+    handful["case_studies"]["3"][1].update(success=3, fail=2)
+    assert {c.topic: c.verdict for c in evaluate_claims(handful)}[GRASP_TOPICS[3]] == DISAGREES
+    # success rising with size is not the grasp's critical size
+    rising = copy.deepcopy(good)
+    rising["size_success"]["logistic"]["slope"] = 300.0
+    assert {c.topic: c.verdict for c in evaluate_claims(rising)}["Critical size"] == DISAGREES
+    # no crossing within the sizes seen: the critical size disagrees, the straddling cannot be computed
+    none = copy.deepcopy(good)
+    none["size_success"].update(critical_size=None, below=None, above=None)
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(none)}
+    assert verdicts["Critical size"] == DISAGREES and verdicts[GRASP_TOPICS[3]] == NOT_COMPUTABLE
+    single = copy.deepcopy(none)
+    single["size_success"]["logistic"] = None
+    assert {c.topic: c.verdict for c in evaluate_claims(single)}["Critical size"] == DISAGREES
+    partial = {"uniformity": good["uniformity"], "config": {"behavior": "grasp"}}
+    verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
+    assert verdicts["Fall at k = 3"] == AGREES and verdicts["Critical size"] == NOT_COMPUTABLE
+
+
+def test_each_behaviour_gets_its_own_claims(results: dict, tmp_path: Path) -> None:
+    tap = [c.topic for c in evaluate_claims(results)]
+    assert len(tap) == 14 and not set(GRASP_TOPICS[1:]) & set(tap)
+    assert [c.topic for c in evaluate_claims(results, behavior="grasp")][:4] == [
+        "Uniformity on average", "Uniformity rises with k", "Uniformity peak", "Fall at k = 3"]
+    push = copy.deepcopy(results)
+    push["config"]["behavior"] = "push"
+    assert [c.topic for c in evaluate_claims(push)] == [
+        "Uniformity rises with k", "Fewer features as r rises", "Number constant in k", "SVM accuracy falls with k"]
+    text = write_report(push, tmp_path).read_text()
+    assert "# Reproduction of Akgun et al. 2009, push:" in text and "tapping and grasping only" in text
+    assert text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**") == 4
+
+
+def test_the_overview_sets_the_behaviours_side_by_side(results: dict, tmp_path: Path) -> None:
+    grasp = _grasp_like(results)
+    (tmp_path / "grasp").mkdir()
+    (tmp_path / "grasp" / "uniformity.png").write_bytes(PNG_MAGIC)
+    text = write_overview({"tap": results, "grasp": grasp}, tmp_path).read_text()
+    assert text.startswith("# Reproduction of Akgun et al. 2009: tap, grasp")
+    assert "| [tap](tap/REPORT.md) | 240 |" in text and "| [grasp](grasp/REPORT.md) |" in text
+    assert "6.0 cm (90 % below, 10 % above)" in text  # the grasp's critical size in the headline table
+    assert "[uniformity](grasp/uniformity.png)" in text and "## tap" in text and "## grasp" in text
+    assert "| Fall at k = 3 |" in text and "| 1 x 2 map: object types |" in text
+    verdicts = text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**")
+    assert verdicts == 14 + 10
+    with pytest.raises(ValueError, match="runs must map each behaviour"):
+        write_overview({}, tmp_path)

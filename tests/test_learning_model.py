@@ -30,6 +30,7 @@ from affordance_learning import (
 )
 from affordance_learning import default_model as default_model_module
 from affordance_learning.experiment import make_synthetic_frame
+from affordance_learning.metrics import size_success
 
 # --------------------------------------------------------------------------------------------- fixtures
 
@@ -87,6 +88,27 @@ def test_purity_rand_and_cross_validated_svm() -> None:
     assert svm_cv_accuracy(X[:, [2, 7]], classes) > 0.9
     with pytest.raises(ValueError, match="at least 2 classes"):
         svm_cv_accuracy(X, np.zeros(300))
+
+
+def test_size_success_finds_where_success_turns_to_failure() -> None:
+    rng = np.random.default_rng(0)
+    sizes = rng.uniform(0.03, 0.09, 2000)
+    held = rng.random(2000) < 1 / (1 + np.exp((sizes - 0.055) / 0.004))
+    found = size_success(sizes, held, n_bins=6)
+    assert found["critical_size"] == pytest.approx(0.055, abs=0.002) and found["logistic"]["slope"] < 0
+    assert [b["n"] for b in found["bins"]] and sum(b["n"] for b in found["bins"]) == 2000
+    assert found["bins"][0]["success"] > 0.95 and found["bins"][-1]["success"] < 0.05
+    below, above = found["below"], found["above"]
+    assert below["n"] + above["n"] == 2000 and below["success"] > 0.8 and above["success"] < 0.2
+    # success independent of size (90 % everywhere): a fit, but no crossing of 50 % among the sizes seen
+    coin = size_success(sizes, rng.random(2000) < 0.9)
+    assert coin["logistic"] is not None and coin["critical_size"] is None and coin["below"] is None
+    # one outcome only: nothing to fit
+    always = size_success(sizes, np.ones(2000, dtype=bool))
+    assert always["logistic"] is None and always["critical_size"] is None
+    assert all(b["success"] == 1.0 for b in always["bins"])
+    with pytest.raises(ValueError, match="same length"):
+        size_success(sizes, held[:5])
 
 
 # -------------------------------------------------------------------------------------------------- SOM
@@ -448,10 +470,53 @@ def test_default_model_refuses_missing_corrupt_and_stale_files(stored_model: tup
     ):
         load_default_model(stale)
     joblib.dump({"model": "something else"}, stale)
-    with pytest.raises(DefaultModelError, match="not a tap model bundle"):
+    with pytest.raises(DefaultModelError, match="not a default model bundle"):
         load_default_model(stale)
 
 
 def test_default_model_path_is_in_the_package() -> None:
     assert default_model_module.DEFAULT_MODEL_PATH.parent.name == "data"
     assert default_model_module.DEFAULT_MODEL_PATH.parent.parent.name == "affordance_learning"
+    assert default_model_module.model_path() == default_model_module.DEFAULT_MODEL_PATH
+    assert default_model_module.model_path("grasp") == default_model_module.MODEL_DIR / "grasp_model.joblib"
+
+
+def test_each_behaviour_has_its_own_default_model(tmp_path: object, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(default_model_module, "MODEL_DIR", tmp_path)  # the package's data directory, elsewhere
+    grasps = make_synthetic_frame(160, random_state=5, behavior="grasp")
+    features = grasps[[c for c in grasps.columns if c.startswith("initial_")]].to_numpy()
+    # not built yet: the error says how to build it
+    with pytest.raises(DefaultModelMissingError, match=r"grasp model .* missing.*affordance train-default "
+                                                        r"--behavior grasp.*1000 canonical grasp interactions"):
+        predict_effect(features[:2], "grasp")
+    model = train_default_model(grasps, behavior="grasp")  # into the behaviour's file
+    assert (tmp_path / "grasp_model.joblib").exists() and joblib.load(tmp_path / "grasp_model.joblib")[
+        "behavior"] == "grasp"
+    prediction = predict_effect(features[:5], "grasp")
+    np.testing.assert_array_equal(
+        prediction.category, model.predict(pd.DataFrame(features[:5], columns=model.feature_names_in_)))
+    assert load_default_model(behavior="grasp") is load_default_model(tmp_path / "grasp_model.joblib",
+                                                                      behavior="grasp")
+    # a model is used only for its own behaviour
+    with pytest.raises(DefaultModelError, match="holds a 'grasp' model, not a 'tap' one.*affordance train-default"):
+        predict_effect(features[:2], path=tmp_path / "grasp_model.joblib")
+    # a bundle stored before the behaviour was recorded is the tap's
+    bundle = joblib.load(tmp_path / "grasp_model.joblib")
+    del bundle["behavior"]
+    joblib.dump(bundle, tmp_path / "old.joblib")
+    assert predict_effect(features[:2], path=tmp_path / "old.joblib").category.shape == (2,)
+    with pytest.raises(DefaultModelError, match="holds a 'tap' model, not a 'grasp' one"):
+        load_default_model(tmp_path / "old.joblib", behavior="grasp")
+
+
+def test_default_models_refuse_unknown_behaviours_and_other_behaviours_data(tmp_path: object) -> None:
+    with pytest.raises(ValueError, match="Unknown behavior 'juggle'. Valid behaviors: tap, grasp, tap_back, push"):
+        predict_effect(np.zeros(49), "juggle")
+    with pytest.raises(ValueError, match="Unknown behavior 'juggle'"):
+        load_default_model(behavior="juggle")
+    taps = make_synthetic_frame(40, random_state=5)
+    with pytest.raises(ValueError, match="holds 'tap' interactions, not 'grasp' ones"):
+        train_default_model(taps, tmp_path / "m.joblib", behavior="grasp")
+    with pytest.raises(ValueError, match="Unknown behavior 'juggle'"):
+        train_default_model(taps, tmp_path / "m.joblib", behavior="juggle")
+    assert not (tmp_path / "m.joblib").exists()

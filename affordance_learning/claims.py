@@ -1,0 +1,544 @@
+"""The paper's statements as claims with numeric rules, and their verdicts on our numbers.
+
+Each statement of Akgun et al. 2009 (section V) becomes a :class:`Claim` with a stated, numeric rule. The
+verdict is "agrees" or "disagrees" by that rule, or "not computable" when the results lack what the rule
+needs (for example k = 4 was not run). The rules are judgement calls written in the report beside each
+verdict, so a reader can disagree with a rule without having to trust prose.
+
+The paper reports two behaviours, and the claims are chosen by the behaviour of the results
+(``results["config"]["behavior"]``, see :func:`claims_for`):
+
+- ``tap``: its 14 statements on tapping (uniformity, selected features, the 1 x 2 and 1 x 4 maps, the SVM).
+- ``grasp``: its statements on grasping (average uniformity, the fall at k = 3, the critical size, the 1 x 3
+  category that straddles it, size deciding the grasp) with those on the method that hold for any behaviour.
+- any other behaviour: only the statements on the method.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+AGREES = "agrees"
+DISAGREES = "disagrees"
+NOT_COMPUTABLE = "not computable"
+
+_ROLLING = ("sphere", "horizontal_cylinder")
+_RESTING = ("box", "vertical_cylinder")
+
+
+@dataclass(frozen=True)
+class Claim:
+    """One statement of the paper set beside our numbers.
+
+    Attributes:
+        topic: Short name of the statement.
+        paper: What the paper says.
+        rule: The numeric rule our verdict follows.
+        ours: Our numbers, as text.
+        verdict: "agrees", "disagrees" or "not computable".
+    """
+
+    topic: str
+    paper: str
+    rule: str
+    ours: str
+    verdict: str
+
+
+class _Missing(Exception):
+    """The results lack what a rule needs."""
+
+
+def _outcome_words(results: Mapping[str, Any]) -> tuple[str, str]:
+    """How a success and a failure read, from the results' config ("success" / "fail" when it does not say)."""
+    config = results.get("config", {})
+    return config.get("success_label", "success"), config.get("fail_label", "fail")
+
+
+def _mean(per_k: Mapping[str, Mapping[str, Any]], k: int | str) -> float:
+    entry = per_k.get(str(k))
+    if entry is None or entry.get("mean") is None:
+        raise _Missing(f"no value for k = {k}")
+    return float(entry["mean"])
+
+
+def _curve(per_k: Mapping[str, Mapping[str, Any]]) -> tuple[list[int], np.ndarray]:
+    ks = sorted(int(k) for k in per_k)
+    if not ks:
+        raise _Missing("no k")
+    return ks, np.array([_mean(per_k, k) for k in ks])
+
+
+def _section(results: Mapping[str, Any], key: str) -> Any:
+    if key not in results:
+        raise _Missing(f"results have no {key!r}")
+    return results[key]
+
+
+def _ranks(values: Sequence[float]) -> np.ndarray:
+    """Ranks 1..n, ties sharing their mean rank."""
+    values = np.asarray(values, dtype=float)
+    ranks = np.empty(values.size)
+    ranks[np.argsort(values, kind="stable")] = np.arange(1, values.size + 1)
+    for v in np.unique(values):
+        ranks[values == v] = ranks[values == v].mean()
+    return ranks
+
+
+def _rho(x: Sequence[float], y: Sequence[float]) -> float:
+    """Spearman rank correlation of x and y; 0 when y is constant (no trend either way)."""
+    if len(x) < 3 or np.ptp(np.asarray(x, dtype=float)) == 0:
+        raise _Missing("fewer than 3 distinct values: no trend to measure")
+    if np.ptp(np.asarray(y, dtype=float)) == 0:
+        return 0.0
+    return float(np.corrcoef(_ranks(x), _ranks(y))[0, 1])
+
+
+def _fmt(values: Sequence[float], digits: int = 1) -> str:
+    return ", ".join(f"{v:.{digits}f}" for v in values)
+
+
+def _uniformity_average(results: Mapping[str, Any]) -> tuple[str, bool]:
+    ks, u = _curve(_section(results, "uniformity"))
+    return f"mean over k = {ks[0]}..{ks[-1]}: {u.mean():.1f} % (per k: {_fmt(u)})", bool(u.mean() > 80.0)
+
+
+def _uniformity_rises(results: Mapping[str, Any]) -> tuple[str, bool]:
+    ks, u = _curve(_section(results, "uniformity"))
+    rho = _rho(ks, u)
+    if np.ptp(u) == 0:
+        return f"U is {u[0]:.1f} % for every k: no rise (rho taken as 0)", False
+    return (
+        f"Spearman rho(k, U) = {rho:+.2f}; U from {u[0]:.1f} % (k = {ks[0]}) to {u[-1]:.1f} % (k = {ks[-1]})",
+        rho >= 0.5,
+    )
+
+
+def _uniformity_peak(results: Mapping[str, Any]) -> tuple[str, bool]:
+    ks, u = _curve(_section(results, "uniformity"))
+    best = int(np.argmax(u))
+    return f"highest mean uniformity {u[best]:.1f} % at k = {ks[best]}", bool(u[best] >= 90.0)
+
+
+def _by_r(results: Mapping[str, Any], key: str) -> dict[float, tuple[list[int], np.ndarray]]:
+    section = _section(results, key)
+    if not section:
+        raise _Missing(f"{key!r} is empty")
+    return {float(r): _curve(per_k) for r, per_k in section.items()}
+
+
+def _group_dominates(results: Mapping[str, Any], group: str) -> tuple[str, bool]:
+    curves = _by_r(results, f"{group}_fraction")
+    means = {r: 100.0 * v.mean() for r, (_, v) in sorted(curves.items())}
+    positive = {r: m for r, m in means.items() if r > 0}
+    if not positive:
+        raise _Missing("no relevancy r > 0")
+    text = f"mean {group} share over k: " + ", ".join(f"r = {r}: {m:.0f} %" for r, m in means.items())
+    return text, all(m > 50.0 for m in positive.values())
+
+
+def _shape_dominates(results: Mapping[str, Any]) -> tuple[str, bool]:
+    return _group_dominates(results, "shape")
+
+
+def _size_dominates(results: Mapping[str, Any]) -> tuple[str, bool]:
+    return _group_dominates(results, "size")
+
+
+def _shape_share_falls_with_lower_r(results: Mapping[str, Any]) -> tuple[str, bool]:
+    curves = _by_r(results, "shape_fraction")
+    rs = sorted(curves)
+    means = [curves[r][1].mean() for r in rs]
+    rho = _rho(rs, means)
+    return f"Spearman rho(r, mean shape share) = {rho:+.2f}", rho > 0
+
+
+def _count_falls_with_r(results: Mapping[str, Any]) -> tuple[str, bool]:
+    curves = _by_r(results, "n_selected")
+    rs = sorted(curves)
+    if len(rs) < 2:
+        raise _Missing("fewer than 2 relevancy values")
+    table = np.array([curves[r][1] for r in rs])  # (r, k)
+    monotone = bool(np.all(np.diff(table, axis=0) <= 1e-9) and np.all(table[-1] < table[0]))
+    means = table.mean(axis=1)
+    text = "mean number over k: " + ", ".join(f"r = {r}: {m:.1f}" for r, m in zip(rs, means, strict=True))
+    return text, monotone
+
+
+def _count_constant_in_k(results: Mapping[str, Any]) -> tuple[str, bool]:
+    curves = _by_r(results, "n_selected")
+    parts, ok = [], True
+    for r, (ks, values) in sorted(curves.items()):
+        upper = np.array([v for k, v in zip(ks, values, strict=True) if k >= 4])
+        if upper.size < 2:
+            raise _Missing("fewer than 2 values of k >= 4")
+        cv = float(upper.std() / upper.mean()) if upper.mean() > 0 else 0.0
+        parts.append(f"r = {r}: {_fmt(upper)} (CV {cv:.2f})")
+        ok &= cv <= 0.15
+    return "number for k >= 4 per r: " + "; ".join(parts), ok
+
+
+def _case(results: Mapping[str, Any], k: int) -> list[Mapping[str, Any]]:
+    clusters = _section(results, "case_studies").get(str(k))
+    if not clusters:
+        raise _Missing(f"no case study for k = {k}")
+    return clusters
+
+
+def _two_cluster_types(results: Mapping[str, Any]) -> tuple[str, bool]:
+    clusters = _case(results, 2)
+    types = sorted({t for c in clusters for t in c["types"]})
+    if not set(_ROLLING + _RESTING) <= set(types):
+        raise _Missing("the case study lacks one of the four object types")
+    home, share = {}, {}
+    for t in types:
+        counts = np.array([c["types"].get(t, 0) for c in clusters])
+        home[t] = int(clusters[int(np.argmax(counts))]["cluster"])
+        share[t] = counts.max() / max(counts.sum(), 1)
+    table = "; ".join(
+        f"cluster {c['cluster']}: " + ", ".join(f"{t} {c['types'].get(t, 0)}" for t in types)
+        for c in clusters
+    )
+    rolling = {home[t] for t in _ROLLING}
+    resting = {home[t] for t in _RESTING}
+    ok = len(rolling) == 1 and len(resting) == 1 and rolling != resting
+    ok = ok and all(share[t] >= 0.75 for t in _ROLLING + _RESTING)
+    shares = ", ".join(f"{t} {100 * share[t]:.0f} %" for t in _ROLLING + _RESTING)
+    return f"{table} (share of each type in its majority cluster: {shares})", bool(ok)
+
+
+def _two_cluster_sizes(results: Mapping[str, Any]) -> tuple[str, bool]:
+    clusters = [c for c in _case(results, 2) if c["sizes"]]
+    everything = np.concatenate([np.asarray(c["sizes"], dtype=float) for c in clusters])
+    span = np.ptp(everything)
+    if span == 0:
+        raise _Missing("all objects have the same size")
+    cover = [np.ptp(np.asarray(c["sizes"], dtype=float)) / span for c in clusters]
+    text = "; ".join(
+        f"cluster {c['cluster']}: {100 * min(c['sizes']):.1f}-{100 * max(c['sizes']):.1f} cm "
+        f"({100 * f:.0f} % of "
+        "the size range)"
+        for c, f in zip(clusters, cover, strict=True)
+    )
+    return text, len(clusters) == 2 and all(f >= 0.75 for f in cover)
+
+
+def _four_cluster_split(results: Mapping[str, Any]) -> tuple[str, bool]:
+    clusters = _case(results, 4)
+    success_label, fail_label = _outcome_words(results)
+    success = sum(c["success"] > c["fail"] for c in clusters)
+    fail = sum(c["fail"] > c["success"] for c in clusters)
+    text = "; ".join(
+        f"cluster {c['cluster']}: {c['success']} {success_label} / {c['fail']} {fail_label}" for c in clusters
+    )
+    return f"{text} -> {success} success and {fail} fail clusters", success == 2 and fail == 2
+
+
+def _accuracy_falls(results: Mapping[str, Any]) -> tuple[str, bool]:
+    curves = _by_r(results, "svm_accuracy")
+    rhos = {r: _rho(ks, v) for r, (ks, v) in sorted(curves.items())}
+    text = "Spearman rho(k, accuracy): " + ", ".join(f"r = {r}: {rho:+.2f}" for r, rho in rhos.items())
+    return text, all(rho <= -0.5 for rho in rhos.values())
+
+
+def _bump_at_four(results: Mapping[str, Any]) -> tuple[str, bool]:
+    section = _section(results, "svm_accuracy")
+    parts, bumps = [], 0
+    for r in sorted(section, key=float):
+        a3, a4 = _mean(section[r], 3), _mean(section[r], 4)
+        parts.append(f"r = {r}: {100 * a3:.1f} -> {100 * a4:.1f} %")
+        bumps += a4 > a3
+    return "accuracy k = 3 -> 4: " + "; ".join(parts), bumps * 2 >= len(section)
+
+
+def _accuracy_by_r(results: Mapping[str, Any]) -> dict[float, float]:
+    return {r: float(v.mean()) for r, (_, v) in _by_r(results, "svm_accuracy").items()}
+
+
+def _low_r_alike(results: Mapping[str, Any]) -> tuple[str, bool]:
+    accuracy = _accuracy_by_r(results)
+    low = {r: a for r, a in accuracy.items() if r in (0.0, 0.2, 0.4)}
+    if len(low) < 2:
+        raise _Missing("fewer than 2 of r = 0, 0.2, 0.4")
+    spread = 100 * (max(low.values()) - min(low.values()))
+    text = ", ".join(f"r = {r}: {100 * a:.1f} %" for r, a in sorted(low.items()))
+    return f"mean accuracy over k: {text} (spread {spread:.1f} points)", spread <= 2.0
+
+
+def _best_r(results: Mapping[str, Any]) -> tuple[str, bool]:
+    accuracy = _accuracy_by_r(results)
+    counts = {r: float(v.mean()) for r, (_, v) in _by_r(results, "n_selected").items()}
+    top = max(accuracy.values())
+    near = [r for r, a in accuracy.items() if a >= top - 0.01]
+    choice = max(near)
+    text = ", ".join(
+        f"r = {r}: {100 * accuracy[r]:.1f} % with {counts.get(r, float('nan')):.1f} features"
+        for r in sorted(accuracy)
+    )
+    return f"{text}; fewest features within 1 point of the best accuracy: r = {choice}", choice == 0.4
+
+
+# --- the grasp ----------------------------------------------------------------------------------------------
+#: The grasp's average uniformity: above the paper's 70 % and not above the tap's 80 %, which it sets apart.
+GRASP_UNIFORMITY = (70.0, 80.0)
+#: A 1 x 3 category straddles the critical size when at least this share of its objects lies on each side
+#: of it, and at least this share of its members has its less common outcome.
+STRADDLE_SHARE = 0.2
+#: ... and it is a category, not a handful of outliers: it holds at least this share of all interactions.
+STRADDLE_MIN_SIZE = 0.1
+#: The critical size decides the grasp when successes are this much more common below it than above it.
+CRITICAL_SIZE_CONTRAST = 0.5
+
+
+def _grasp_uniformity_average(results: Mapping[str, Any]) -> tuple[str, bool]:
+    ks, u = _curve(_section(results, "uniformity"))
+    low, high = GRASP_UNIFORMITY
+    return f"mean over k = {ks[0]}..{ks[-1]}: {u.mean():.1f} % (per k: {_fmt(u)})", bool(low < u.mean() <= high)
+
+
+def _fall_at_three(results: Mapping[str, Any]) -> tuple[str, bool]:
+    section = _section(results, "uniformity")
+    u2, u3, u4 = (_mean(section, k) for k in (2, 3, 4))
+    return f"mean uniformity at k = 2, 3, 4: {u2:.1f}, {u3:.1f}, {u4:.1f} %", u3 < u2 and u3 < u4
+
+
+def _critical_size(results: Mapping[str, Any]) -> tuple[str, bool]:
+    section = _section(results, "size_success")
+    fit, critical = section.get("logistic"), section.get("critical_size")
+    if fit is None:
+        return "one outcome only: no size separates success from failure", False
+    if critical is None:
+        return (f"the logistic fit (slope {fit['slope'] / 100:+.2f} per cm of logit) does not cross 50 % within "
+                "the sizes seen", False)
+    below, above = section["below"], section["above"]
+    if below["success"] is None or above["success"] is None:
+        raise _Missing("no object on one side of the critical size")
+    contrast = below["success"] - above["success"]
+    text = (f"the fit crosses 50 % at {100 * critical:.1f} cm (slope {fit['slope'] / 100:+.2f} per cm of logit); "
+            f"successes below it {100 * below['success']:.0f} % of {below['n']}, above it "
+            f"{100 * above['success']:.0f} % of {above['n']}")
+    return text, bool(fit["slope"] < 0 and contrast >= CRITICAL_SIZE_CONTRAST)
+
+
+def _straddling_cluster(results: Mapping[str, Any]) -> tuple[str, bool]:
+    critical = _section(results, "size_success").get("critical_size")
+    if critical is None:
+        raise _Missing("no critical size: the fit of success on size does not cross 50 % within the sizes seen")
+    success_label, fail_label = _outcome_words(results)
+    parts, straddling = [], []
+    clusters = _case(results, 3)
+    total = sum(c["success"] + c["fail"] for c in clusters)
+    for c in clusters:
+        sizes = np.asarray(c["sizes"], dtype=float)
+        if sizes.size == 0:
+            parts.append(f"cluster {c['cluster']}: empty")
+            continue
+        n = c["success"] + c["fail"]
+        below = float(np.mean(sizes < critical))
+        minority = min(c["success"], c["fail"]) / max(n, 1)
+        if (min(below, 1.0 - below) >= STRADDLE_SHARE and minority >= STRADDLE_SHARE
+                and n >= STRADDLE_MIN_SIZE * total):
+            straddling.append(str(c["cluster"]))
+        parts.append(f"cluster {c['cluster']} ({100 * n / max(total, 1):.0f} % of the interactions): "
+                     f"{100 * sizes.min():.1f}-{100 * sizes.max():.1f} cm, {100 * below:.0f} % below; "
+                     f"{c['success']} {success_label} / {c['fail']} {fail_label}")
+    text = (f"critical size {100 * critical:.1f} cm; " + "; ".join(parts)
+            + f" -> straddling: {', '.join(straddling) or 'none'}")
+    return text, bool(straddling)
+
+
+_Judge = Callable[[Mapping[str, Any]], tuple[str, bool]]
+#: A claim before it is judged: topic, the paper's statement, the rule, and the function that applies it.
+_Spec = tuple[str, str, str, _Judge]
+
+_UNIFORMITY_RISES: _Spec = (
+    "Uniformity rises with k",
+    "Uniformity of clusters increases with the number of clusters.",
+    "Spearman rank correlation of k and mean uniformity >= 0.5",
+    _uniformity_rises,
+)
+_UNIFORMITY_PEAK: _Spec = (
+    "Uniformity peak",
+    "It can reach up to 95 %.",
+    "highest mean uniformity over k >= 90 %",
+    _uniformity_peak,
+)
+_FEWER_FEATURES: _Spec = (
+    "Fewer features as r rises",
+    "The number of selected features tends to be inversely proportional to r.",
+    "for every k the mean number never grows with r, and is lower at the largest r than at the smallest",
+    _count_falls_with_r,
+)
+_NUMBER_CONSTANT: _Spec = (
+    "Number constant in k",
+    "The number of selected features remains the same above some number of clusters.",
+    "for every r, the coefficient of variation over k >= 4 of the mean number <= 0.15",
+    _count_constant_in_k,
+)
+_ACCURACY_FALLS: _Spec = (
+    "SVM accuracy falls with k",
+    "SVM prediction accuracy decreases as the number of effect categories grows.",
+    "for every r, Spearman rank correlation of k and mean accuracy <= -0.5",
+    _accuracy_falls,
+)
+
+#: The paper's statements on the method, which do not depend on the behaviour.
+METHOD_CLAIMS: tuple[_Spec, ...] = (_UNIFORMITY_RISES, _FEWER_FEATURES, _NUMBER_CONSTANT, _ACCURACY_FALLS)
+
+GRASP_CLAIMS: tuple[_Spec, ...] = (
+    (
+        "Uniformity on average",
+        "The average uniformity is above ... 70 % for grasping.",
+        f"mean over k of the mean uniformity > {GRASP_UNIFORMITY[0]:.0f} % and <= {GRASP_UNIFORMITY[1]:.0f} % "
+        "(the paper sets the grasp's average apart from the tap's 'above 80 %')",
+        _grasp_uniformity_average,
+    ),
+    _UNIFORMITY_RISES,
+    _UNIFORMITY_PEAK,
+    (
+        "Fall at k = 3",
+        "There is a fall in the general trend of increase in the grasp behaviour for the 3 cluster case.",
+        "mean uniformity at k = 3 below both k = 2 and k = 4",
+        _fall_at_three,
+    ),
+    (
+        "Critical size",
+        "The grasping behaviour is affected mostly by the size of the object ... there is a critical size value "
+        "determining the graspability.",
+        "a logistic fit of success on object size crosses 50 % within the sizes seen (the critical size), "
+        "success falls with size, and the share of successes below the critical size is at least "
+        f"{100 * CRITICAL_SIZE_CONTRAST:.0f} points above that above it",
+        _critical_size,
+    ),
+    (
+        "1 x 3 map: a category straddles the critical size",
+        "One of the clusters falls near this region, stealing from both and therefore decreasing uniformity.",
+        f"a cluster of the 1 x 3 map (first trial) with >= {100 * STRADDLE_MIN_SIZE:.0f} % of the interactions "
+        f"has >= {100 * STRADDLE_SHARE:.0f} % of its objects on each side of the critical size and "
+        f">= {100 * STRADDLE_SHARE:.0f} % of its members with its less common outcome",
+        _straddling_cluster,
+    ),
+    (
+        "Size features dominate",
+        "The grasping behaviour is affected mostly by the size of the object to be grasped.",
+        "for every r > 0, the mean over k of the size share of the selected features > 50 % (18 of the 49 "
+        "features are size features)",
+        _size_dominates,
+    ),
+    _FEWER_FEATURES,
+    _NUMBER_CONSTANT,
+    _ACCURACY_FALLS,
+)
+
+TAP_CLAIMS: tuple[_Spec, ...] = (
+    (
+        "Uniformity on average",
+        "The average uniformity is above 80 % for tapping.",
+        "mean over k of the mean uniformity > 80 %",
+        _uniformity_average,
+    ),
+    _UNIFORMITY_RISES,
+    _UNIFORMITY_PEAK,
+    (
+        "Shape features dominate",
+        "Shape features dominate the selected features.",
+        "for every r > 0, the mean over k of the shape share of the selected features > 50 %",
+        _shape_dominates,
+    ),
+    (
+        "Shape share and r",
+        "When the relevancy threshold is decreased ... the percentage of shape features decreases.",
+        "Spearman rank correlation of r and the mean shape share > 0",
+        _shape_share_falls_with_lower_r,
+    ),
+    _FEWER_FEATURES,
+    _NUMBER_CONSTANT,
+    (
+        "1 x 2 map: object types",
+        "One cluster holds spheres and horizontal cylinders (rollable), the other boxes and "
+        "vertical cylinders.",
+        "spheres and lying cylinders share a majority cluster, boxes and standing cylinders the "
+        "other, each type with >= 75 % of its objects there (first trial)",
+        _two_cluster_types,
+    ),
+    (
+        "1 x 2 map: sizes",
+        "Both clusters have instances from the whole size range.",
+        "each of the 2 clusters spans >= 75 % of the range of object sizes (first trial)",
+        _two_cluster_sizes,
+    ),
+    (
+        "1 x 4 map: success/fail",
+        "Two of the four clusters are success clusters, the other two fail clusters.",
+        "exactly 2 clusters with more successes (rolled) than failures and 2 with more failures (first trial)",
+        _four_cluster_split,
+    ),
+    _ACCURACY_FALLS,
+    (
+        "Bump at k = 4",
+        "Accuracy increases at 4 clusters against the decreasing trend (four object types).",
+        "mean accuracy at k = 4 above that at k = 3 for at least half of the r values",
+        _bump_at_four,
+    ),
+    (
+        "r = 0, 0.2, 0.4 alike",
+        "Accuracy is almost the same for relevancy values of 0 %, 20 % and 40 %.",
+        "mean accuracy over k of these r within 2 percentage points",
+        _low_r_alike,
+    ),
+    (
+        "r = 0.4 best",
+        "40 % is the best relevancy: maximum accuracy with the highest perceptual economy.",
+        "the largest r whose mean accuracy over k is within 1 point of the best r's is 0.4",
+        _best_r,
+    ),
+)
+
+
+#: The claims of each behaviour the paper reports on; any other behaviour gets :data:`METHOD_CLAIMS`.
+CLAIM_SETS: dict[str, tuple[_Spec, ...]] = {"tap": TAP_CLAIMS, "grasp": GRASP_CLAIMS}
+
+
+def results_behavior(results: Mapping[str, Any]) -> str:
+    """The behaviour of a results dict (``config["behavior"]``); results without it, written before the
+    behaviour was recorded, are the tap's."""
+    return str(results.get("config", {}).get("behavior", "tap"))
+
+
+def claims_scope(behavior: str) -> str:
+    """Which of the paper's statements are checked for ``behavior``, as a sentence for the reports."""
+    if behavior == "tap":
+        return "The paper's statements on tapping (section V)."
+    if behavior == "grasp":
+        return ("The paper's statements on grasping (section V.B), and those on the method that hold for any "
+                "behaviour (sections V.B, V.C, V.E).")
+    return (f"The paper reports on tapping and grasping only; for {behavior} only its statements on the method, "
+            "which hold for any behaviour, are checked (sections V.B, V.C, V.E).")
+
+
+def claims_for(behavior: str) -> tuple[_Spec, ...]:
+    """The claims (topic, the paper, rule, judge) checked for ``behavior``: its own set in
+    :data:`CLAIM_SETS`, else :data:`METHOD_CLAIMS`."""
+    return CLAIM_SETS.get(behavior, METHOD_CLAIMS)
+
+
+def evaluate_claims(results: Mapping[str, Any], behavior: str | None = None) -> list[Claim]:
+    """The paper's claims on a behaviour with our numbers and a verdict computed from them.
+
+    Args:
+        results: The dict of :func:`affordance_learning.experiment.run_protocol` (or its JSON), or part of it.
+        behavior: Whose claims to check; by default the results' own (:func:`results_behavior`).
+    """
+    claims = []
+    for topic, paper, rule, judge in claims_for(results_behavior(results) if behavior is None else behavior):
+        try:
+            ours, ok = judge(results)
+            verdict = AGREES if ok else DISAGREES
+        except _Missing as why:
+            ours, verdict = f"({why})", NOT_COMPUTABLE
+        claims.append(Claim(topic=topic, paper=paper, rule=rule, ours=ours, verdict=verdict))
+    return claims
