@@ -13,13 +13,14 @@ index       meaning                                                          ran
 ==========  ===============================================================  ======================
 0           height of the palm centre above the canonical contact height     -1.5 .. +1.5 cm
 1           lateral offset of the stroke, across the stroke direction        -2 .. +2 cm
-2           hand speed along the stroke, 0.2 m/s x 3 ** action[2]            0.067 .. 0.6 m/s
+2           hand speed along the stroke, 0.18 m/s x 3 ** action[2]           0.06 .. 0.54 m/s
 ==========  ===============================================================  ======================
 
-The canonical tap is moderate (the paper: "moderately hitting an object from its side"): at 0.2 m/s a ball or a
-lying cylinder rolls some 5 to 25 cm on the table and stays in view; the speed scale is geometric, because the
-distance a struck object rolls grows with the square of its speed: at the gentlest tap (-1) rolling objects
-move 2-3 cm, at the hardest (+1) four in five roll off the 1 m wide table (see ``assets/README.md``).
+The canonical tap is moderate (the paper: "moderately hitting an object from its side"): at 0.18 m/s a ball or a
+lying cylinder rolls some 5 to 25 cm on the table and stays in view of the head camera; the speed scale is
+geometric, because the distance a struck object rolls grows with the square of its speed: at the gentlest tap (-1)
+rolling objects move 2-3 cm, at the hardest (+1) two in three roll off the 1 m wide table (see
+``assets/README.md``).
 
 For the grasp, 0 is the canonical grasp:
 
@@ -54,7 +55,7 @@ ACTION_DIM = 3
 HEIGHT_RANGE = 0.015  # [m]
 LATERAL_RANGE = 0.02  # [m]
 #: Hand speed of the canonical tap [m/s], and the factor by which action[2] = +-1 multiplies or divides it.
-SPEED_CANONICAL, SPEED_FACTOR = 0.2, 3.0
+SPEED_CANONICAL, SPEED_FACTOR = 0.18, 3.0
 #: Gap between hand surface and object before the stroke [m].
 CLEARANCE = 0.03
 #: Distance the hand keeps moving after it first touches the object [m].

@@ -126,7 +126,7 @@ class TapAffordanceEnv(gym.Env):
     |-------|---------|-------|
     | 0 | height of the palm above the canonical contact height | -1.5 .. +1.5 cm |
     | 1 | lateral offset of the stroke, across its direction | -2 .. +2 cm |
-    | 2 | hand speed along the stroke, 0.2 x 3 ** a m/s | 0.067 .. 0.6 m/s |
+    | 2 | hand speed along the stroke, 0.18 x 3 ** a m/s | 0.06 .. 0.54 m/s |
 
     For ``behavior="grasp"``, 0 is the canonical grasp:
 

@@ -54,7 +54,7 @@ def test_action_moves_height_lateral_offset_and_speed():
     # the tap moves along -y; its "across" direction is +x (direction turned by +90 degrees)
     np.testing.assert_allclose(moved.p_start - base.p_start, [0.02, 0.0, 0.015], atol=1e-12)
     np.testing.assert_allclose(moved.p_end - base.p_end, [0.02, 0.0, 0.015], atol=1e-12)  # a parallel stroke
-    assert moved.speed == pytest.approx(0.6)  # hardest: 3 x the canonical 0.2 m/s
+    assert moved.speed == pytest.approx(3 * SPEED_CANONICAL)  # hardest: 3 x the canonical speed
     gentle = plan_stroke(get_behavior("tap"), box, p_object, 0.0, TABLE, np.array([0.0, 0.0, -1.0]))
     assert gentle.speed == pytest.approx(0.2 / 3)
 

@@ -24,6 +24,7 @@ def test_wheel_ships_assets(tmp_path):
     assert "affordance_env/assets/README.md" in names
     assert "affordance_env/tap_env.py" in names and "affordance_learning/__init__.py" in names
     assert "affordance_learning/data/tap_model.joblib" in names
+    assert "affordance_learning/data/grasp_model.joblib" in names
     entry_points = next(n for n in names if n.endswith("entry_points.txt"))
     assert "affordance = affordance_learning.cli:main" in zipfile.ZipFile(wheel).read(entry_points).decode()
 

@@ -61,3 +61,18 @@ def test_corrupt_or_missing_model_is_refused(tmp_path):
         default_model.load_default_model(tmp_path / "bad.joblib")
     with pytest.raises(FileNotFoundError, match="affordance train-default"):
         default_model.load_default_model(tmp_path / "none.joblib")
+
+
+def test_the_shipped_grasp_model_answers_for_the_grasp():
+    # the grasp has its own shipped model, trained on canonical grasps: the same features get the grasp's
+    # predicted effect, not the tap's (a grasped object is carried 6 cm to the robot's left, -y)
+    env = TapAffordanceEnv(behavior="grasp", object_types=("sphere",), size_range=(0.045, 0.045))
+    features = np.array([env.reset(seed=s)[0]["features"] for s in range(3)])
+    grasp = predict_effect(features, behavior="grasp")
+    direct = default_model.load_default_model(behavior="grasp").predict_effect(features)
+    np.testing.assert_array_equal(grasp.category, direct.category)
+    np.testing.assert_allclose(grasp.effect, direct.effect)
+    tap = predict_effect(features)
+    assert not np.allclose(grasp.effect, tap.effect)
+    mean_y = FEATURE_NAMES.index("mean_y")
+    assert np.all(grasp.effect[:, mean_y] < -0.03)
