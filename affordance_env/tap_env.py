@@ -115,7 +115,7 @@ class TapAffordanceEnv(gym.Env):
     wood on wood, see ``assets/README.md``); past its edges an object falls to the floor. The range camera in the
     head has the iCub eye camera's field of view (57 x 72 degrees at the default 4:3 image). The head keeps the
     gaze of the initial snapshot until the final one, so both snapshots see the table from the same pose: a
-    moderate tap rolls a ball 10-26 cm, and it is seen where it stops. 3-D features (``mean_x``, ``hand_dx``, ...)
+    moderate tap rolls a ball 8-26 cm, and it is seen where it stops. 3-D features (``mean_x``, ``hand_dx``, ...)
     are in the robot's root frame, which is fixed (the robot does not walk), so final minus initial is the
     object's motion; image features are in the head camera's image, also unmoved between the two snapshots.
 
