@@ -181,8 +181,9 @@ class MotionExecutor:
             qd /= stretch
             qdd /= stretch ** 2
         physics = self.physics
-        for q_tick, qd_tick, qdd_tick in zip(q, qd, qdd, strict=True):
-            self._tick(q_tick + physics.servo_lead * qd_tick + physics.inertial_lead(qdd_tick))
+        led = q + physics.servo_lead * qd  # the velocity feedforward of every tick at once
+        for q_tick, qdd_tick in zip(led, qdd, strict=True):
+            self._tick(q_tick + physics.inertial_lead(qdd_tick))
 
     def settle(self, p_world_target: np.ndarray, tolerance: float = SETTLE_TOLERANCE,
                max_time: float = SETTLE_MAX_TIME) -> float:
