@@ -34,7 +34,7 @@ def main() -> None:
             env.reset(seed=i)
         data = env.physics.data
         start = time.perf_counter()
-        image = env.camera.capture(data)
+        image = env.camera.capture(data, occluded=env.physics.active_geom)  # as the env captures
         mask = image.mask_of(env.physics.active_geom)
         p_hand = env.physics.hand_position()
         uv_hand = image.project(p_hand)
