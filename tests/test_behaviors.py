@@ -56,7 +56,7 @@ def test_action_moves_height_lateral_offset_and_speed():
     np.testing.assert_allclose(moved.p_end - base.p_end, [0.02, 0.0, 0.015], atol=1e-12)  # a parallel stroke
     assert moved.speed == pytest.approx(3 * SPEED_CANONICAL)  # hardest: 3 x the canonical speed
     gentle = plan_stroke(get_behavior("tap"), box, p_object, 0.0, TABLE, np.array([0.0, 0.0, -1.0]))
-    assert gentle.speed == pytest.approx(0.2 / 3)
+    assert gentle.speed == pytest.approx(SPEED_CANONICAL / 3)
 
 
 def test_push_and_tap_back_move_the_other_ways():
