@@ -48,22 +48,16 @@ IK_POSITION_TOLERANCE, IK_ORIENTATION_TOLERANCE = 0.005, 0.35
 
 
 @dataclass(frozen=True)
-class StrokeOutcome:
-    """What happened during a stroke.
+class ReachOutcome:
+    """What every behaviour reports of its reach and its first touch.
 
     Attributes:
-        ik_success: Every waypoint of the stroke (pre-stroke pose and the stroke line) was reached by the IK
-            within tolerance.
-        ik_position_error: Largest IK position error over the waypoints [m].
-        ik_orientation_error: Largest IK orientation error over the waypoints [rad].
+        ik_success: Every pose the hand was sent to was reached by the IK within tolerance.
+        ik_position_error: Largest IK position error over those poses [m].
+        ik_orientation_error: Largest IK orientation error over those poses [rad].
         contact: The hand touched the object.
         contact_time: Simulation time of the first touch [s] (NaN without contact).
         hand_speed: Hand speed at first touch [m/s] (0 without contact).
-        hand_travel: Distance the palm travelled along the stroke direction [m].
-        start_error: Distance of the palm from the pre-stroke pose when the stroke started [m].
-        object_moved: How far the object moved before the stroke started (touched during the reach) [m].
-        q_withdraw: Joint targets of the pose above the pre-stroke pose, which the way home passes through so that
-            it never crosses the object; None if the plan has no such pose.
     """
 
     ik_success: bool
@@ -72,10 +66,25 @@ class StrokeOutcome:
     contact: bool
     contact_time: float
     hand_speed: float
+
+
+@dataclass(frozen=True)
+class StrokeOutcome(ReachOutcome):
+    """What happened during a stroke (:class:`ReachOutcome` over the pre-stroke pose and the stroke line; the
+    first touch to the physics step).
+
+    Attributes:
+        hand_travel: Distance the palm travelled along the stroke direction [m].
+        start_error: Distance of the palm from the pre-stroke pose when the stroke started [m].
+        object_moved: How far the object moved before the stroke started (touched during the reach) [m].
+        q_withdraw: Joint targets of the pose above the pre-stroke pose, which the way home passes through so that
+            it never crosses the object; None if the plan has no such pose.
+    """
+
     hand_travel: float
     start_error: float
     object_moved: float
-    q_withdraw: np.ndarray
+    q_withdraw: np.ndarray | None
 
 
 #: Grasp timing [s]: reach above the object, descend to it, keep squeezing after the closing ramp, lift, carry the
@@ -90,32 +99,29 @@ GRASP_SETTLE_MAX_TIME = 0.1
 
 
 @dataclass(frozen=True)
-class GraspOutcome:
-    """What happened during a grasp, measured in the simulation.
+class GraspOutcome(ReachOutcome):
+    """What happened during a grasp, measured in the simulation (:class:`ReachOutcome` over every pose of the
+    grasp; the first touch to the control tick).
 
     Attributes:
-        ik_success: Every pose of the grasp was reached by the IK within tolerance.
-        ik_position_error: Largest IK position error over the poses [m].
-        ik_orientation_error: Largest IK orientation error over the poses [rad].
-        contact: The hand touched the object.
-        contact_time: Simulation time of the first touch [s], to the control tick (NaN without contact).
-        hand_speed: Palm speed over the control tick of the first touch [m/s] (0 without contact).
         rise: How far the object's centre had risen above its start at the end of the hold [m].
         links_holding: Hand links touching the object at the end of the hold.
         on_table: Whether the object touched the table at the end of the hold.
         release_time: Simulation time when the hand had opened again [s].
     """
 
-    ik_success: bool
-    ik_position_error: float
-    ik_orientation_error: float
-    contact: bool
-    contact_time: float
-    hand_speed: float
     rise: float
     links_holding: tuple[str, ...]
     on_table: bool
     release_time: float
+
+
+def _ik_verdict(results: list[IKResult]) -> tuple[bool, float, float]:
+    """(all within IK_POSITION_TOLERANCE and IK_ORIENTATION_TOLERANCE, largest position error [m], largest
+    orientation error [rad]) over IK results."""
+    pos_err = max(r.position_error for r in results)
+    rot_err = max(r.orientation_error for r in results)
+    return pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE, pos_err, rot_err
 
 
 def _smoothstep(s: float) -> float:
@@ -199,10 +205,11 @@ class MotionExecutor:
             self._tick(q)
         return float(np.linalg.norm(self.physics.hand_position() - p_world_target))
 
-    def _ik(self, p: np.ndarray, q_init: np.ndarray, plan: StrokePlan) -> IKResult:
+    def _ik(self, p: np.ndarray, q_init: np.ndarray, plan: StrokePlan | GraspPlan) -> IKResult:
+        """IK of a palm position with the plan's hand orientation (and joint ranges, if it has any)."""
         return self.kinematics.solve_ik(
             p, q_init, plan.R_world_hand, position_tolerance=1e-3, orientation_tolerance=IK_ORIENTATION_TOLERANCE,
-            joint_ranges=plan.joint_ranges,
+            joint_ranges=getattr(plan, "joint_ranges", None),
         )
 
     def plan_approach(self, plan: StrokePlan) -> tuple[IKResult | None, IKResult]:
@@ -250,12 +257,8 @@ class MotionExecutor:
                 break
         travel = float(np.dot(physics.hand_position() - p_hand_start, plan.direction))
         # The pose above the object is a via point that only has to clear it; the stroke itself must be exact.
-        stroke_results = [start, *line.results]
-        pos_err = max(r.position_error for r in stroke_results)
-        rot_err = max(r.orientation_error for r in stroke_results)
-        ik_ok = pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE
-        return StrokeOutcome(ik_ok, pos_err, rot_err, contact, contact_time, hand_speed, travel, start_error,
-                             object_moved, None if above is None else above.q)
+        return StrokeOutcome(*_ik_verdict([start, *line.results]), contact, contact_time, hand_speed, travel,
+                             start_error, object_moved, None if above is None else above.q)
 
     def _tick_watching(self, q: np.ndarray, watch: dict) -> None:
         """One control tick towards ``q``, noting in ``watch`` the first hand-object touch (to the tick) and the
@@ -291,17 +294,10 @@ class MotionExecutor:
                 q[joints.index(name)] = value
             return q
 
-        def ik(p: np.ndarray, q_init: np.ndarray) -> IKResult:
-            return kinematics.solve_ik(p, q_init, plan.R_world_hand, position_tolerance=1e-3,
-                                       orientation_tolerance=IK_ORIENTATION_TOLERANCE)
-
         q_open = with_hand(physics.joint_targets(), plan.hand_open)
-        results = [ik(plan.p_above, q_open)]
+        results = [self._ik(plan.p_above, q_open, plan)]
         for p in (plan.p_grasp, plan.p_lift, plan.p_place, plan.p_retreat):
-            results.append(ik(p, results[-1].q))
-        pos_err = max(r.position_error for r in results)
-        rot_err = max(r.orientation_error for r in results)
-        ik_ok = pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE
+            results.append(self._ik(p, results[-1].q, plan))
         q_above, q_grasp, q_lift, q_place, q_retreat = (r.q for r in results)
         z_start = float(physics.object_pose()[2])
         watch = {"contact": False, "time": float("nan"), "speed": 0.0}
@@ -325,8 +321,8 @@ class MotionExecutor:
         self._ramp(with_hand(q_place, plan.hand_open), GRASP_OPEN_TIME, watch)
         release_time = float(physics.data.time)
         self._ramp(with_hand(q_retreat, plan.hand_open), GRASP_RETREAT_TIME, watch)
-        return GraspOutcome(ik_ok, pos_err, rot_err, watch["contact"], watch["time"], watch["speed"], rise,
-                            holding, on_table, release_time)
+        return GraspOutcome(*_ik_verdict(results), watch["contact"], watch["time"], watch["speed"], rise, holding,
+                            on_table, release_time)
 
     def go_home(self, q_home: np.ndarray, via: np.ndarray | None = None) -> bool:
         """Return to ``q_home`` through ``via`` (after :meth:`stroke`: up and back above the pre-stroke pose) and
