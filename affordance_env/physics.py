@@ -97,6 +97,13 @@ class TapPhysics:
         self.ctrl_low = model.actuator_ctrlrange[self.actuators, 0].copy()
         self.ctrl_high = model.actuator_ctrlrange[self.actuators, 1].copy()
         self._ctrl = np.empty(len(self.actuators))
+        # Views into the data, made once: a control tick reads and writes them without building new arrays.
+        data = self.data
+        self._ctrl_view = data.ctrl[self._act] if isinstance(self._act, slice) else None
+        self._qvel_view = data.qvel[self._qvel]
+        self._object_p = data.qpos[self.object_qpos : self.object_qpos + 3]
+        self._object_v = data.qvel[self.object_qvel : self.object_qvel + 3]
+        self._object_w = data.cvel[self.object_body, :3]
         self.body_names = [model.body(b).name for b in range(model.nbody)]
         # The table is static: its top height and extent are fixed once.
         mujoco.mj_kinematics(model, self.scratch)
@@ -134,7 +141,7 @@ class TapPhysics:
 
     def joint_velocities(self) -> np.ndarray:
         """Robot joint velocities in active-joint order [rad/s]."""
-        return self.data.qvel[self._qvel].copy()
+        return self._qvel_view.copy()
 
     def set_joint_targets(self, q: np.ndarray) -> None:
         """Command the position servos to ``q`` [rad] (active-joint order), clipped to the joint ranges; the values
@@ -142,6 +149,9 @@ class TapPhysics:
         if self._actuated is not None:
             q = np.asarray(q)[self._actuated]
         # np.minimum/np.maximum into the control vector: np.clip's wrapper costs more than the clipping
+        if self._ctrl_view is not None:
+            np.minimum(np.maximum(q, self.ctrl_low, out=self._ctrl), self.ctrl_high, out=self._ctrl_view)
+            return
         np.minimum(np.maximum(q, self.ctrl_low, out=self._ctrl), self.ctrl_high, out=self._ctrl)
         self.data.ctrl[self._act] = self._ctrl
 
@@ -267,19 +277,21 @@ class TapPhysics:
         return self.monitor
 
     def _sample_monitor(self) -> None:
-        a, v, data = self.object_qpos, self.object_qvel, self.data
-        # qvel[v:v+3] is the centre's world velocity (the body origin is its centre of mass); cvel's rotational
-        # part is the angular velocity in world axes (computed at the start of the last step, 2 ms before).
-        self.monitor.sample(data.time, data.qpos[a : a + 3].tolist(), data.qvel[v : v + 3].tolist(),
-                            data.cvel[self.object_body, :3].tolist())
+        # qvel's linear part is the centre's world velocity (the body origin is its centre of mass); cvel's
+        # rotational part is the angular velocity in world axes (computed at the start of the last step).
+        self.monitor.sample(self.data.time, self._object_p.tolist(), self._object_v.tolist(),
+                            self._object_w.tolist())
 
     # --- stepping --------------------------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
         """Advance the simulation by ``n`` timesteps."""
-        mujoco.mj_step(self.model, self.data, n)
-        if self.monitor is not None and self.data.time >= self._next_sample - 1e-9:  # every 10 ms at least
-            self._sample_monitor()
-            self._next_sample = self.data.time + MONITOR_PERIOD
+        data = self.data
+        mujoco.mj_step(self.model, data, n)
+        if self.monitor is not None:
+            time = data.time
+            if time >= self._next_sample - 1e-9:  # every 10 ms at least
+                self._sample_monitor()
+                self._next_sample = time + MONITOR_PERIOD
         if self.on_step is not None:
             self.on_step(self)
 
