@@ -166,6 +166,10 @@ class RangeCamera:
                                              & (model.geom_group >= 0) & (model.geom_group <= 5))
         self._support = None if support is None or not self._world_group.any() else self._support_face(support)
         self._d_camera_rays = self.intrinsics.ray_directions().reshape(-1, 3)
+        # The rays as three rows (x, y, z): rotating them is one small matrix product, and each coordinate is a
+        # contiguous row for the per-ray arithmetic below.
+        self._d_camera_rays_T = np.ascontiguousarray(self._d_camera_rays.T)
+        self._not_plane = model.geom_type != int(mujoco.mjtGeom.mjGEOM_PLANE)  # geom types never change
         n = width * height
         self._geom_ids = np.empty(n, dtype=np.int32)
         self._dist = np.empty(n, dtype=np.float64)
@@ -193,18 +197,21 @@ class RangeCamera:
 
     def _cast(self, data: mujoco.MjData, p_world_camera: np.ndarray, d_world: np.ndarray, rays: np.ndarray,
               group: np.ndarray, normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
-        """MuJoCo's nearest hit (geom ids, distances; normals written into ``normal``) of the rays ``rays``."""
+        """MuJoCo's nearest hit (geom ids, distances; normals written into ``normal``) of the rays ``rays``
+        (``d_world``: the ray directions as rows x, y, z, (3, n))."""
         ids, dist = np.empty(rays.size, np.int32), np.empty(rays.size)
-        mujoco.mj_multiRay(self.model, data, p_world_camera, np.ascontiguousarray(d_world[rays]).reshape(-1), group,
-                           True, -1, ids, dist, normal, rays.size, self.max_range)
+        mujoco.mj_multiRay(self.model, data, p_world_camera, np.ascontiguousarray(d_world[:, rays].T).reshape(-1),
+                           group, True, -1, ids, dist, normal, rays.size, self.max_range)
         return ids, dist
 
     def _world_pass(self, data: mujoco.MjData, p_world_camera: np.ndarray, R_world_camera: np.ndarray,
                     d_world: np.ndarray, normal: np.ndarray | None) -> None:
-        """Nearest hit of every ray among the geoms of group 0, into ``self._geom_ids``, ``self._dist``."""
+        """Nearest hit of every ray among the geoms of group 0, into ``self._geom_ids``, ``self._dist``
+        (``d_world``: the ray directions as rows x, y, z, (3, n))."""
         if self._support is None:
             mujoco.mj_multiRay(
-                self.model, data, p_world_camera, d_world.reshape(-1), self._world_group, True, -1,
+                self.model, data, p_world_camera, np.ascontiguousarray(d_world.T).reshape(-1), self._world_group,
+                True, -1,
                 self._geom_ids, self._dist, normal, len(self._dist), self.max_range,
             )
             return
@@ -212,9 +219,9 @@ class RangeCamera:
         on_face = np.zeros(len(self._dist), dtype=bool)
         if p_world_camera[2] > top:
             with np.errstate(divide="ignore", invalid="ignore"):
-                t = (top - p_world_camera[2]) / d_world[:, 2]
-            x = p_world_camera[0] + t * d_world[:, 0]
-            y = p_world_camera[1] + t * d_world[:, 1]
+                t = (top - p_world_camera[2]) / d_world[2]
+            x = p_world_camera[0] + t * d_world[0]
+            y = p_world_camera[1] + t * d_world[1]
             on_face = (t > 0) & (t <= self.max_range) & (x >= low[0]) & (x <= high[0]) & (y >= low[1]) & (y <= high[1])
             self._geom_ids[on_face] = geom
             self._dist[on_face] = t[on_face]
@@ -222,7 +229,7 @@ class RangeCamera:
                 normal.reshape(-1, 3)[on_face] = (0.0, 0.0, 1.0)
         # Geoms of group 0 that may end a ray before the face: all but the box and the planes below it.
         model = self.model
-        others = np.flatnonzero((model.geom_group == 0) & (model.geom_type != mujoco.mjtGeom.mjGEOM_PLANE))
+        others = np.flatnonzero((model.geom_group == 0) & self._not_plane)
         others = others[others != geom]
         cast = ~on_face
         cast[self._rays_near(others, data, p_world_camera, R_world_camera, np.flatnonzero(on_face))] = True
@@ -309,7 +316,7 @@ class RangeCamera:
         """
         K = self.intrinsics
         p_world_camera, R_world_camera = self.pose(data)
-        d_world = self._d_camera_rays @ R_world_camera.T
+        d_world = R_world_camera @ self._d_camera_rays_T  # (3, n): rows x, y, z
         normal = np.empty(3 * len(self._dist)) if normals else None
         self._geom_ids[:] = -1
         if self._world_group.any():
@@ -334,11 +341,12 @@ class RangeCamera:
                 normal.reshape(-1, 3)[rays[nearer]] = near_normal.reshape(-1, 3)[nearer]
         hit = self._geom_ids >= 0
         dist = np.where(hit, self._dist, np.inf)
-        points = p_world_camera + d_world * np.where(hit, self._dist, np.nan)[:, None]
+        points = d_world * np.where(hit, self._dist, np.nan)
+        points += p_world_camera[:, None]  # (3, n); its transpose is the (n, 3) view below
         return RangeImage(
             ranges=dist.reshape(K.height, K.width).astype(np.float32),
             geom_ids=self._geom_ids.reshape(K.height, K.width).copy(),
-            p_world_points=points.reshape(K.height, K.width, 3),
+            p_world_points=points.T.reshape(K.height, K.width, 3),
             p_world_camera=p_world_camera,
             R_world_camera=R_world_camera,
             intrinsics=K,
