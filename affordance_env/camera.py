@@ -231,8 +231,8 @@ class RangeCamera:
         model = self.model
         others = np.flatnonzero((model.geom_group == 0) & self._not_plane)
         others = others[others != geom]
-        cast = ~on_face
-        cast[self._rays_near(others, data, p_world_camera, R_world_camera, np.flatnonzero(on_face))] = True
+        cast = ~on_face  # and the face's rays inside the geoms' rectangles (the others are cast already)
+        cast[self._rays_near(others, data, p_world_camera, R_world_camera)] = True
         rays = np.flatnonzero(cast)
         if rays.size:
             ray_normal = np.empty(3 * rays.size) if normal is not None else None

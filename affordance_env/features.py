@@ -198,9 +198,8 @@ def compute_features(
     v_pad, u_pad = np.divmod(pixel_index, m_pad.shape[1])
     v_obj, u_obj = v_pad + (r0 - 1), u_pad + (c0 - 1)
     image_index = v_obj * mask.shape[1] + u_obj  # the same pixels in the full image
-    p_world_obj = np.ascontiguousarray(
-        np.take(points.reshape(-1, 3), image_index, axis=0).T, dtype=np.float64
-    )
+    # (3, k), gathered along the pixel axis (contiguous when the camera hands out its (3, n) points transposed)
+    p_world_obj = np.ascontiguousarray(np.take(points.reshape(-1, 3).T, image_index, axis=1), dtype=np.float64)
     range_obj = np.take(ranges.reshape(-1), image_index).astype(np.float64)
     _check_on_mask(p_world_obj, range_obj)
     uv_obj = np.stack([u_obj, v_obj]).astype(np.float64)
