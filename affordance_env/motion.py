@@ -41,6 +41,11 @@ SETTLE_TOLERANCE, SETTLE_MAX_TIME = 0.003, 0.4
 HOLD_SPEED_TOLERANCE, HOLD_MAX_TIME = 0.01, 1.0
 #: Consecutive control ticks at which the robot must be that slow to count as still.
 HOLD_STILL_TICKS = 2
+#: Before the first touch, the stroke checks for contact at every physics step only while the hand is within this
+#: distance of the object [m]; farther away it cannot touch it before the tick ends. To cover it in the 6 steps
+#: from the kinematics it is measured on (one step old) to the tick's end, hand and object would have to close
+#: at 1.25 m/s, over twice the fastest stroke (0.54 m/s), while the object rests.
+CONTACT_WATCH_DISTANCE = 0.015
 #: Spacing of the IK solutions along the stroke line [m].
 IK_SPACING = 0.01
 #: IK tolerances for the stroke waypoints: position [m] and orientation [rad].
@@ -237,6 +242,9 @@ class MotionExecutor:
         palm = physics.data.site_xpos[physics.palm_site]  # a view: the palm position after each step
         for i in range(len(line)):
             physics.set_joint_targets(line.target(i))
+            if not contact and physics.hand_object_distance(CONTACT_WATCH_DISTANCE) >= CONTACT_WATCH_DISTANCE:
+                physics.step(self.steps_per_tick)  # the same steps, without a check after each
+                continue
             for _ in range(self.steps_per_tick):
                 if not contact:
                     p_before = palm.copy()

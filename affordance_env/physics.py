@@ -85,6 +85,7 @@ class TapPhysics:
         self.hand_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] in contact_bodies])
         self._is_hand_geom = np.zeros(model.ngeom, dtype=bool)
         self._is_hand_geom[self.hand_geoms] = True
+        self._hand_geom_list = self.hand_geoms.tolist()
         #: Servo stiffness kp [N m/rad] and kv / kp [s] per active joint (a coupled joint has no servo: infinite
         #: stiffness, no lead). A target led by kv / kp times the reference velocity cancels the servo's damping
         #: lag, so the joint follows a moving reference (velocity feedforward).
@@ -193,6 +194,12 @@ class TapPhysics:
         """Whether any contact joins the object and the table top."""
         pair = {self.active_geom, self.table_geom}
         return any({g1, g2} == pair for g1, g2 in self.data.contact.geom[: self.data.ncon].tolist())
+
+    def hand_object_distance(self, max_distance: float) -> float:
+        """Smallest distance between the hand (wrist, forearm) and the object [m], from the kinematics of the last
+        step (MuJoCo's ``mj_geomDistance``); ``max_distance`` if they are at least that far apart."""
+        model, data, obj = self.model, self.data, self.active_geom
+        return min(mujoco.mj_geomDistance(model, data, g, obj, max_distance, None) for g in self._hand_geom_list)
 
     def hand_touches_object(self) -> bool:
         """Whether any contact joins the hand (or wrist, forearm) and the object."""

@@ -286,6 +286,26 @@ def test_a_stroke_started_off_its_pose_is_reported(monkeypatch):
     assert info["success"] is False
 
 
+def test_the_first_touch_is_found_to_the_step_while_far_ticks_run_unwatched(monkeypatch):
+    # Far from the object the stroke runs whole control ticks without a contact check after each step; the
+    # touch, its time and the hand's speed are those found by watching every step of the stroke.
+    import affordance_env.motion as motion
+
+    def interactions():
+        env = TapAffordanceEnv(camera_width=32, camera_height=24)
+        out = []
+        for seed, action in ((0, np.zeros(3)), (1, np.zeros(3)), (2, np.array([0.4, -0.6, 0.9]))):
+            env.reset(seed=seed)
+            info = env.step(action)[4]
+            out.append((info["contact"], info["hand_speed"], info["effect"].tolist(), info["outcome_time"]))
+        return out
+
+    skipping = interactions()
+    monkeypatch.setattr(motion, "CONTACT_WATCH_DISTANCE", np.inf)  # watch every step of the stroke
+    assert all(contact for contact, *_ in skipping)
+    assert interactions() == skipping
+
+
 def test_success_is_rolled_for_taps_and_moved_for_push():
     tap = TapAffordanceEnv(camera_width=32, camera_height=24)
     for object_type, succeeds in (("sphere", True), ("box", False)):  # a tapped ball rolls, a box slides
