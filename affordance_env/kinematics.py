@@ -10,6 +10,7 @@ simulation. Configurations are vectors in the variant's ``active_joints`` order;
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -72,6 +73,7 @@ class Kinematics:
     def __init__(self, hand_frame: str | None = None, head_frame: str = HEAD_FRAME, *, variant: str = "tap") -> None:
         self.variant = get_variant(variant)
         self.joint_names = self.variant.active_joints
+        self._last_rotation = np.full((3, 3), np.nan)  # the last target orientation found to be a rotation
         hand_frame = self.variant.hand_frame if hand_frame is None else hand_frame
         self.model = _build_model(self.variant.name)
         self.data = self.model.createData()
@@ -180,11 +182,14 @@ class Kinematics:
             raise ValueError(f"p_world_target must be 3 finite coordinates [m], got {p_world_target!r}.")
         if R_world_target is not None:
             R_world_target = np.asarray(R_world_target, dtype=float)
-            if R_world_target.shape != (3, 3) or np.abs(R_world_target @ R_world_target.T - np.eye(3)).max() > 1e-6:
-                raise ValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
+            # a stroke asks for one orientation many times: the last one checked need not be checked again
+            if not (R_world_target.shape == (3, 3) and np.array_equal(R_world_target, self._last_rotation)):
+                if R_world_target.shape != (3, 3) or np.abs(R_world_target @ R_world_target.T - np.eye(3)).max() > 1e-6:
+                    raise ValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
+                self._last_rotation = R_world_target.copy()
         lower, upper = self.joint_limits(joint_ranges)
         lower, upper = lower[self._to_pin], upper[self._to_pin]  # in Pinocchio's order from here on
-        q = np.clip(self._check_q(q_init)[self._to_pin], lower, upper)
+        q = np.minimum(np.maximum(self._check_q(q_init)[self._to_pin], lower), upper)
         dofs = self._reach_pin
         lower, upper = lower[dofs], upper[dofs]
         model, data, frame = self.model, self.data, self.hand_frame_id
@@ -198,13 +203,13 @@ class Kinematics:
             J = pin.computeFrameJacobian(model, data, q, frame, pin.LOCAL_WORLD_ALIGNED)
             T_world_hand = data.oMf[frame]
             error[:3] = p_target - T_world_hand.translation
-            pos_err = float(np.linalg.norm(error[:3]))
+            pos_err = math.sqrt(error[:3] @ error[:3])
             jac = J[:n_error, dofs]
             if R_world_target is None:
                 rot_err = 0.0
             else:
                 e_rot = pin.log3(R_world_target @ T_world_hand.rotation.T)
-                rot_err = float(np.linalg.norm(e_rot))
+                rot_err = math.sqrt(e_rot @ e_rot)
                 error[3:] = orientation_weight * e_rot
                 jac[3:] *= orientation_weight
             if pos_err <= position_tolerance and rot_err <= orientation_tolerance * 0.5:

@@ -93,3 +93,13 @@ def test_bad_targets_raise(kinematics, bad):
 def test_unknown_frame_lists_available_frames():
     with pytest.raises(ValueError, match="Available frames"):
         Kinematics(hand_frame="r_hnd")
+
+
+def test_a_target_orientation_that_is_not_a_rotation_is_refused_even_after_a_good_one(kinematics):
+    q = np.zeros(kinematics.nq)
+    target = kinematics.hand_pose(q)
+    kinematics.solve_ik(target.translation, q, target.rotation)  # checked once, then taken as known
+    for bad in (2.0 * target.rotation, target.rotation[:, ::-1] * [1.0, 1.0, 1.1], np.eye(2)):
+        with pytest.raises(ValueError, match="R_world_target must be a 3x3 rotation"):
+            kinematics.solve_ik(target.translation, q, bad)
+    kinematics.solve_ik(target.translation, q, target.rotation)
