@@ -191,10 +191,10 @@ class MotionExecutor:
             q, qd, qdd = profile((np.arange(1, n + 1) * (end / n))[:, None])
             qd /= stretch
             qdd /= stretch ** 2
-        physics = self.physics
-        led = q + physics.servo_lead * qd  # the velocity feedforward of every tick at once
+        step_toward, n_steps = self.physics.step_toward, self.steps_per_tick
+        led = q + self.physics.servo_lead * qd  # the velocity feedforward of every tick at once
         for q_tick, qdd_tick in zip(led, qdd, strict=True):
-            self._tick(q_tick + physics.inertial_lead(qdd_tick))
+            step_toward(q_tick, qdd_tick, n_steps)  # and the inertial feedforward of the tick's configuration
 
     def settle(self, p_world_target: np.ndarray, tolerance: float = SETTLE_TOLERANCE,
                max_time: float = SETTLE_MAX_TIME) -> float:
