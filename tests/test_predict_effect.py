@@ -69,7 +69,8 @@ def test_the_shipped_grasp_model_answers_for_the_grasp():
     env = TapAffordanceEnv(behavior="grasp", object_types=("sphere",), size_range=(0.045, 0.045))
     features = np.array([env.reset(seed=s)[0]["features"] for s in range(3)])
     grasp = predict_effect(features, behavior="grasp")
-    direct = default_model.load_default_model(behavior="grasp").predict_effect(features)
+    direct = default_model.load_default_model(behavior="grasp").predict_effect(
+        pd.DataFrame(features, columns=FEATURE_NAMES))  # the model was fitted on named columns
     np.testing.assert_array_equal(grasp.category, direct.category)
     np.testing.assert_allclose(grasp.effect, direct.effect)
     tap = predict_effect(features)
