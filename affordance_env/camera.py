@@ -100,6 +100,8 @@ def _in_front(corners: np.ndarray, near: float = 1e-3) -> np.ndarray:
     the part of the box in front of the camera."""
     depth = -corners[:, 2]
     front = depth >= near
+    if front.all():  # the usual case: the whole box is in front
+        return corners
     points = [corners[front]]
     for a, b in _EDGES:
         if front[a] != front[b]:
