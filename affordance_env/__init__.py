@@ -10,7 +10,6 @@
 or, without the import, ``gym.make("affordance_env:TapAffordance-v0")``.
 """
 
-from affordance_env.dataset import load_dataset
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
 from affordance_env.objects import OBJECT_TYPES
 from affordance_env.registration import register_envs
@@ -19,6 +18,15 @@ from affordance_env.robot_model import ACTIVE_JOINTS
 register_envs()
 
 __version__ = "0.2.0"
+
+
+def __getattr__(name: str):
+    # The dataset reader needs pandas and pyarrow; an env alone does not, so they are imported when first asked.
+    if name == "load_dataset":
+        from affordance_env.dataset.load import load_dataset
+
+        return load_dataset
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "ACTIVE_JOINTS",

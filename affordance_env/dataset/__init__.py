@@ -27,8 +27,17 @@ from affordance_env.dataset.format import (
     chunk_name,
     read_manifest,
 )
-from affordance_env.dataset.load import images, load_dataset
-from affordance_env.dataset.minari_export import export_minari
+
+_LAZY = {"images": "load", "load_dataset": "load", "export_minari": "minari_export"}
+
+
+def __getattr__(name: str):
+    # Reading (pandas) and the Minari export are imported when first asked: collecting needs neither.
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(f"affordance_env.dataset.{_LAZY[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [
     "ACTIONS",
