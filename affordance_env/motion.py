@@ -124,11 +124,6 @@ def _ik_verdict(results: list[IKResult]) -> tuple[bool, float, float]:
     return pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE, pos_err, rot_err
 
 
-def _smoothstep(s: float) -> float:
-    """3 s^2 - 2 s^3: from 0 to 1 as s goes from 0 to 1, with zero slope at both ends."""
-    return s * s * (3.0 - 2.0 * s)
-
-
 class MotionExecutor:
     """Runs strokes on ``physics`` using ``kinematics`` (both describe the same robot)."""
 
@@ -260,12 +255,13 @@ class MotionExecutor:
         return StrokeOutcome(*_ik_verdict([start, *line.results]), contact, contact_time, hand_speed, travel,
                              start_error, object_moved, None if above is None else above.q)
 
-    def _tick_watching(self, q: np.ndarray, watch: dict) -> None:
-        """One control tick towards ``q``, noting in ``watch`` the first hand-object touch (to the tick) and the
-        palm's speed over that tick."""
+    def _tick_watching(self, q: np.ndarray | None, watch: dict) -> None:
+        """One control tick towards ``q`` (None: keep the current targets), noting in ``watch`` the first
+        hand-object touch (to the tick) and the palm's speed over that tick."""
         physics = self.physics
-        physics.set_joint_targets(q)
-        if watch["contact"]:
+        if q is not None:
+            physics.set_joint_targets(q)
+        if watch["contact"]:  # known: nothing more to look for
             physics.step(self.steps_per_tick)
             return
         p_before = physics.hand_position()
@@ -277,10 +273,18 @@ class MotionExecutor:
     def _ramp(self, q_target: np.ndarray, duration: float, watch: dict) -> None:
         """Ramp the targets to ``q_target`` over ``duration`` [s] along a smoothstep (zero speed at both ends),
         watching for the first touch (:meth:`_tick_watching`)."""
-        q_from = self.physics.joint_targets()
+        physics = self.physics
+        q_from = physics.joint_targets()
         n = max(1, round(duration / CONTROL_DT))
-        for k in range(1, n + 1):
-            self._tick_watching(q_from + (q_target - q_from) * _smoothstep(k / n), watch)
+        s = np.arange(1, n + 1) / n
+        targets = q_from + np.outer(s * s * (3.0 - 2.0 * s), q_target - q_from)  # every tick's smoothstep at once
+        for q in targets:
+            self._tick_watching(q, watch)
+
+    def _hold(self, duration: float, watch: dict) -> None:
+        """Keep the current targets for ``duration`` [s], watching for the first touch (:meth:`_tick_watching`)."""
+        for _ in range(max(1, round(duration / CONTROL_DT))):
+            self._tick_watching(None, watch)
 
     def grasp(self, plan: GraspPlan) -> GraspOutcome:
         """Reach above the object with the open hand, descend, close the hand on a ramp, lift, hold, carry the
@@ -311,9 +315,9 @@ class MotionExecutor:
         # Close from where the arm stands (short of the grasp pose if something stopped it), the fingers on a ramp.
         q_arm = physics.joint_targets()
         self._ramp(with_hand(q_arm, plan.hand_closed), plan.close_time, watch)
-        self._ramp(with_hand(q_arm, plan.hand_closed), GRASP_SQUEEZE_TIME, watch)
+        self._hold(GRASP_SQUEEZE_TIME, watch)
         self._ramp(with_hand(q_lift, plan.hand_closed), GRASP_LIFT_TIME, watch)
-        self._ramp(with_hand(q_lift, plan.hand_closed), plan.hold_time, watch)
+        self._hold(plan.hold_time, watch)
         rise = float(physics.object_pose()[2]) - z_start
         holding = tuple(sorted(physics.links_touching_object()))
         on_table = physics.object_touches_table()
