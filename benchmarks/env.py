@@ -44,7 +44,7 @@ def main() -> None:
 
     # Time MuJoCo's own calls in place (the env's code runs unchanged, its monitor included).
     original = {"mj_step": mujoco.mj_step, "mj_multiRay": mujoco.mj_multiRay}
-    taken = [0]  # physics steps as taken, not simulated time over the timestep: the grasp holds at a longer one
+    taken = [0]  # physics steps as taken, not simulated time over the timestep: the grasp carries at a longer one
 
     def counted_step(model, data, nstep=1):
         taken[0] += nstep

@@ -19,7 +19,7 @@ from affordance_env.behaviors import (
     plan_grasp,
 )
 from affordance_env.kinematics import Kinematics
-from affordance_env.motion import GRASP_HOLD_TIMESTEP
+from affordance_env.motion import GRASP_CARRY_TIMESTEP, GRASP_LIFT_TIME, GRASP_PLACE_TIME
 from affordance_env.objects import object_geometry
 from affordance_env.robot_model import HAND_COUPLINGS, HAND_OPEN, coupled_position
 from affordance_env.scene import GRASP_TIMESTEP, home_qpos
@@ -157,7 +157,7 @@ def test_a_small_sphere_is_lifted_held_and_put_down_beside(grasp_env):
 
 
 @pytest.mark.slow
-def test_the_hold_alone_is_simulated_at_its_own_timestep(grasp_env):
+def test_the_carry_alone_is_simulated_at_its_own_timestep(grasp_env):
     physics = grasp_env.physics
     steps = []  # (timestep, time) after every step call
 
@@ -165,12 +165,15 @@ def test_the_hold_alone_is_simulated_at_its_own_timestep(grasp_env):
         steps.append((p.model.opt.timestep, p.data.time))
 
     assert _grasp(grasp_env, "sphere", 0.045, on_step=watch)[4]["success"]
-    assert GRASP_HOLD_TIMESTEP != GRASP_TIMESTEP and {dt for dt, _ in steps} == {GRASP_TIMESTEP, GRASP_HOLD_TIMESTEP}
-    held = [t for dt, t in steps if dt == GRASP_HOLD_TIMESTEP]
-    assert held[-1] - held[0] == pytest.approx(1.0 - 0.01)  # the 1 s hold, one control tick after another
+    assert GRASP_CARRY_TIMESTEP != GRASP_TIMESTEP
+    assert {dt for dt, _ in steps} == {GRASP_TIMESTEP, GRASP_CARRY_TIMESTEP}
+    carried = [t for dt, t in steps if dt == GRASP_CARRY_TIMESTEP]
+    # the lift, the 1 s hold and the carry down, one control tick after another
+    assert carried[-1] - carried[0] == pytest.approx(GRASP_LIFT_TIME + 1.0 + GRASP_PLACE_TIME - 0.01)
     assert physics.model.opt.timestep == GRASP_TIMESTEP and grasp_env.motion.steps_per_tick == 2  # restored
     with pytest.raises(ValueError, match="divide the control period"):
-        grasp_env.motion._hold(0.1, {"contact": True}, timestep=0.003)
+        with grasp_env.motion._stepping(0.003):
+            pass
 
 
 @pytest.mark.slow
