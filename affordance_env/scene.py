@@ -88,12 +88,11 @@ HAND_KP, HAND_DAMPING, HAND_ARMATURE = 1.0, 0.03, 1e-3
 #: and its fastest dynamics are resolved at 5 ms with at least 2 steps per time constant (MuJoCo's stability
 #: bound) and mostly 4 or more: the contacts' (MuJoCo's default 20 ms), the finger coupling's (10 ms, below), the
 #: finger servos' (sqrt(armature / kp) = 32 ms) and the arm servos' (25 ms and more). Over the 90 canonical
-#: grasps of ``benchmarks/grasp.py`` (seeds 0-89) the share held per third of sizes is 97, 63 and 7 % at 5 ms
-#: against 100, 53 and 7 % at 2 ms; 84 of the 90 end the same (at 2.5 ms, 88 end as at 2 ms): the others are
-#: pushed objects whose fate, like that of a tapped ball at the table's edge, turns on small differences. A step
-#: of the grasp, with its many contacts on a 30-degree-of-freedom robot, costs some 50 microseconds, so at 2 ms
-#: a grasp costs three to four taps, and at 5 ms about 1.6 (``benchmarks/env.py --behavior tap grasp``). It
-#: divides the 10 ms control tick.
+#: grasps of ``benchmarks/grasp.py`` (seeds 0-89) the share held per third of sizes is 100, 53 and 7 % at 5 ms as
+#: at 2 ms, and every one of the 90 ends the same, held or not, at 2, 2.5 and 5 ms (``--timestep``). While the hand
+#: carries the object it has grasped, the two move as one and the grasp steps at 10 ms (``motion.GRASP_CARRY_TIMESTEP``
+#: says why): a grasp takes 667 steps, 2065 at 2 ms, and costs about 1.7 taps on one core
+#: (``benchmarks/env.py --behavior tap grasp``). It divides the 10 ms control tick.
 GRASP_TIMESTEP = 0.005
 #: Coupling of the distal finger joints to their proximal joints (MuJoCo ``equality joint``): the linkage is
 #: stiff, so the constraint is solved with a time constant of 10 ms (2 timesteps of the grasp variant, MuJoCo's
