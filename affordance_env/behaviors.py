@@ -306,8 +306,8 @@ def plan_stroke(
 #: fingers (x) and towards the little finger (y). The opposed thumb hangs under the palm, 4 cm to the thumb side
 #: (-y), and the fingers curl in from 10 cm out, pushing the object back towards the thumb: 3 cm out and 2.5 cm
 #: to the thumb side the object lies between the thumb and the index and middle fingers. Over the 90 canonical
-#: grasps of ``benchmarks/grasp.py`` (97, 63 and 7 % held per third of sizes), this point moved by 5 mm along
-#: either axis holds 100 % of the smallest third and 7 % of the largest, and 47-80 % of the middle one: it sets
+#: grasps of ``benchmarks/grasp.py`` (100, 53 and 7 % held per third of sizes), this point moved by 5 mm along
+#: either axis holds 93-100 % of the smallest third, 47-80 % of the middle one and 7-13 % of the largest: it sets
 #: where in the middle third the critical size falls.
 GRASP_CENTRE_HAND = (0.03, -0.025)
 #: Gap between the palm and the object's top when the hand closes [m], and the change action[0] = +-1 makes.

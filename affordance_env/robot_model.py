@@ -131,8 +131,11 @@ def coupled_position(distal: str, q_proximal: float | np.ndarray) -> float | np.
     """Angle [rad] of the coupled ``distal`` joint when its proximal joint is at ``q_proximal`` [rad]."""
     if distal not in HAND_COUPLINGS:
         raise ValueError(f"{distal!r} is not a coupled joint. Coupled joints: {', '.join(HAND_COUPLINGS)}.")
-    coefficients = HAND_COUPLINGS[distal][1]
-    return sum(c * np.asarray(q_proximal) ** i for i, c in enumerate(coefficients))
+    q = q_proximal if isinstance(q_proximal, np.ndarray) else float(q_proximal)  # a scalar as a float: fast
+    angle = 0.0
+    for c in reversed(HAND_COUPLINGS[distal][1]):  # Horner's scheme
+        angle = angle * q + c
+    return angle
 
 
 @dataclass(frozen=True)

@@ -7,6 +7,8 @@ and ``"grasp"``, the left arm with the fingered ``left_hand_mk3`` hand (:func:`h
 
 from __future__ import annotations
 
+import functools
+
 import mujoco
 import numpy as np
 
@@ -15,6 +17,7 @@ from affordance_env.robot_model import (
     CAMERA_VISIBLE_LINKS,  # noqa: F401 (the tap variant's, named here beside the geom groups as before)
     HAND_COUPLINGS,
     HAND_JOINTS,
+    HAND_LINKS,
     HAND_MOUNT_FRAME,
     HAND_MOUNT_POS,
     HAND_OPEN,
@@ -52,6 +55,18 @@ FINGER_FRICTION = (1.0, 0.0033, 0.0001)
 #: Contact dimensionality of the fingered hand: 4, sliding and torsional friction, the "soft finger" contact
 #: model of grasping (a pad resists a held object's spin about the contact normal).
 FINGER_CONDIM = 4
+#: Links of the fingered hand that collide through a capsule fitted to their mesh (:func:`phalanx_capsules`) instead
+#: of through the mesh's convex hull: the phalanges, the medial and distal links of the index, middle and little
+#: fingers and of the thumb. Each is a rounded bar, 26-45 mm long, 16-19 mm thick across its pad and 16-18 mm wide:
+#: a capsule along its length whose radius is half its thickness puts the gripping surface, and the rounded tip,
+#: where the mesh has them. Its contacts are cheaper to compute, and one capsule touches a face with one or two
+#: contacts where a hull gave two to four. The palm, the index finger's knuckle link and the thumb's metacarpus and
+#: proximal link are blocks, not bars, and keep their hulls.
+PHALANX_LINKS: tuple[str, ...] = tuple(link for link in HAND_LINKS
+                                       if link.endswith(("_medial_link", "_fingertip_link")))
+#: Geom group of the phalanges' capsules, which only collide: neither the range camera nor the renderer sees them;
+#: both see the link's mesh, kept as a geom that collides with nothing.
+COLLISION_GEOM_GROUP = 3
 
 #: Position-servo stiffness per joint group [N m / rad].
 SERVO_KP: dict[str, float] = {"torso": 300.0, "neck": 50.0, "arm": 60.0, "wrist": 10.0}
@@ -73,12 +88,11 @@ HAND_KP, HAND_DAMPING, HAND_ARMATURE = 1.0, 0.03, 1e-3
 #: and its fastest dynamics are resolved at 5 ms with at least 2 steps per time constant (MuJoCo's stability
 #: bound) and mostly 4 or more: the contacts' (MuJoCo's default 20 ms), the finger coupling's (10 ms, below), the
 #: finger servos' (sqrt(armature / kp) = 32 ms) and the arm servos' (25 ms and more). Over the 90 canonical
-#: grasps of ``benchmarks/grasp.py`` (seeds 0-89) the share held per third of sizes is 97, 63 and 7 % at 5 ms
-#: against 100, 53 and 7 % at 2 ms; 84 of the 90 end the same (at 2.5 ms, 88 end as at 2 ms): the others are
-#: pushed objects whose fate, like that of a tapped ball at the table's edge, turns on small differences. A step
-#: of the grasp, with its many contacts on a 30-degree-of-freedom robot, costs some 50 microseconds, so at 2 ms
-#: a grasp costs three to four taps, and at 5 ms about 1.6 (``benchmarks/env.py --behavior tap grasp``). It
-#: divides the 10 ms control tick.
+#: grasps of ``benchmarks/grasp.py`` (seeds 0-89) the share held per third of sizes is 100, 53 and 7 % at 5 ms as
+#: at 2 ms, and every one of the 90 ends the same, held or not, at 2, 2.5 and 5 ms (``--timestep``). While the hand
+#: carries the object it has grasped, the two move as one and the grasp steps at 10 ms (``motion.GRASP_CARRY_TIMESTEP``
+#: says why): a grasp takes 667 steps, 2065 at 2 ms, and costs about 1.7 taps on one core
+#: (``benchmarks/env.py --behavior tap grasp``). It divides the 10 ms control tick.
 GRASP_TIMESTEP = 0.005
 #: Coupling of the distal finger joints to their proximal joints (MuJoCo ``equality joint``): the linkage is
 #: stiff, so the constraint is solved with a time constant of 10 ms (2 timesteps of the grasp variant, MuJoCo's
@@ -174,6 +188,38 @@ def hand_inertias() -> dict[str, list[float]]:
     return tensors
 
 
+@functools.cache
+def phalanx_capsules() -> dict[str, tuple[tuple[float, float, float], float, float]]:
+    """The collision capsule of each link in PHALANX_LINKS, fitted to the link's mesh.
+
+    A phalanx's link frame has x along its length and y along its joints' axes, so z is across its pad. The capsule
+    lies along x through the centre of the mesh's bounding box (in the link frame); its radius is half the box's
+    z extent, the phalanx's thickness, and its rounded ends touch the box's ends. Returns
+    ``{link: (centre [m] (3,), half-length of the axis segment [m], radius [m])}``.
+    """
+    spec = mujoco.MjSpec.from_string(hand_urdf())
+    spec.compiler.fusestatic = False
+    model = spec.compile()
+    capsules = {}
+    for link in PHALANX_LINKS:
+        body = model.body(link).id
+        vertices = []
+        for g in np.flatnonzero(model.geom_bodyid == body):
+            mesh = model.geom_dataid[g]
+            R = np.empty(9)
+            mujoco.mju_quat2Mat(R, model.geom_quat[g])
+            start, count = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
+            vertices.append(model.mesh_vert[start : start + count] @ R.reshape(3, 3).T + model.geom_pos[g])
+        p_link_vertices = np.vstack(vertices)
+        low, high = p_link_vertices.min(axis=0), p_link_vertices.max(axis=0)
+        extent = high - low
+        if np.argmax(extent) != 0:
+            raise ValueError(f"{link} is expected to be longest along its x axis; its mesh extends {extent} m.")
+        radius = float(extent[2] / 2)
+        capsules[link] = (tuple(float(c) for c in (low + high) / 2), float(extent[0] / 2 - radius), radius)
+    return capsules
+
+
 def _contact_geom(geom: mujoco.MjsGeom) -> None:
     geom.contype = ROBOT_CONTYPE
     geom.conaffinity = ROBOT_CONAFFINITY
@@ -184,6 +230,7 @@ def hand_spec() -> mujoco.MjSpec:
     """The ``left_hand_mk3`` hand as MuJoCo reads its URDF, made simulable (see ``assets/README.md``)."""
     spec = mujoco.MjSpec.from_string(hand_urdf())
     inertias = hand_inertias()
+    capsules = phalanx_capsules()
     for body in spec.bodies:
         if body.name == "world":
             continue
@@ -191,13 +238,24 @@ def hand_spec() -> mujoco.MjSpec:
         if body.name in inertias:
             body.fullinertia = inertias[body.name]
         body.gravcomp = 1.0
-        for i, geom in enumerate(body.geoms):
+        geoms = list(body.geoms)
+        if body.name in capsules:  # the mesh is only seen; a capsule collides in its place
+            for i, geom in enumerate(geoms):
+                geom.name = f"{body.name}_visual" + (f"_{i}" if i else "")
+                geom.contype = geom.conaffinity = 0
+                geom.group = SEEN_ROBOT_GEOM_GROUP
+            centre, half_length, radius = capsules[body.name]
+            capsule = body.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, pos=list(centre), size=[radius, half_length, 0],
+                                    quat=[np.sqrt(0.5), 0.0, np.sqrt(0.5), 0.0])  # the capsule's z along the link's x
+            geoms = [capsule]
+        for i, geom in enumerate(geoms):
             geom.name = f"{body.name}_collision" + (f"_{i}" if i else "")
             # Contact bits as the tap's hand: the hand touches objects and the table, never itself.
             _contact_geom(geom)
             geom.friction = list(FINGER_FRICTION)
             geom.condim = FINGER_CONDIM
-            geom.group = SEEN_ROBOT_GEOM_GROUP
+            geom.group = COLLISION_GEOM_GROUP if body.name in capsules else SEEN_ROBOT_GEOM_GROUP
+        for geom in body.geoms:
             geom.rgba = [0.75, 0.75, 0.78, 1.0] if body.name == HAND_ROOT_LINK else [0.35, 0.35, 0.38, 1.0]
     for joint in spec.joints:
         joint.damping = [HAND_DAMPING, 0.0, 0.0]

@@ -19,9 +19,10 @@ from affordance_env.behaviors import (
     plan_grasp,
 )
 from affordance_env.kinematics import Kinematics
+from affordance_env.motion import GRASP_CARRY_TIMESTEP, GRASP_LIFT_TIME, GRASP_PLACE_TIME
 from affordance_env.objects import object_geometry
 from affordance_env.robot_model import HAND_COUPLINGS, HAND_OPEN, coupled_position
-from affordance_env.scene import home_qpos
+from affordance_env.scene import GRASP_TIMESTEP, home_qpos
 from affordance_env.tap_env import PLACEMENT_CENTRE, PLACEMENT_HALF_WIDTH, YAW_JITTER, TapAffordanceEnv
 
 TABLE = -0.07
@@ -153,6 +154,26 @@ def test_a_small_sphere_is_lifted_held_and_put_down_beside(grasp_env):
     assert abs(final[2] - initial[2]) < 0.005 and info["outcome"] == "rest" and info["visible"]
     assert obs["mask"].any() and terminated
     assert obs["joints"].shape == (24,)
+
+
+@pytest.mark.slow
+def test_the_carry_alone_is_simulated_at_its_own_timestep(grasp_env):
+    physics = grasp_env.physics
+    steps = []  # (timestep, time) after every step call
+
+    def watch(p):
+        steps.append((p.model.opt.timestep, p.data.time))
+
+    assert _grasp(grasp_env, "sphere", 0.045, on_step=watch)[4]["success"]
+    assert GRASP_CARRY_TIMESTEP != GRASP_TIMESTEP
+    assert {dt for dt, _ in steps} == {GRASP_TIMESTEP, GRASP_CARRY_TIMESTEP}
+    carried = [t for dt, t in steps if dt == GRASP_CARRY_TIMESTEP]
+    # the lift, the 1 s hold and the carry down, one control tick after another
+    assert carried[-1] - carried[0] == pytest.approx(GRASP_LIFT_TIME + 1.0 + GRASP_PLACE_TIME - 0.01)
+    assert physics.model.opt.timestep == GRASP_TIMESTEP and grasp_env.motion.steps_per_tick == 2  # restored
+    with pytest.raises(ValueError, match="divide the control period"):
+        with grasp_env.motion._stepping(0.003):
+            pass
 
 
 @pytest.mark.slow

@@ -17,7 +17,7 @@ from affordance_env.robot_model import (
     coupled_position,
     get_variant,
 )
-from affordance_env.scene import SEEN_ROBOT_GEOM_GROUP, build_model, home_qpos, robot_spec
+from affordance_env.scene import PHALANX_LINKS, SEEN_ROBOT_GEOM_GROUP, build_model, home_qpos, robot_spec
 
 GRASP = get_variant("grasp")
 
@@ -100,11 +100,43 @@ def test_collisions_hand_touches_world_never_itself(grasp_model):
         assert not _touch(model, g, table) and not _touch(model, g, sphere), body[g]
     fingertip = model.geom("l_hand_index_fingertip_link_collision").id
     assert model.geom_friction[fingertip][0] == pytest.approx(1.0) and model.geom_priority[fingertip] == 1
-    # the left arm from the upper arm down is what the range camera casts; the right arm is not
-    for g in robot:
+    # a phalanx collides through its capsule, and its mesh is only seen
+    visual = [g for g in range(model.ngeom) if "_visual" in model.geom(g).name]
+    link.update({g: model.geom(g).name.split("_visual")[0] for g in visual})
+    assert {link[g] for g in visual} == set(PHALANX_LINKS)
+    for g in visual:
+        assert not _touch(model, g, table) and not _touch(model, g, sphere), link[g]
+    # the left arm from the upper arm down is what the range camera casts (a phalanx: its mesh); the right arm is not
+    for g in robot + visual:
         seen = model.geom_group[g] == SEEN_ROBOT_GEOM_GROUP
-        assert seen == (link[g] in GRASP.camera_visible_links or link[g] in HAND_LINKS), link[g]
+        visible = link[g] in GRASP.camera_visible_links or link[g] in HAND_LINKS
+        assert seen == (visible and not (g in robot and link[g] in PHALANX_LINKS)), model.geom(g).name
     assert not any(link[g].startswith("r_") and model.geom_group[g] == SEEN_ROBOT_GEOM_GROUP for g in robot)
+
+
+def test_phalanges_collide_through_capsules_that_span_their_meshes(grasp_model):
+    model = grasp_model
+    for phalanx in PHALANX_LINKS:
+        mesh, capsule = model.geom(f"{phalanx}_visual").id, model.geom(f"{phalanx}_collision").id
+        assert model.geom_type[mesh] == mujoco.mjtGeom.mjGEOM_MESH
+        assert model.geom_type[capsule] == mujoco.mjtGeom.mjGEOM_CAPSULE
+        R_link_mesh, R_link_capsule = np.empty(9), np.empty(9)
+        mujoco.mju_quat2Mat(R_link_mesh, model.geom_quat[mesh])
+        mujoco.mju_quat2Mat(R_link_capsule, model.geom_quat[capsule])
+        start, count = model.mesh_vertadr[model.geom_dataid[mesh]], model.mesh_vertnum[model.geom_dataid[mesh]]
+        p_link_mesh = model.mesh_vert[start : start + count] @ R_link_mesh.reshape(3, 3).T + model.geom_pos[mesh]
+        radius, half_length = model.geom_size[capsule][:2]
+        axis = R_link_capsule.reshape(3, 3)[:, 2]
+        np.testing.assert_allclose(np.abs(axis), [1, 0, 0], atol=1e-12)  # along the phalanx, the link's x
+        centre = model.geom_pos[capsule]
+        capsule_low = centre - [half_length + radius, radius, radius]
+        capsule_high = centre + [half_length + radius, radius, radius]
+        # its ends where the mesh's are, and its surface across the pad (z) where the mesh's is
+        np.testing.assert_allclose(capsule_low[[0, 2]], p_link_mesh.min(axis=0)[[0, 2]], atol=1e-9)
+        np.testing.assert_allclose(capsule_high[[0, 2]], p_link_mesh.max(axis=0)[[0, 2]], atol=1e-9)
+        # and as wide as the mesh within 1.5 mm (a phalanx is 16-18 mm wide and 16-19 mm thick)
+        width = p_link_mesh.max(axis=0)[1] - p_link_mesh.min(axis=0)[1]
+        assert abs(2 * radius - width) < 3e-3, phalanx
 
 
 def test_couplings_name_the_real_joints(grasp_model):
