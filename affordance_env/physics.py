@@ -102,7 +102,7 @@ class TapPhysics:
         # Views into the data, made once: a control tick reads and writes them without building new arrays.
         data = self.data
         self._ctrl_view = data.ctrl[self._act] if isinstance(self._act, slice) else None
-        self._qvel_view = data.qvel[self._qvel]
+        self._qvel_view = data.qvel[self._qvel] if isinstance(self._qvel, slice) else None  # (an index array copies)
         self._object_p = data.qpos[self.object_qpos : self.object_qpos + 3]
         self._object_v = data.qvel[self.object_qvel : self.object_qvel + 3]
         self._object_w = data.cvel[self.object_body, :3]
@@ -143,6 +143,8 @@ class TapPhysics:
 
     def joint_velocities(self) -> np.ndarray:
         """Robot joint velocities in active-joint order [rad/s]."""
+        if self._qvel_view is None:
+            return self.data.qvel[self._qvel]
         return self._qvel_view.copy()
 
     def set_joint_targets(self, q: np.ndarray) -> None:

@@ -160,3 +160,19 @@ def test_unknown_object_type_lists_valid_choices(bad):
 def test_non_positive_or_non_finite_size_is_refused(bad):
     with pytest.raises(ValueError, match="size"):
         object_geometry("box", bad)
+
+
+@pytest.mark.parametrize("variant", ["tap", "grasp"])
+def test_joint_queries_follow_the_simulation_in_every_variant(variant):
+    # The robot's joint positions, velocities and targets are read from the live state at every call, whatever
+    # the layout of the variant's joints in MuJoCo's arrays (the grasp's are not one run of indices).
+    physics = TapPhysics(build_model(variant), variant)
+    physics.reset_home()
+    q = physics.joint_targets()
+    q[: len(q) // 2] += 0.2
+    physics.set_joint_targets(q)
+    for _ in range(3):
+        physics.step(5)
+        np.testing.assert_array_equal(physics.joint_velocities(), physics.data.qvel[physics.robot_qvel])
+        np.testing.assert_array_equal(physics.joint_positions(), physics.data.qpos[physics.robot_qpos])
+    assert np.abs(physics.joint_velocities()).max() > 0.1  # the robot moves
