@@ -109,7 +109,8 @@ class TapAffordanceEnv(gym.Env):
     Only the fingers' servos move the object (no welds, no applied forces). Whether the object fits the open hand,
     between the thumb and the fingertips, decides the outcome: with the default sizes about half the canonical
     grasps hold (``info["success"]``), nearly all under 6.4 cm and few over 8.2 cm (``benchmarks/grasp.py``).
-    The grasp variant of the scene integrates at 5 ms instead of 2 (``affordance_env.scene.GRASP_TIMESTEP``).
+    The grasp variant of the scene integrates at 5 ms instead of 2 (``affordance_env.scene.GRASP_TIMESTEP``), and
+    at 10 ms while the closed hand lifts, holds and carries the object (``affordance_env.motion.GRASP_CARRY_TIMESTEP``).
 
     The world: a 60 x 100 cm wooden lab table whose top is what objects rest on and roll on (rolling resistance of
     wood on wood, see ``assets/README.md``); past its edges an object falls to the floor. The range camera in the
