@@ -150,7 +150,11 @@ class MotionExecutor:
     def __init__(self, physics: TapPhysics, kinematics: Kinematics) -> None:
         self.physics = physics
         self.kinematics = kinematics
-        self.steps_per_tick = max(1, round(CONTROL_DT / physics.model.opt.timestep))
+
+    @property
+    def steps_per_tick(self) -> int:
+        """Physics steps per control tick at the model's current timestep."""
+        return max(1, round(CONTROL_DT / self.physics.model.opt.timestep))
 
     def _tick(self, q: np.ndarray) -> None:
         self.physics.set_joint_targets(q)
@@ -320,13 +324,12 @@ class MotionExecutor:
         steps = round(CONTROL_DT / timestep)
         if not (timestep > 0 and abs(steps * timestep - CONTROL_DT) < 1e-12):
             raise ValueError(f"timestep must divide the control period {CONTROL_DT} s, got {timestep!r}.")
-        model = self.physics.model
-        saved = model.opt.timestep, self.steps_per_tick
-        model.opt.timestep, self.steps_per_tick = timestep, steps
+        opt = self.physics.model.opt
+        saved, opt.timestep = opt.timestep, timestep
         try:
             yield
         finally:
-            model.opt.timestep, self.steps_per_tick = saved
+            opt.timestep = saved
 
     def grasp(self, plan: GraspPlan) -> GraspOutcome:
         """Reach above the object with the open hand, descend, close the hand on a ramp, lift, hold, carry the

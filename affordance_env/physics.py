@@ -102,7 +102,6 @@ class TapPhysics:
         # Views into the data, made once: a control tick reads and writes them without building new arrays.
         data = self.data
         self._ctrl_view = data.ctrl[self._act] if isinstance(self._act, slice) else None
-        self._qvel_view = data.qvel[self._qvel] if isinstance(self._qvel, slice) else None  # (an index array copies)
         self._object_p = data.qpos[self.object_qpos : self.object_qpos + 3]
         self._object_v = data.qvel[self.object_qvel : self.object_qvel + 3]
         self._object_w = data.cvel[self.object_body, :3]
@@ -143,9 +142,7 @@ class TapPhysics:
 
     def joint_velocities(self) -> np.ndarray:
         """Robot joint velocities in active-joint order [rad/s]."""
-        if self._qvel_view is None:
-            return self.data.qvel[self._qvel]
-        return self._qvel_view.copy()
+        return self.data.qvel[self._qvel].copy()
 
     def set_joint_targets(self, q: np.ndarray) -> None:
         """Command the position servos to ``q`` [rad] (active-joint order), clipped to the joint ranges; the values
@@ -159,21 +156,18 @@ class TapPhysics:
         np.minimum(np.maximum(q, self.ctrl_low, out=self._ctrl), self.ctrl_high, out=self._ctrl)
         self.data.ctrl[self._act] = self._ctrl
 
-    def inertial_lead(self, qdd: np.ndarray) -> np.ndarray:
+    def inertial_lead(self, qdd: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Servo target offsets [rad] whose spring torques accelerate the robot's joints at ``qdd`` [rad/s^2]
         (active-joint order) in the current configuration: M qdd / kp (acceleration feedforward; 0 for coupled
-        joints, which have no servo)."""
+        joints, which have no servo), into ``out`` if given."""
         self._qacc[self._qvel] = qdd
         mujoco.mj_mulM(self.model, self.data, self._torque, self._qacc)
-        return self._torque[self._qvel] / self.servo_kp
+        return np.divide(self._torque[self._qvel], self.servo_kp, out=out)
 
     def step_toward(self, q: np.ndarray, qdd: np.ndarray, n: int) -> None:
         """One control tick: :meth:`set_joint_targets` to ``q`` plus :meth:`inertial_lead` of ``qdd``, then
         :meth:`step` ``n`` times (the same as those three calls, with less Python between the steps)."""
-        lead = self._lead
-        self._qacc[self._qvel] = qdd
-        mujoco.mj_mulM(self.model, self.data, self._torque, self._qacc)
-        np.divide(self._torque[self._qvel], self.servo_kp, out=lead)
+        lead = self.inertial_lead(qdd, out=self._lead)
         np.add(q, lead, out=lead)
         self.set_joint_targets(lead)
         self.step(n)
