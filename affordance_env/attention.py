@@ -41,7 +41,7 @@ class AttentionResult:
 
 
 def _centroid(camera: RangeCamera, physics: TapPhysics) -> tuple[np.ndarray, np.ndarray] | None:
-    image = camera.capture(physics.data, occluded=physics.active_geom)
+    image = camera.capture(physics.data, occluded=physics.active_geom, window=True)  # only where it may be
     mask = image.mask_of(physics.active_geom)
     if not mask.any():
         return None

@@ -215,3 +215,46 @@ def test_a_support_that_is_not_an_axis_aligned_box_is_refused(wall):
         RangeCamera(model, "cam", width=8, height=8, support="ball")
     with pytest.raises(ValueError, match="no geom named 'table'"):
         RangeCamera(model, "cam", width=8, height=8, support="table")
+
+
+def test_a_window_capture_sees_the_object_as_the_whole_image_does():
+    # Attention looks only inside the object's image rectangle: its mask, ranges and points must be those of the
+    # whole image, with the arm in front of the object, the object rolling and fallen, and nothing hit elsewhere.
+    env = TapAffordanceEnv(camera_width=80, camera_height=60)
+    geom = env.physics.active_geom
+    interactions = [({"object_type": "box"}, np.zeros(3)), ({"object_type": "sphere"}, np.array([1.0, -1.0, 0.5])),
+                    ({"object_type": "vertical_cylinder", "size": 0.08}, np.array([0.0, 0.0, 1.0]))]
+    states = _images_along_interactions(env, interactions)
+    data = env.physics.data
+    seen = 0
+    for qpos, qvel in states:
+        data.qpos[:], data.qvel[:] = qpos, qvel
+        mujoco.mj_forward(env.physics.model, data)
+        geom = env.physics.active_geom
+        whole = env.camera.capture(data, occluded=geom)
+        window = env.camera.capture(data, occluded=geom, window=True)
+        mask = whole.mask_of(geom)
+        np.testing.assert_array_equal(window.mask_of(geom), mask)
+        np.testing.assert_array_equal(window.ranges[mask], whole.ranges[mask])
+        np.testing.assert_array_equal(window.p_world_points[mask], whole.p_world_points[mask])
+        rectangle = np.zeros(mask.shape, bool)
+        rectangle.flat[env.camera._rays_near(np.array([geom]), data, *env.camera.pose(data))] = True
+        assert mask[~rectangle].sum() == 0 and np.all(window.geom_ids[~rectangle] == -1)  # nothing cast outside
+        assert np.all(window.geom_ids[rectangle] == whole.geom_ids[rectangle])
+        seen += mask.sum() > 0
+    assert seen > 0.5 * len(states)
+    with pytest.raises(ValueError, match="give occluded"):
+        env.camera.capture(data, window=True)
+
+
+def test_the_rays_cast_for_a_ball_are_about_its_silhouette():
+    # The object's rays are those inside both its box's image rectangle and its bounding sphere's cone: for a
+    # ball, about its silhouette, where the rectangle of its bounding cube holds twice as many.
+    env = TapAffordanceEnv()
+    env.reset(seed=0, options={"object_type": "sphere", "size": 0.08})
+    data, geom = env.physics.data, env.physics.active_geom
+    rays = env.camera._rays_near(np.array([geom]), data, *env.camera.pose(data))
+    mask = env.camera.capture(data, occluded=geom).mask_of(geom)
+    assert set(np.flatnonzero(mask).tolist()) <= set(rays.tolist())
+    ((_, u0, u1, v0, v1),) = env.camera._rectangles(np.array([geom]), data, *env.camera.pose(data))
+    assert rays.size < 1.3 * mask.sum() and (u1 - u0) * (v1 - v0) > 1.6 * mask.sum()
