@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -19,9 +20,10 @@ from affordance_env.behaviors import (
     get_behavior,
     is_success,
     plan_grasp,
+    StrokePlan,
     plan_stroke,
 )
-from affordance_env.camera import RangeCamera
+from affordance_env.camera import Intrinsics, RangeCamera
 from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
 from affordance_env.kinematics import Kinematics
 from affordance_env.motion import (
@@ -241,22 +243,13 @@ class TapAffordanceEnv(gym.Env):
         render_width: int = 480,
         render_height: int = 360,
     ) -> None:
+        self.check_options(behavior=behavior, object_types=object_types, size_range=size_range,
+                           camera_width=camera_width, camera_height=camera_height, camera_fovy=camera_fovy,
+                           roll_threshold=roll_threshold, settle_timeout=settle_timeout, range_noise=range_noise,
+                           render_mode=render_mode)
         self.behavior = get_behavior(behavior)
-        if isinstance(object_types, str) or len(object_types) == 0:
-            raise ValueError(f"object_types must be a non-empty sequence of {OBJECT_TYPES}, got {object_types!r}.")
         self.object_types = tuple(check_object_type(t) for t in object_types)
-        low, high = (check_size(s) for s in size_range)
-        if low > high:
-            raise ValueError(f"size_range must be (low, high) with low <= high, got {size_range!r}.")
-        self.size_range = (low, high)
-        if not roll_threshold > 0:
-            raise ValueError(f"roll_threshold must be a positive distance [m], got {roll_threshold!r}.")
-        if not settle_timeout > 0:
-            raise ValueError(f"settle_timeout must be positive [s], got {settle_timeout!r}.")
-        if render_mode not in (None, *self.metadata["render_modes"]):
-            raise ValueError(
-                f"render_mode must be None or one of {self.metadata['render_modes']}, got {render_mode!r}."
-            )
+        self.size_range = (check_size(size_range[0]), check_size(size_range[1]))
         self.roll_threshold = float(roll_threshold)
         self.range_noise = check_range_noise(range_noise)
         self.settle_timeout = float(settle_timeout)
@@ -271,6 +264,9 @@ class TapAffordanceEnv(gym.Env):
                                   support="table_top")
         self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy,
                                             support="table_top")
+        if not isinstance(self.behavior, GraspBehavior):  # every approach's IK starts from one posture
+            self.physics.reset_home()
+            self.motion.set_approach_posture(self._nominal_plan())
         self._renderer = None
         self._render_size = (render_width, render_height)
         #: With a render mode: pictures taken every 1/render_fps s of simulated time since the last ``reset``
@@ -299,7 +295,42 @@ class TapAffordanceEnv(gym.Env):
         self._initial: dict[str, Any] | None = None
         self._q_home = np.zeros(nq)
 
+    @classmethod
+    def check_options(cls, **options: Any) -> None:
+        """Raise ValueError, naming the value and what was expected, for any of the constructor's options that it
+        would refuse; without building anything (a collection checks its options so before it starts workers)."""
+        try:
+            bound = inspect.signature(cls.__init__).bind(None, **options)
+        except TypeError as exc:
+            raise ValueError(f"Options of TapAffordance-v0: {exc}.") from None
+        bound.apply_defaults()
+        o = bound.arguments
+        get_behavior(o["behavior"])
+        if isinstance(o["object_types"], str) or len(o["object_types"]) == 0:
+            raise ValueError(f"object_types must be a non-empty sequence of {OBJECT_TYPES}, got "
+                             f"{o['object_types']!r}.")
+        for object_type in o["object_types"]:
+            check_object_type(object_type)
+        low, high = (check_size(s) for s in o["size_range"])
+        if low > high:
+            raise ValueError(f"size_range must be (low, high) with low <= high, got {o['size_range']!r}.")
+        Intrinsics.from_fovy(o["camera_width"], o["camera_height"], o["camera_fovy"])
+        if not o["roll_threshold"] > 0:
+            raise ValueError(f"roll_threshold must be a positive distance [m], got {o['roll_threshold']!r}.")
+        if not o["settle_timeout"] > 0:
+            raise ValueError(f"settle_timeout must be positive [s], got {o['settle_timeout']!r}.")
+        check_range_noise(o["range_noise"])
+        if o["render_mode"] not in (None, *cls.metadata["render_modes"]):
+            raise ValueError(f"render_mode must be None or one of {cls.metadata['render_modes']}, got "
+                             f"{o['render_mode']!r}.")
+
     # ------------------------------------------------------------------------------------------------------
+    def _nominal_plan(self) -> StrokePlan:
+        """The canonical stroke of a sphere of the middle size at the centre of the placement region."""
+        geometry = object_geometry("sphere", float(np.mean(self.size_range)))
+        centre = np.array([*PLACEMENT_CENTRE, self.physics.table_top + geometry.half_height])
+        return plan_stroke(self.behavior, geometry, centre, 0.0, self.physics.table_top, np.zeros(ACTION_DIM))
+
     def _blank_observation(self) -> dict[str, np.ndarray]:
         space = self.observation_space
         return {
