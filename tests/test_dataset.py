@@ -138,6 +138,8 @@ def test_bad_arguments_are_clear_errors(tmp_path):
         collect(tmp_path / "d", 2, scheduler="ray")
     with pytest.raises(ValueError, match="Unknown object type"):
         collect(tmp_path / "d", 2, env_options={**SMALL, "object_types": ["cube"]})
+    with pytest.raises(ValueError, match="camera resolution"):  # checked here, before any worker starts
+        collect(tmp_path / "d", 2, workers=2, env_options={**SMALL, "camera_width": 1})
     assert not (tmp_path / "d").exists()
 
 

@@ -84,14 +84,6 @@ def _worker_env(options_json: str):
     return envs[options_json]
 
 
-def _drop_worker_env(options_json: str) -> None:
-    """Forget an env whose state may be broken (it raised); the next interaction builds a fresh one."""
-    env = _worker.__dict__.get("envs", {}).pop(options_json, None)
-    if env is not None:
-        with contextlib.suppress(Exception):
-            env.close()
-
-
 def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) -> tuple[int, int, dict]:
     """Run interactions ``start .. stop-1``, write them as chunk ``index``; returns (index, n, failures)."""
     from affordance_env import __version__
@@ -222,9 +214,12 @@ def collect(
         scheduler = "dask"
     options = _full_options(dict(env_options or {}))
     options_json = json.dumps(options, sort_keys=True)
-    _worker_env(options_json)  # bad options fail here, clearly, before any work
-    if not (scheduler == "joblib" and workers == 1):
-        _drop_worker_env(options_json)  # the workers build their own
+    if scheduler == "joblib" and workers == 1:
+        _worker_env(options_json)  # bad options fail here, clearly, before any work; this process collects
+    else:  # the workers build their own envs: check the options without building one here
+        from affordance_env.tap_env import TapAffordanceEnv
+
+        TapAffordanceEnv.check_options(**options)
     header = dataset_header(seed, action, chunk_size, options, save_images)
     out, episodes = Path(out), int(episodes)
 
