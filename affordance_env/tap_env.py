@@ -16,11 +16,11 @@ from affordance_env.behaviors import (
     BEHAVIORS,
     ROLL_THRESHOLD,
     GraspBehavior,
+    StrokePlan,
     check_action,
     get_behavior,
     is_success,
     plan_grasp,
-    StrokePlan,
     plan_stroke,
 )
 from affordance_env.camera import Intrinsics, RangeCamera

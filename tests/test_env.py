@@ -7,9 +7,9 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import affordance_env
+import affordance_env.tap_env as tap_env_module
 from affordance_env.features import FEATURE_NAMES, effect_features
 from affordance_env.range_noise import kinect_axial_sigma
-import affordance_env.tap_env as tap_env_module
 from affordance_env.tap_env import TapAffordanceEnv
 
 
