@@ -281,12 +281,13 @@ class MotionExecutor:
         dt = physics.model.opt.timestep
         stopped = False
         palm = physics.data.site_xpos[physics.palm_site]  # a view: the palm position after each step
+        steps_per_tick = self.steps_per_tick  # the timestep does not change during the stroke
         for i in range(len(line)):
             physics.set_joint_targets(line.target(i))
             if not contact and physics.hand_object_distance(CONTACT_WATCH_DISTANCE) >= CONTACT_WATCH_DISTANCE:
-                physics.step(self.steps_per_tick)  # the same steps, without a check after each
+                physics.step(steps_per_tick)  # the same steps, without a check after each
                 continue
-            for _ in range(self.steps_per_tick):
+            for _ in range(steps_per_tick):
                 if not contact:
                     p_before = palm.copy()
                     physics.step()

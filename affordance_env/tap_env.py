@@ -432,6 +432,7 @@ class TapAffordanceEnv(gym.Env):
         """
         physics = self.physics
         t_end = since + self.settle_timeout
+        steps_per_tick = self.motion.steps_per_tick
         while True:
             if monitor.left_table:
                 return "off_table", monitor.exit_time - since
@@ -439,7 +440,7 @@ class TapAffordanceEnv(gym.Env):
                 return "rest", max(monitor.still_since, since) + REST_DURATION - since
             if physics.data.time >= t_end - 1e-9:
                 return "timeout", self.settle_timeout
-            physics.step(self.motion.steps_per_tick)
+            physics.step(steps_per_tick)
 
     def step(self, action):
         """Execute the behaviour with ``action`` and take the final snapshot; the episode then terminates."""
