@@ -1,0 +1,128 @@
+"""The cache of compiled models: a cached model is the compiled one, and any change of input is a new entry."""
+
+from __future__ import annotations
+
+import os
+import shutil
+
+import mujoco
+import numpy as np
+import pytest
+
+from affordance_env import model_cache, scene
+from affordance_env.robot_model import icub_urdf
+
+
+def _bytes(model: mujoco.MjModel) -> bytes:
+    buffer = np.empty(mujoco.mj_sizeModel(model), dtype=np.uint8)
+    mujoco.mj_saveModel(model, None, buffer)
+    return buffer.tobytes()
+
+
+@pytest.fixture(scope="module")
+def compiled() -> bytes:
+    """The tap model as compiling gives it, without the cache."""
+    return _bytes(scene.build_spec("tap").compile())
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    monkeypatch.setenv(model_cache.CACHE_ENV, str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
+
+def test_a_cached_model_is_the_compiled_model_byte_for_byte(cache, compiled, monkeypatch):
+    first = scene.build_model("tap")  # compiled, and stored
+    (stored,) = cache.glob("model-tap-*.mjb")
+    assert _bytes(first) == compiled
+
+    def no_compiling(variant):
+        raise AssertionError("the model was compiled again instead of read from the cache")
+
+    monkeypatch.setattr(scene, "build_spec", no_compiling)
+    second = scene.build_model("tap")
+    assert _bytes(second) == compiled
+    assert second is not first  # each env gets a model of its own to modify
+
+
+def test_a_damaged_cached_model_is_compiled_again_and_replaced(cache, compiled):
+    scene.build_model("tap")
+    (stored,) = cache.glob("model-tap-*.mjb")
+    size = stored.stat().st_size
+    with open(stored, "r+b") as f:  # as a write cut short would leave it
+        f.truncate(size // 2)
+    assert _bytes(scene.build_model("tap")) == compiled
+    assert stored.stat().st_size == size
+
+
+def test_the_cache_key_changes_with_every_input(tmp_path, monkeypatch):
+    mesh = tmp_path / "link.stl"
+    mesh.write_bytes(b"solid a")
+    urdf = f'<robot><link><visual><geometry><mesh filename="{mesh}"/></geometry></visual></link></robot>'
+    key = model_cache.fingerprint("tap", (urdf,))
+    assert model_cache.fingerprint("tap", (urdf,)) == key  # a pure function of the inputs
+    assert model_cache.fingerprint("grasp", (urdf,)) != key
+    assert model_cache.fingerprint("tap", (urdf + " ",)) != key
+    mesh.write_bytes(b"solid b")  # the same URDF, another mesh
+    assert model_cache.fingerprint("tap", (urdf,)) != key
+    mesh.write_bytes(b"solid a")
+    assets = tmp_path / "assets"
+    assets.mkdir()
+    for name in ("scene.xml", "README.md"):
+        (assets / name).write_bytes((model_cache.assets_dir() / name).read_bytes())
+    monkeypatch.setattr(model_cache, "assets_dir", lambda: assets)
+    assert model_cache.fingerprint("tap", (urdf,)) == key  # the same assets, elsewhere
+    (assets / "scene.xml").write_text((assets / "scene.xml").read_text().replace("</mujoco>", "</mujoco>\n"))
+    assert model_cache.fingerprint("tap", (urdf,)) != key
+    monkeypatch.setattr(mujoco, "__version__", mujoco.__version__ + ".1")
+    assert model_cache.fingerprint("tap", (urdf,)) != key
+
+
+def test_the_key_covers_the_package_source(tmp_path, monkeypatch):
+    urdf = icub_urdf()
+    key = model_cache.fingerprint("tap", (urdf,))
+    package = tmp_path / "affordance_env"
+    shutil.copytree(model_cache._PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__"))
+    monkeypatch.setattr(model_cache, "_PACKAGE", package)
+    assert model_cache.fingerprint("tap", (urdf,)) == key
+    with open(package / "scene.py", "a") as f:
+        f.write("\nROBOT_CONTYPE = 3\n")
+    assert model_cache.fingerprint("tap", (urdf,)) != key
+
+
+def test_old_models_of_a_variant_are_removed(cache, compiled):
+    cache.mkdir()
+    for i in range(model_cache.KEEP + 2):
+        old = cache / f"model-tap-{i:032x}.mjb"
+        old.write_bytes(b"old")
+        os.utime(old, (1e9 + i, 1e9 + i))
+    other = cache / f"model-grasp-{0:032x}.mjb"
+    other.write_bytes(b"another variant")
+    os.utime(other, (1e9, 1e9))
+    scene.build_model("tap")
+    kept = sorted(p.name for p in cache.glob("model-tap-*.mjb"))
+    assert len(kept) == model_cache.KEEP
+    assert f"model-tap-{model_cache.KEEP + 1:032x}.mjb" in kept  # the newest old one, and the new one
+    assert other.exists()
+
+
+def test_without_a_usable_cache_the_model_is_compiled(tmp_path, monkeypatch, compiled):
+    monkeypatch.setenv(model_cache.CACHE_ENV, "off")
+    monkeypatch.setenv("HOME", str(tmp_path))
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "xdg"))
+    assert model_cache.cache_dir() is None
+    assert _bytes(scene.build_model("tap")) == compiled
+    assert not any(tmp_path.iterdir())
+    blocker = tmp_path / "a-file"  # the cache directory cannot be made: a file is in the way
+    blocker.write_text("")
+    monkeypatch.setenv(model_cache.CACHE_ENV, str(blocker / "cache"))
+    assert _bytes(scene.build_model("tap")) == compiled
+
+
+def test_the_default_directory_follows_xdg(tmp_path, monkeypatch):
+    monkeypatch.delenv(model_cache.CACHE_ENV, raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert model_cache.cache_dir() == tmp_path / "tap-affordance"
+    monkeypatch.delenv("XDG_CACHE_HOME")
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    assert model_cache.cache_dir() == tmp_path / "home" / ".cache" / "tap-affordance"
