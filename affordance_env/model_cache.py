@@ -20,10 +20,12 @@ newest :data:`KEEP` files of each variant are kept.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import re
 import tempfile
+import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -36,6 +38,8 @@ from affordance_env.assets_path import assets_dir
 CACHE_ENV = "TAP_AFFORDANCE_CACHE"
 #: Cached models kept per variant (older ones are removed when a new one is written).
 KEEP = 3
+#: A temporary file older than this [s] is what a killed write left: removed when the next model is written.
+STALE_TMP_AGE = 600.0
 _PACKAGE = Path(__file__).resolve().parent
 _MESH_FILE = re.compile(r'filename="([^"]+)"')
 
@@ -111,3 +115,7 @@ def _store(model: mujoco.MjModel, path: Path) -> None:
     older = sorted(path.parent.glob(f"model-{variant}-*.mjb"), key=lambda p: p.stat().st_mtime, reverse=True)
     for stale in older[KEEP:]:
         stale.unlink(missing_ok=True)
+    for left in path.parent.glob(".model-*.tmp"):  # of writes killed midway (a write takes a tenth of a second)
+        with contextlib.suppress(OSError):
+            if time.time() - left.stat().st_mtime > STALE_TMP_AGE:
+                left.unlink()

@@ -90,12 +90,17 @@ def test_the_key_covers_the_package_source(tmp_path, monkeypatch):
     assert model_cache.fingerprint("tap", (urdf,)) != key
 
 
-def test_old_models_of_a_variant_are_removed(cache, compiled):
+def test_old_models_and_files_of_killed_writes_are_removed(cache, compiled):
     cache.mkdir()
     for i in range(model_cache.KEEP + 2):
         old = cache / f"model-tap-{i:032x}.mjb"
         old.write_bytes(b"old")
         os.utime(old, (1e9 + i, 1e9 + i))
+    killed = cache / ".model-tap-x.mjb.abc.tmp"  # a write killed an hour ago, and one under way
+    killed.write_bytes(b"half")
+    os.utime(killed, (os.path.getmtime(killed) - 3600,) * 2)
+    writing = cache / ".model-tap-y.mjb.def.tmp"
+    writing.write_bytes(b"half")
     other = cache / f"model-grasp-{0:032x}.mjb"
     other.write_bytes(b"another variant")
     os.utime(other, (1e9, 1e9))
@@ -104,6 +109,7 @@ def test_old_models_of_a_variant_are_removed(cache, compiled):
     assert len(kept) == model_cache.KEEP
     assert f"model-tap-{model_cache.KEEP + 1:032x}.mjb" in kept  # the newest old one, and the new one
     assert other.exists()
+    assert not killed.exists() and writing.exists()
 
 
 def test_without_a_usable_cache_the_model_is_compiled(tmp_path, monkeypatch, compiled):
