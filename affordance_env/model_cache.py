@@ -24,7 +24,6 @@ import contextlib
 import hashlib
 import os
 import re
-import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -33,6 +32,7 @@ import mujoco
 import numpy as np
 
 from affordance_env.assets_path import assets_dir
+from affordance_env.fileio import write_atomically
 
 #: Environment variable naming the cache directory (``off``: no cache).
 CACHE_ENV = "TAP_AFFORDANCE_CACHE"
@@ -103,14 +103,7 @@ def _store(model: mujoco.MjModel, path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     buffer = np.empty(mujoco.mj_sizeModel(model), dtype=np.uint8)
     mujoco.mj_saveModel(model, None, buffer)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(buffer.tobytes())
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    write_atomically(path, buffer.tofile)
     variant = path.name.split("-")[1]
     older = sorted(path.parent.glob(f"model-{variant}-*.mjb"), key=lambda p: p.stat().st_mtime, reverse=True)
     for stale in older[KEEP:]:

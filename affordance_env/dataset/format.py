@@ -15,12 +15,9 @@ name and renamed when complete (:func:`write_atomically`).
 
 from __future__ import annotations
 
-import contextlib
 import json
 import os
-import uuid
 from collections import Counter
-from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -30,6 +27,7 @@ import pyarrow.parquet as pq
 
 from affordance_env.behaviors import ACTION_DIM
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
+from affordance_env.fileio import write_atomically
 
 #: Version of the on-disk format; :func:`~affordance_env.dataset.load_dataset` reads versions 1 up to this one.
 #: Version 4 added the ``success`` column.
@@ -99,24 +97,6 @@ def interaction_row(episode: int, env_seed: int, action: np.ndarray, reset: tupl
             row[f"{stage}_range"] = obs["range"].astype(np.float16).tobytes()
             row[f"{stage}_mask"] = np.packbits(obs["mask"].astype(bool)).tobytes()
     return row
-
-
-def write_atomically(path: Path, write: Callable[[Path], Any]) -> None:
-    """``write(tmp)`` to a unique temporary name beside ``path``, flush it to disk, rename it to ``path``."""
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.tmp")
-    try:
-        write(tmp)
-        with open(tmp, "rb") as f:
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-    with contextlib.suppress(OSError):  # make the rename durable too (not every file system can)
-        fd = os.open(path.parent, os.O_RDONLY)
-        try:
-            os.fsync(fd)
-        finally:
-            os.close(fd)
 
 
 def chunk_name(index: int) -> str:
