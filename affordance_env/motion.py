@@ -47,6 +47,19 @@ HOLD_STILL_TICKS = 2
 #: from the kinematics it is measured on (one step old) to the tick's end, hand and object would have to close
 #: at 1.25 m/s, over twice the fastest stroke (0.54 m/s), while the object rests.
 CONTACT_WATCH_DISTANCE = 0.015
+#: Timestep [s] of a tap interaction outside its stroke: while the head turns to the object, the arm reaches the
+#: pre-stroke pose, returns home, and the object rolls and comes to rest. The stroke, from its start to the end of
+#: its follow-through, keeps the tap scene's 2 ms, which resolves the impact (the palm moves at most 1.1 mm a step).
+#: Elsewhere the fastest dynamics are the contacts' (MuJoCo's default time constant, 20 ms) and the arm servos'
+#: (25 ms and more), 4 steps or more at 5 ms where MuJoCo needs 2; the grasp variant steps at 5 ms too
+#: (``scene.GRASP_TIMESTEP``). A resting object creeps no more at 5 ms than at 2 (a few micrometres in 2 s).
+#: Over 300 interactions (tap, tap_back and push, half canonical, half at random actions: ``python
+#: benchmarks/timestep.py --episodes 100``) the object ends a median 0.35 mm (90 % within 1.6 mm) from where it
+#: ends at 2 ms throughout, 0.3 % of the travel of those that rolled over 5 cm; at 1 ms outside the stroke it ends
+#: 0.16 mm (1.2 mm) from there, so 2 ms is no nearer to converged than that. 3 labels of the 300 differ, each at
+#: a threshold: two pushes that moved 30 mm give or take 1.4 mm against the 3 cm of their success rule, and a
+#: ball that rolled 47 cm to the table's edge went over it. A canonical tap takes 469 steps instead of 913.
+FREE_TIMESTEP = 0.005
 #: Spacing of the IK solutions along the stroke line [m]. Between two solutions the targets are interpolated in
 #: joint space; over 2 cm the palm then stays within 1.0 mm of the line (measured over 30 canonical strokes), as
 #: it does over 1 cm: what remains is the IK's own tolerance (1 mm), not the interpolation.
@@ -154,6 +167,8 @@ class MotionExecutor:
         self.kinematics = kinematics
         self._opt = physics.model.opt  # MuJoCo's options, read at every tick: the wrapper is made once
         self._tick_timestep, self._steps_per_tick = 0.0, 1  # the last timestep seen, and its steps per tick
+        #: Timestep [s] of a tap interaction outside its stroke (FREE_TIMESTEP; the scene's own: as fine as the stroke).
+        self.free_timestep = FREE_TIMESTEP
         #: Where the IK of every pre-stroke pose starts (see :meth:`set_approach_posture`); None: the current
         #: servo targets.
         self.approach_posture: np.ndarray | None = None
@@ -272,8 +287,9 @@ class MotionExecutor:
         above, start = self.plan_approach(plan)
         line = StrokeLine(self, plan, start.q)
         p_object_before = physics.object_pose()[:3]
-        self.move_through([start.q] if above is None else [above.q, start.q])  # through the pose above, if any
-        start_error = self.settle(plan.p_start)
+        with self.stepping(self.free_timestep):  # the object rests and the hand moves in free space
+            self.move_through([start.q] if above is None else [above.q, start.q])  # through the pose above, if any
+            start_error = self.settle(plan.p_start)
         object_moved = float(np.linalg.norm(physics.object_pose()[:3] - p_object_before))
         p_hand_start = physics.hand_position()
         contact, contact_time, hand_speed = False, float("nan"), 0.0
@@ -347,7 +363,7 @@ class MotionExecutor:
             self._tick_watching(None, watch)
 
     @contextmanager
-    def _stepping(self, timestep: float) -> Iterator[None]:
+    def stepping(self, timestep: float) -> Iterator[None]:
         """Simulate at ``timestep`` [s], a divisor of CONTROL_DT, inside the block; at the model's own after it."""
         steps = round(CONTROL_DT / timestep)
         if not (timestep > 0 and abs(steps * timestep - CONTROL_DT) < 1e-12):
@@ -386,7 +402,7 @@ class MotionExecutor:
         q_arm = physics.joint_targets()
         self._ramp(with_hand(q_arm, plan.hand_closed), plan.close_time, watch)
         self._hold(GRASP_SQUEEZE_TIME, watch)
-        with self._stepping(GRASP_CARRY_TIMESTEP):  # the hand carries what it holds: up, still, down
+        with self.stepping(GRASP_CARRY_TIMESTEP):  # the hand carries what it holds: up, still, down
             self._ramp(with_hand(q_lift, plan.hand_closed), GRASP_LIFT_TIME, watch)
             self._hold(plan.hold_time, watch)
             rise = float(physics.object_pose()[2]) - z_start

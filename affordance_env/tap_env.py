@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import inspect
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -111,8 +112,11 @@ class TapAffordanceEnv(gym.Env):
     Only the fingers' servos move the object (no welds, no applied forces). Whether the object fits the open hand,
     between the thumb and the fingertips, decides the outcome: with the default sizes about half the canonical
     grasps hold (``info["success"]``), nearly all under 6.4 cm and few over 8.2 cm (``benchmarks/grasp.py``).
-    The grasp variant of the scene integrates at 5 ms instead of 2 (``affordance_env.scene.GRASP_TIMESTEP``), and
-    at 10 ms while the closed hand lifts, holds and carries the object (``affordance_env.motion.GRASP_CARRY_TIMESTEP``).
+    A tap's stroke, from its start to the end of its follow-through, is simulated at 2 ms, which resolves the
+    impact; the rest of a tap interaction (the head turning, the reach, the way home, the object rolling to rest)
+    at 5 ms (``affordance_env.motion.FREE_TIMESTEP``). The grasp variant of the scene integrates at 5 ms
+    (``affordance_env.scene.GRASP_TIMESTEP``), and at 10 ms while the closed hand lifts, holds and carries the object
+    (``affordance_env.motion.GRASP_CARRY_TIMESTEP``).
 
     The world: a 60 x 100 cm wooden lab table whose top is what objects rest on and roll on (rolling resistance of
     wood on wood, see ``assets/README.md``); past its edges an object falls to the floor. The range camera in the
@@ -407,8 +411,9 @@ class TapAffordanceEnv(gym.Env):
         self._q_home = physics.joint_targets()
         geometry = object_geometry(object_type, size)
         physics.set_object(geometry, xy, yaw)  # 0.1 mm above the table: it settles while the head turns
-        attention = attend(physics, self.attention_camera, self.motion.move_joints)
-        still = self.motion.hold_still(also=_object_at_rest)
+        with self._free_stepping():
+            attention = attend(physics, self.attention_camera, self.motion.move_joints)
+            still = self.motion.hold_still(also=_object_at_rest)
         self._q_home = physics.joint_targets()  # the arm's home, with the gaze on the object
         obs, features = self._snapshot()
         pose = physics.object_pose()
@@ -422,6 +427,12 @@ class TapAffordanceEnv(gym.Env):
             "still": still,
         }
         return obs, info
+
+    def _free_stepping(self) -> contextlib.AbstractContextManager:
+        """A tap interaction steps at ``motion.FREE_TIMESTEP`` outside its stroke; a grasp at its own timesteps."""
+        if isinstance(self.behavior, GraspBehavior):
+            return contextlib.nullcontext()
+        return self.motion.stepping(self.motion.free_timestep)
 
     def _wait_outcome(self, monitor: ObjectMonitor, since: float) -> tuple[str, float]:
         """Simulate until the object has left the table, has been at rest since ``since`` [s] or later, or
@@ -455,11 +466,12 @@ class TapAffordanceEnv(gym.Env):
         monitor = physics.start_monitor()  # from now on, whatever the arm does
         try:
             stroke = self.motion.grasp(plan) if grasping else self.motion.stroke(plan)
-            still = self.motion.go_home(self._q_home, via=None if grasping else stroke.q_withdraw)
-            # The outcome is awaited from the first touch of a stroke, or from the release of a grasp.
-            since = stroke.release_time if grasping else (
-                stroke.contact_time if stroke.contact else physics.data.time)
-            outcome, outcome_time = self._wait_outcome(monitor, since)
+            with self._free_stepping():
+                still = self.motion.go_home(self._q_home, via=None if grasping else stroke.q_withdraw)
+                # The outcome is awaited from the first touch of a stroke, or from the release of a grasp.
+                since = stroke.release_time if grasping else (
+                    stroke.contact_time if stroke.contact else physics.data.time)
+                outcome, outcome_time = self._wait_outcome(monitor, since)
         finally:
             physics.monitor = None
         if self.render_mode is not None:

@@ -317,6 +317,35 @@ def test_the_first_touch_is_found_to_the_step_while_far_ticks_run_unwatched(monk
     assert interactions() == skipping
 
 
+def test_the_stroke_steps_at_2_ms_and_the_rest_of_a_tap_at_the_free_timestep(env):
+    # The impact is resolved at the scene's 2 ms: every step from the start of the stroke to the end of its
+    # follow-through, the first touch among them; the head turning, the reach, the way home and the wait for the
+    # object step at FREE_TIMESTEP, and the model keeps its own timestep between interactions.
+    import affordance_env.motion as motion
+
+    physics, seen = env.physics, []
+    step = physics.step
+
+    def recording(n: int = 1) -> None:
+        step(n)
+        seen.append((physics.model.opt.timestep, physics.hand_touches_object()))
+
+    physics.step = recording
+    try:
+        env.reset(seed=0)
+        in_reset = len(seen)
+        assert env.step(np.zeros(3))[4]["contact"]
+    finally:
+        del physics.step
+    timesteps = np.array([timestep for timestep, _ in seen])
+    fine = np.flatnonzero(timesteps == 0.002)
+    assert fine.size > 50 and fine[0] > in_reset and np.all(np.diff(fine) == 1)  # one block, inside step()
+    assert np.all(np.delete(timesteps, fine) == motion.FREE_TIMESTEP) and fine[-1] < len(seen) - 50
+    first_touch = next(i for i, (_, touching) in enumerate(seen) if touching)
+    assert fine[0] < first_touch <= fine[-1]
+    assert physics.model.opt.timestep == 0.002
+
+
 def test_success_is_rolled_for_taps_and_moved_for_push():
     tap = TapAffordanceEnv(camera_width=32, camera_height=24)
     for object_type, succeeds in (("sphere", True), ("box", False)):  # a tapped ball rolls, a box slides

@@ -172,7 +172,7 @@ def test_the_carry_alone_is_simulated_at_its_own_timestep(grasp_env):
     assert carried[-1] - carried[0] == pytest.approx(GRASP_LIFT_TIME + 1.0 + GRASP_PLACE_TIME - 0.01)
     assert physics.model.opt.timestep == GRASP_TIMESTEP and grasp_env.motion.steps_per_tick == 2  # restored
     with pytest.raises(ValueError, match="divide the control period"):
-        with grasp_env.motion._stepping(0.003):
+        with grasp_env.motion.stepping(0.003):
             pass
 
 
