@@ -167,7 +167,8 @@ class MotionExecutor:
         self.kinematics = kinematics
         self._opt = physics.model.opt  # MuJoCo's options, read at every tick: the wrapper is made once
         self._tick_timestep, self._steps_per_tick = 0.0, 1  # the last timestep seen, and its steps per tick
-        #: Timestep [s] of a tap interaction outside its stroke (FREE_TIMESTEP; the scene's own: as fine as the stroke).
+        #: Timestep [s] of a tap interaction outside its stroke (FREE_TIMESTEP); the scene's own (2 ms) steps the
+        #: whole interaction as finely as the stroke (``benchmarks/timestep.py`` compares the two).
         self.free_timestep = FREE_TIMESTEP
         #: Where the IK of every pre-stroke pose starts (see :meth:`set_approach_posture`); None: the current
         #: servo targets.
