@@ -15,10 +15,12 @@ about one pixel in the same paper) is not modelled: the object mask stays the si
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from affordance_env.camera import RangeImage
+if TYPE_CHECKING:  # only for annotations: importing the camera would import MuJoCo
+    from affordance_env.camera import RangeImage
 
 #: Noise models the environment offers (``range_noise=``).
 RANGE_NOISE_MODELS: tuple[str, ...] = ("kinect_v1",)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import inspect
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -15,7 +16,6 @@ from affordance_env.attention import attend
 from affordance_env.behaviors import (
     ACTION_DIM,
     BEHAVIORS,
-    ROLL_THRESHOLD,
     GraspBehavior,
     StrokePlan,
     check_action,
@@ -24,7 +24,7 @@ from affordance_env.behaviors import (
     plan_grasp,
     plan_stroke,
 )
-from affordance_env.camera import Intrinsics, RangeCamera
+from affordance_env.camera import RangeCamera
 from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
 from affordance_env.kinematics import Kinematics
 from affordance_env.motion import (
@@ -33,10 +33,11 @@ from affordance_env.motion import (
     GraspOutcome,
     MotionExecutor,
 )
-from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size, object_geometry
+from affordance_env.objects import check_object_type, check_size, object_geometry
+from affordance_env.options import EnvOptions
 from affordance_env.outcome import REST_DURATION, ObjectMonitor, grasp_success, outcome_labels
 from affordance_env.physics import TapPhysics
-from affordance_env.range_noise import add_kinect_noise, check_range_noise
+from affordance_env.range_noise import add_kinect_noise
 from affordance_env.scene import build_model
 
 #: Region of the table where objects are placed: centre (x, y) and half-widths [m].
@@ -233,30 +234,29 @@ class TapAffordanceEnv(gym.Env):
 
     def __init__(
         self,
-        behavior: str = "tap",
-        object_types: Sequence[str] = OBJECT_TYPES,
-        size_range: tuple[float, float] = (0.04, 0.10),
-        camera_width: int = 160,
-        camera_height: int = 120,
-        camera_fovy: float = 57.4,
-        roll_threshold: float = ROLL_THRESHOLD,
-        settle_timeout: float = 3.0,
-        range_noise: str | None = None,
+        behavior: str = EnvOptions.behavior,
+        object_types: Sequence[str] = EnvOptions.object_types,
+        size_range: tuple[float, float] = EnvOptions.size_range,
+        camera_width: int = EnvOptions.camera_width,
+        camera_height: int = EnvOptions.camera_height,
+        camera_fovy: float = EnvOptions.camera_fovy,
+        roll_threshold: float = EnvOptions.roll_threshold,
+        settle_timeout: float = EnvOptions.settle_timeout,
+        range_noise: str | None = EnvOptions.range_noise,
         reward_fn: Callable[[dict[str, Any]], float] | None = None,
         render_mode: str | None = None,
         render_width: int = 480,
         render_height: int = 360,
     ) -> None:
-        self.check_options(behavior=behavior, object_types=object_types, size_range=size_range,
-                           camera_width=camera_width, camera_height=camera_height, camera_fovy=camera_fovy,
-                           roll_threshold=roll_threshold, settle_timeout=settle_timeout, range_noise=range_noise,
-                           render_mode=render_mode)
-        self.behavior = get_behavior(behavior)
-        self.object_types = tuple(check_object_type(t) for t in object_types)
-        self.size_range = (check_size(size_range[0]), check_size(size_range[1]))
-        self.roll_threshold = float(roll_threshold)
-        self.range_noise = check_range_noise(range_noise)
-        self.settle_timeout = float(settle_timeout)
+        options = EnvOptions(behavior, object_types, size_range, camera_width, camera_height, camera_fovy,
+                             roll_threshold, settle_timeout, range_noise)  # checked and normalised
+        self._check_render_mode(render_mode)
+        self.behavior = get_behavior(options.behavior)
+        self.object_types = options.object_types
+        self.size_range = options.size_range
+        self.roll_threshold = options.roll_threshold
+        self.range_noise = options.range_noise
+        self.settle_timeout = options.settle_timeout
         self.reward_fn = default_reward if reward_fn is None else reward_fn
         self.render_mode = render_mode
 
@@ -302,33 +302,23 @@ class TapAffordanceEnv(gym.Env):
     @classmethod
     def check_options(cls, **options: Any) -> None:
         """Raise ValueError, naming the value and what was expected, for any of the constructor's options that it
-        would refuse; without building anything (a collection checks its options so before it starts workers)."""
+        would refuse; without building anything (:class:`~affordance_env.options.EnvOptions` checks the options
+        that decide the data without importing the simulator, which is what a collection uses)."""
         try:
             bound = inspect.signature(cls.__init__).bind(None, **options)
         except TypeError as exc:
             raise ValueError(f"Options of TapAffordance-v0: {exc}.") from None
         bound.apply_defaults()
-        o = bound.arguments
-        get_behavior(o["behavior"])
-        if isinstance(o["object_types"], str) or len(o["object_types"]) == 0:
-            raise ValueError(f"object_types must be a non-empty sequence of {OBJECT_TYPES}, got "
-                             f"{o['object_types']!r}.")
-        for object_type in o["object_types"]:
-            check_object_type(object_type)
-        low, high = (check_size(s) for s in o["size_range"])
-        if low > high:
-            raise ValueError(f"size_range must be (low, high) with low <= high, got {o['size_range']!r}.")
-        Intrinsics.from_fovy(o["camera_width"], o["camera_height"], o["camera_fovy"])
-        if not o["roll_threshold"] > 0:
-            raise ValueError(f"roll_threshold must be a positive distance [m], got {o['roll_threshold']!r}.")
-        if not o["settle_timeout"] > 0:
-            raise ValueError(f"settle_timeout must be positive [s], got {o['settle_timeout']!r}.")
-        check_range_noise(o["range_noise"])
-        if o["render_mode"] not in (None, *cls.metadata["render_modes"]):
-            raise ValueError(f"render_mode must be None or one of {cls.metadata['render_modes']}, got "
-                             f"{o['render_mode']!r}.")
+        data_options = {f.name for f in dataclasses.fields(EnvOptions)}
+        EnvOptions(**{name: value for name, value in bound.arguments.items() if name in data_options})
+        cls._check_render_mode(bound.arguments["render_mode"])
 
-    # ------------------------------------------------------------------------------------------------------
+    @classmethod
+    def _check_render_mode(cls, render_mode: str | None) -> None:
+        if render_mode not in (None, *cls.metadata["render_modes"]):
+            raise ValueError(f"render_mode must be None or one of {cls.metadata['render_modes']}, got "
+                             f"{render_mode!r}.")
+
     def _nominal_plan(self) -> StrokePlan:
         """The canonical stroke of a sphere of the middle size at the centre of the placement region."""
         geometry = object_geometry("sphere", float(np.mean(self.size_range)))

@@ -9,6 +9,7 @@ from gymnasium.utils.env_checker import check_env
 import affordance_env
 import affordance_env.tap_env as tap_env_module
 from affordance_env.features import FEATURE_NAMES, effect_features
+from affordance_env.options import EnvOptions
 from affordance_env.range_noise import kinect_axial_sigma
 from affordance_env.tap_env import TapAffordanceEnv
 
@@ -112,6 +113,9 @@ def test_bad_options_get_clear_errors(kwargs, match, monkeypatch):
     TapAffordanceEnv.check_options(**{"behavior": "push", "camera_width": 32, "camera_height": 24})
     with pytest.raises(ValueError, match="colour"):
         TapAffordanceEnv.check_options(colour="red")
+    if "render_mode" not in kwargs:  # and so do the data options alone, as a collection checks them
+        with pytest.raises(ValueError, match=match):
+            EnvOptions.checked(**kwargs)
 
 
 def test_reward_fn_is_used():

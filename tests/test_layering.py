@@ -33,3 +33,12 @@ def test_using_the_environment_loads_nothing_of_the_learning_package():
             "print(sorted(m for m in sys.modules if m.startswith('affordance_learning')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_checking_a_collections_options_loads_neither_mujoco_nor_pinocchio():
+    # The coordinating process of a collection checks the options, then only schedules workers.
+    code = ("import sys; from affordance_env.dataset.collect import _full_options; "
+            "_full_options({'behavior': 'push', 'size_range': (0.05, 0.08)}); "
+            "print(sorted(m for m in ('mujoco', 'pinocchio', 'affordance_env.tap_env') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"

@@ -16,7 +16,7 @@ stops the collection with its traceback, and the chunks already written stay. Wh
 from __future__ import annotations
 
 import contextlib
-import inspect
+import dataclasses
 import json
 import os
 import sys
@@ -48,11 +48,10 @@ from affordance_env.dataset.format import (
     write_atomically,
     write_manifest,
 )
+from affordance_env.options import EnvOptions
 
 ACTIONS = ("canonical", "random")
 SCHEDULERS = ("joblib", "dask")
-#: Env arguments that a dataset cannot record, or that do not change the data.
-_NOT_COLLECTED = ("self", "reward_fn", "render_mode", "render_width", "render_height")
 
 
 def interaction_seed(seed: int, episode: int) -> int:
@@ -121,15 +120,15 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) ->
 
 # --- the coordinator -------------------------------------------------------------------------------------
 def _full_options(env_options: dict[str, Any]) -> dict[str, Any]:
-    """The env options with every default filled in, as JSON values, so that equal settings compare equal."""
-    from affordance_env.tap_env import TapAffordanceEnv
-
-    parameters = inspect.signature(TapAffordanceEnv.__init__).parameters
-    allowed = [name for name in parameters if name not in _NOT_COLLECTED]
+    """The env options with every default filled in, as JSON values, so that equal settings compare equal;
+    checked (:class:`~affordance_env.options.EnvOptions`) without building an env or importing the simulator."""
+    fields = dataclasses.fields(EnvOptions)
+    allowed = [f.name for f in fields]
     unknown = sorted(set(env_options) - set(allowed))
     if unknown:
         raise ValueError(f"unknown or unsupported env options {unknown} for collection; allowed: {allowed}.")
-    full = {name: parameters[name].default for name in allowed}
+    EnvOptions(**env_options)
+    full = {f.name: f.default for f in fields}
     full.update(env_options)
     return json.loads(json.dumps(full, default=list))
 
@@ -215,11 +214,7 @@ def collect(
     options = _full_options(dict(env_options or {}))
     options_json = json.dumps(options, sort_keys=True)
     if scheduler == "joblib" and workers == 1:
-        _worker_env(options_json)  # bad options fail here, clearly, before any work; this process collects
-    else:  # the workers build their own envs: check the options without building one here
-        from affordance_env.tap_env import TapAffordanceEnv
-
-        TapAffordanceEnv.check_options(**options)
+        _worker_env(options_json)  # this process collects: build its env now, before any work
     header = dataset_header(seed, action, chunk_size, options, save_images)
     out, episodes = Path(out), int(episodes)
 

@@ -1,0 +1,74 @@
+"""The options of TapAffordance-v0 that decide its data: their defaults, and their checks.
+
+Checking them builds nothing and imports neither MuJoCo nor Pinocchio, so a collection checks its options in its
+coordinating process, in milliseconds, before it starts the workers that build the environments.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import numbers
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+from affordance_env.behaviors import ROLL_THRESHOLD, get_behavior
+from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size
+from affordance_env.pinhole import Intrinsics
+from affordance_env.range_noise import check_range_noise
+
+
+@dataclass(frozen=True)
+class EnvOptions:
+    """The data options of :class:`~affordance_env.tap_env.TapAffordanceEnv` (its constructor's defaults are
+    these), checked and normalised when made: a bad value raises ValueError naming it and what was expected.
+
+    Sequences become tuples, sizes and distances floats, so that equal settings compare equal.
+    """
+
+    behavior: str = "tap"
+    object_types: Sequence[str] = OBJECT_TYPES
+    size_range: tuple[float, float] = (0.04, 0.10)
+    camera_width: int = 160
+    camera_height: int = 120
+    camera_fovy: float = 57.4
+    roll_threshold: float = ROLL_THRESHOLD
+    settle_timeout: float = 3.0
+    range_noise: str | None = None
+
+    def __post_init__(self) -> None:
+        get_behavior(self.behavior)
+        types = self.object_types
+        if isinstance(types, str) or not isinstance(types, Sequence) or len(types) == 0:
+            raise ValueError(f"object_types must be a non-empty sequence of {OBJECT_TYPES}, got {types!r}.")
+        normalised: dict[str, Any] = {"object_types": tuple(check_object_type(t) for t in types)}
+        size_range = self.size_range
+        if isinstance(size_range, str) or not isinstance(size_range, Sequence) or len(size_range) != 2:
+            raise ValueError(f"size_range must be (low, high) in metres, got {size_range!r}.")
+        low, high = (check_size(s) for s in size_range)
+        if low > high:
+            raise ValueError(f"size_range must be (low, high) with low <= high, got {size_range!r}.")
+        normalised["size_range"] = (low, high)
+        Intrinsics.from_fovy(self.camera_width, self.camera_height, self.camera_fovy)
+        for name in ("roll_threshold", "settle_timeout"):
+            value = getattr(self, name)
+            real = isinstance(value, numbers.Real) and not isinstance(value, bool)
+            if not (real and math.isfinite(value) and value > 0):
+                unit = "distance [m]" if name == "roll_threshold" else "duration [s]"
+                raise ValueError(f"{name} must be a positive {unit}, got {value!r}.")
+            normalised[name] = float(value)
+        normalised["camera_width"], normalised["camera_height"] = int(self.camera_width), int(self.camera_height)
+        normalised["camera_fovy"] = float(self.camera_fovy)
+        check_range_noise(self.range_noise)
+        for name, value in normalised.items():
+            object.__setattr__(self, name, value)
+
+    @classmethod
+    def checked(cls, **options: Any) -> EnvOptions:
+        """The options from keyword arguments; an unknown name raises ValueError listing the known ones."""
+        known = [f.name for f in dataclasses.fields(cls)]
+        unknown = sorted(set(options) - set(known))
+        if unknown:
+            raise ValueError(f"Unknown options {unknown} of TapAffordance-v0; its data options are {known}.")
+        return cls(**options)
