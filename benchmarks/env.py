@@ -3,7 +3,9 @@
     python benchmarks/env.py [--episodes 200] [--repeats 3] [--width W] [--height H] [--behavior tap [grasp ...]]
 
 Prints interactions per second (reset + step), and the share of wall time spent inside ``mj_step`` (physics),
-in ray casting (range camera) and in the 49 features, measured by timing those calls in the same run. With
+in range images (the snapshots' and the attention's; of which ray casting) and in the 49 features, measured by
+timing those calls in the same run; and the share ``mj_step`` would have if nothing but physics and perception cost
+any time, the ceiling on it that perception sets. With
 several behaviours, they take turns round by round in the same run (so that they share the machine's load),
 and the wall time per interaction of each is compared with the first's.
 """
@@ -18,6 +20,7 @@ import mujoco
 import numpy as np
 
 import affordance_env.tap_env as tap_env_module
+from affordance_env.camera import RangeCamera
 from affordance_env.tap_env import TapAffordanceEnv
 
 
@@ -53,6 +56,9 @@ def main() -> None:
     mujoco.mj_step = timed("mj_step", counted_step)
     mujoco.mj_multiRay = timed("ray casting", original["mj_multiRay"])
     tap_env_module.compute_features = timed("features", tap_env_module.compute_features)
+    # Every range image: the snapshots' and the attention's (ray casting included, and the arrays around it).
+    original_capture = RangeCamera.capture
+    RangeCamera.capture = timed("range images", original_capture)
     per_interaction = {}
     try:
         size = {k: v for k, v in (("camera_width", args.width), ("camera_height", args.height)) if v is not None}
@@ -82,6 +88,7 @@ def main() -> None:
             _report(env, behavior, args, wall, best, rounds[behavior], simulated[behavior], steps[behavior])
     finally:
         mujoco.mj_step, mujoco.mj_multiRay = original["mj_step"], original["mj_multiRay"]
+        RangeCamera.capture = original_capture
     first = args.behavior[0]
     for behavior in args.behavior[1:]:
         ratio = per_interaction[behavior] / per_interaction[first]
@@ -97,9 +104,21 @@ def _report(env: TapAffordanceEnv, behavior: str, args: argparse.Namespace, wall
     print(f"  interactions per second (one core): {args.episodes / wall:8.1f}")
     print(f"  physics steps per interaction     : {steps / args.episodes:8.0f} ({simulated / args.episodes:.2f} s "
           "simulated)")
-    for name in ("mj_step", "ray casting", "features"):
-        print(f"  share of wall time in {name:<12}: {100 * spent.get(name, 0.0) / wall:7.1f} %")
-    print(f"  everything else (IK, control, ...): {100 * (1 - sum(spent.values()) / wall):7.1f} %")
+    per = 1e3 / args.episodes  # [ms per interaction] per second of the round
+    for name, label in (("mj_step", "share of wall time in mj_step     "),
+                        ("range images", "share of wall time in range images"),
+                        ("ray casting", "  of which in ray casting         "),
+                        ("features", "share of wall time in features    ")):
+        print(f"  {label}: {100 * spent.get(name, 0.0) / wall:7.1f} %   ({per * spent.get(name, 0.0):.1f} ms per "
+              "interaction)")
+    measured = sum(v for k, v in spent.items() if k != "ray casting")  # ray casting is part of the range images
+    print(f"  everything else (IK, control, ...): {100 * (1 - measured / wall):7.1f} %   "
+          f"({per * (wall - measured):.1f} ms per interaction)")
+    # What perception alone leaves to physics: the share mj_step would have if nothing else cost anything.
+    perception = spent.get("range images", 0.0) + spent.get("features", 0.0)
+    physics = spent.get("mj_step", 0.0)
+    ceiling = 100 * physics / (physics + perception)
+    print(f"  mj_step's share if nothing but physics and perception cost any time: {ceiling:.1f} %")
 
 
 if __name__ == "__main__":
