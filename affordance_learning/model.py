@@ -114,6 +114,8 @@ class AffordanceModel(BaseEstimator):
             largest weight (always at least the best one).
         n_neighbors: ReliefF's nearest hits, and nearest misses per other category, >= 1.
         som_iterations: Training steps of the map (one effect each), >= 1.
+        som_n_init: Maps trained from successive seeds, of which the one of lowest quantization error is kept
+            (:class:`SOMClustering`'s ``n_init``), >= 1.
         svm_C: SVM regularisation, > 0.
         svm_gamma: RBF kernel coefficient of the SVM on standardised features: ``"scale"``, ``"auto"`` or > 0.
         random_state: Seed of the map (initial weights and training order): int, generator or None.
@@ -143,6 +145,7 @@ class AffordanceModel(BaseEstimator):
         relevancy: float = 0.4,
         n_neighbors: int = 10,
         som_iterations: int = 5000,
+        som_n_init: int = 1,
         svm_C: float = 1.0,
         svm_gamma: float | str = "scale",
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
@@ -151,6 +154,7 @@ class AffordanceModel(BaseEstimator):
         self.relevancy = relevancy
         self.n_neighbors = n_neighbors
         self.som_iterations = som_iterations
+        self.som_n_init = som_n_init
         self.svm_C = svm_C
         self.svm_gamma = svm_gamma
         self.random_state = random_state
@@ -160,6 +164,7 @@ class AffordanceModel(BaseEstimator):
         _check_relevancy(self.relevancy)
         _check_int("n_neighbors", self.n_neighbors, 1)
         _check_int("som_iterations", self.som_iterations, 1)
+        _check_int("som_n_init", self.som_n_init, 1)
         C = self.svm_C
         if isinstance(C, bool) or not isinstance(C, numbers.Real) or not np.isfinite(C) or C <= 0:
             raise ValueError(f"svm_C must be a finite number > 0, got {C!r}.")
@@ -201,6 +206,7 @@ class AffordanceModel(BaseEstimator):
             n_clusters=self.n_clusters,
             n_iterations=self.som_iterations,
             random_state=som_seed(self.random_state),
+            n_init=self.som_n_init,
         ).fit(self.effect_scaler_.transform(E))
         labels = self.som_.labels_
         self.labels_ = labels

@@ -39,6 +39,11 @@ def som_seed(random_state: int | np.random.RandomState | np.random.Generator | N
     )
 
 
+def _distances(X: np.ndarray, centers: np.ndarray) -> np.ndarray:
+    """Euclidean distance of every row to every node, (n_samples, n_clusters), in the units of ``X``."""
+    return np.linalg.norm(X[:, None, :] - centers[None, :, :], axis=-1)
+
+
 class SOMClustering(ClusterMixin, BaseEstimator):
     """Cluster rows with a one-dimensional (1 x ``n_clusters``) self-organising map, trained by minisom.
 
@@ -58,11 +63,17 @@ class SOMClustering(ClusterMixin, BaseEstimator):
         sigma: Initial radius of the Gaussian neighbourhood [nodes], > 0.
         learning_rate: Initial learning rate, > 0.
         random_state: Seed of the initial weights and of the training order (int, generator or None).
+        n_init: Maps trained, each from its own seed; the one whose rows lie nearest to their nodes (lowest
+            quantization error) is kept, as k-means keeps its run of lowest inertia (scikit-learn's ``n_init``).
+            An integer ``random_state`` s seeds them with s, s + 1, ...; a generator draws their seeds.
+            A map's training is a stochastic descent from random weights, and one run can settle with two kinds
+            of effect in one node and a few outliers in another.
 
     Attributes:
         cluster_centers_: Node weights, (n_clusters, n_features), in the units of ``X``.
         labels_: Node of each training row, (n_samples,) int.
         quantization_error_: Mean distance of the training rows to their node, in the units of ``X``.
+        seed_: minisom's ``random_seed`` of the map kept (None when unseeded).
         n_iter_: Training steps run.
         n_features_in_: Number of features seen in ``fit``.
         feature_names_in_: Column names, when ``X`` has string column names.
@@ -75,15 +86,17 @@ class SOMClustering(ClusterMixin, BaseEstimator):
         sigma: float = 1.0,
         learning_rate: float = 0.5,
         random_state: int | np.random.RandomState | np.random.Generator | None = None,
+        n_init: int = 1,
     ) -> None:
         self.n_clusters = n_clusters
         self.n_iterations = n_iterations
         self.sigma = sigma
         self.learning_rate = learning_rate
         self.random_state = random_state
+        self.n_init = n_init
 
     def _check_params(self) -> None:
-        for name, low in (("n_clusters", 1), ("n_iterations", 1)):
+        for name, low in (("n_clusters", 1), ("n_iterations", 1), ("n_init", 1)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
                 raise ValueError(f"{name} must be an integer >= {low}, got {value!r}.")
@@ -104,28 +117,36 @@ class SOMClustering(ClusterMixin, BaseEstimator):
         """
         self._check_params()
         X = validate_data(self, X, dtype=np.float64)
-        som = MiniSom(
-            1,
-            int(self.n_clusters),
-            X.shape[1],
-            sigma=float(self.sigma),
-            learning_rate=float(self.learning_rate),
-            random_seed=som_seed(self.random_state),
-        )
-        som.train(X, int(self.n_iterations), random_order=True)
-        self.cluster_centers_ = np.array(som.get_weights()[0], dtype=np.float64)
-        distances = self._distances(X)
-        self.labels_ = np.argmin(distances, axis=1).astype(np.int64)
-        self.quantization_error_ = float(distances[np.arange(len(X)), self.labels_].mean())
+        best = None
+        for seed in self._seeds():
+            som = MiniSom(
+                1,
+                int(self.n_clusters),
+                X.shape[1],
+                sigma=float(self.sigma),
+                learning_rate=float(self.learning_rate),
+                random_seed=seed,
+            )
+            som.train(X, int(self.n_iterations), random_order=True)
+            centers = np.array(som.get_weights()[0], dtype=np.float64)
+            distances = _distances(X, centers)
+            labels = np.argmin(distances, axis=1).astype(np.int64)
+            error = float(distances[np.arange(len(X)), labels].mean())
+            if best is None or error < best[0]:  # the first of equals
+                best = (error, seed, centers, labels)
+        self.quantization_error_, self.seed_, self.cluster_centers_, self.labels_ = best
         self.n_iter_ = int(self.n_iterations)
         return self
 
-    def _distances(self, X: np.ndarray) -> np.ndarray:
-        """Euclidean distance of every row to every node, (n_samples, n_clusters), in the units of ``X``."""
-        return np.linalg.norm(X[:, None, :] - self.cluster_centers_[None, :, :], axis=-1)
+    def _seeds(self) -> list[int | None]:
+        """minisom's ``random_seed`` of each of the ``n_init`` maps."""
+        first = som_seed(self.random_state)
+        if first is None or isinstance(self.random_state, np.random.RandomState | np.random.Generator):
+            return [first] + [som_seed(self.random_state) for _ in range(int(self.n_init) - 1)]
+        return [(first + i) % (_MAX_SEED + 1) for i in range(int(self.n_init))]
 
     def predict(self, X: ArrayLike) -> np.ndarray:
         """Nearest node of every row of ``X``, (n_samples,) int."""
         check_is_fitted(self)
         X = validate_data(self, X, dtype=np.float64, reset=False)
-        return np.argmin(self._distances(X), axis=1).astype(np.int64)
+        return np.argmin(_distances(X, self.cluster_centers_), axis=1).astype(np.int64)

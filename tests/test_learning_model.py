@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 from minisom import MiniSom
 from sklearn.base import clone
+from sklearn.preprocessing import StandardScaler
 from sklearn.utils import estimator_checks
 from sklearn.utils.estimator_checks import parametrize_with_checks
 
@@ -137,6 +138,34 @@ def test_som_clones_and_repeats_with_the_same_seed() -> None:
         SOMClustering(sigma=0.0).fit(E)
     with pytest.raises(ValueError, match="n_iterations"):
         SOMClustering(n_iterations=2.5).fit(E)
+
+
+def test_som_n_init_keeps_the_map_of_lowest_quantization_error() -> None:
+    _, E, _ = three_classes(200)
+    runs = [SOMClustering(n_clusters=4, n_iterations=60, random_state=20 + i).fit(E) for i in range(6)]
+    errors = [run.quantization_error_ for run in runs]
+    assert len(set(errors)) == 6  # the seeds give different maps, so the choice matters
+    best = int(np.argmin(errors))
+    assert best != 0
+    kept = SOMClustering(n_clusters=4, n_iterations=60, random_state=20, n_init=6).fit(E)
+    assert kept.seed_ == 20 + best and kept.quantization_error_ == errors[best]
+    np.testing.assert_array_equal(kept.cluster_centers_, runs[best].cluster_centers_)
+    np.testing.assert_array_equal(kept.labels_, runs[best].labels_)
+    np.testing.assert_array_equal(kept.predict(E), kept.labels_)
+    # n_init=1 is the single map of the seed; a generator draws its seeds, the same each time from the same state
+    single = SOMClustering(n_clusters=4, n_iterations=60, random_state=20).fit(E)
+    assert single.seed_ == 20 and single.quantization_error_ == errors[0]
+    drawn = [SOMClustering(n_clusters=4, n_iterations=60, random_state=np.random.default_rng(3), n_init=4).fit(E)
+             for _ in range(2)]
+    np.testing.assert_array_equal(drawn[0].cluster_centers_, drawn[1].cluster_centers_)
+    with pytest.raises(ValueError, match="n_init must be an integer >= 1, got 0"):
+        SOMClustering(n_init=0).fit(E)
+    # the model hands it to its map, which it trains on the standardised effects
+    model = AffordanceModel(n_clusters=4, som_iterations=60, som_n_init=6, random_state=20).fit(E, E)
+    expected = SOMClustering(n_clusters=4, n_iterations=60, random_state=20, n_init=6).fit(
+        StandardScaler().fit_transform(E))
+    assert model.som_.seed_ == expected.seed_
+    np.testing.assert_array_equal(model.labels_, expected.labels_)
 
 
 # ---------------------------------------------------------------------------------------------- ReliefF
@@ -366,6 +395,7 @@ def test_same_seed_same_model_and_joblib_round_trip(tmp_path: pytest.TempPathFac
         ({"n_clusters": 11}, "n_clusters"),
         ({"n_neighbors": 0}, "n_neighbors"),
         ({"som_iterations": 0}, "som_iterations"),
+        ({"som_n_init": 0}, "som_n_init"),
         ({"svm_C": 0.0}, "svm_C"),
         ({"svm_gamma": "wide"}, "svm_gamma"),
     ],
