@@ -17,7 +17,7 @@ from affordance_env.robot_model import ACTIVE_JOINTS
 
 register_envs()
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 
 def __getattr__(name: str):

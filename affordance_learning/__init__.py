@@ -11,7 +11,7 @@
   and its outputs (``affordance reproduce`` runs them end to end for the tap and the grasp).
 """
 
-__version__ = "0.2.0"
+__version__ = "0.3.0"
 
 from affordance_learning.default_model import (  # noqa: E402 (after __version__, which it reads)
     DefaultModelError,

@@ -33,6 +33,14 @@ def test_spheres_and_boxes_get_different_effects(observations):
     assert np.all(np.abs(boxes.effect[:, mean_y]) < 0.04)
 
 
+def test_the_shipped_models_keep_the_best_of_their_maps():
+    # trained as train-default trains them: the map of lowest quantization error of DEFAULT_SOM_N_INIT seeds
+    for behavior in ("tap", "grasp"):
+        model = joblib.load(default_model.model_path(behavior))["model"]
+        assert model.som_n_init == default_model.DEFAULT_SOM_N_INIT
+        assert model.som_.seed_ in range(default_model.DEFAULT_SOM_N_INIT)
+
+
 def test_one_vector_and_dataframe(observations):
     one = predict_effect(observations["sphere"][0])
     assert one.category.shape == (1,)
