@@ -70,5 +70,6 @@ class EnvOptions:
         known = [f.name for f in dataclasses.fields(cls)]
         unknown = sorted(set(options) - set(known))
         if unknown:
-            raise ValueError(f"Unknown options {unknown} of TapAffordance-v0; its data options are {known}.")
+            raise ValueError(f"unknown or unsupported env options {unknown}; the data options of TapAffordance-v0 "
+                             f"(what a dataset records) are {known}.")
         return cls(**options)

@@ -248,8 +248,10 @@ class TapAffordanceEnv(gym.Env):
         render_width: int = 480,
         render_height: int = 360,
     ) -> None:
-        options = EnvOptions(behavior, object_types, size_range, camera_width, camera_height, camera_fovy,
-                             roll_threshold, settle_timeout, range_noise)  # checked and normalised
+        options = EnvOptions(behavior=behavior, object_types=object_types, size_range=size_range,
+                             camera_width=camera_width, camera_height=camera_height, camera_fovy=camera_fovy,
+                             roll_threshold=roll_threshold, settle_timeout=settle_timeout,
+                             range_noise=range_noise)  # checked and normalised
         self._check_render_mode(render_mode)
         self.behavior = get_behavior(options.behavior)
         self.object_types = options.object_types

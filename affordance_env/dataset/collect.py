@@ -122,13 +122,8 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) ->
 def _full_options(env_options: dict[str, Any]) -> dict[str, Any]:
     """The env options with every default filled in, as JSON values, so that equal settings compare equal;
     checked (:class:`~affordance_env.options.EnvOptions`) without building an env or importing the simulator."""
-    fields = dataclasses.fields(EnvOptions)
-    allowed = [f.name for f in fields]
-    unknown = sorted(set(env_options) - set(allowed))
-    if unknown:
-        raise ValueError(f"unknown or unsupported env options {unknown} for collection; allowed: {allowed}.")
-    EnvOptions(**env_options)
-    full = {f.name: f.default for f in fields}
+    EnvOptions.checked(**env_options)
+    full = {f.name: f.default for f in dataclasses.fields(EnvOptions)}
     full.update(env_options)
     return json.loads(json.dumps(full, default=list))
 
