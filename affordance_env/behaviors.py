@@ -29,16 +29,18 @@ index       meaning                                                          ran
 ==========  ===============================================================  ======================
 0           height of the palm above the object's top when the hand closes   -0.5 .. +1.5 cm
 1           offset of the object across the hand (towards the little finger) -1.5 .. +1.5 cm
-2           time to close the hand, 0.4 s / 2 ** action[2]                   0.8 .. 0.2 s
+2           finger speed while closing, 0.75 + 0.25 action[2] of the motors'  0.5 .. 1 of 180 deg/s
+            speed limit
 ==========  ===============================================================  ======================
 
 The grasp: palm down above the object, fingers pointing forward and to the right (60 degrees right of straight
 ahead; turned with the object's yaw), the thumb opposed (under the palm, on the robot's side) and the fingers
-open; the palm descends to just above the object's top, the fingers and the thumb close on a ramp, the palm
-rises LIFT_HEIGHT and holds still for HOLD_TIME, then carries the object PLACE_SHIFT to the robot's left, lowers
-it to the table and opens the hand. An object fits the open hand if it passes between the thumb, which hangs
-6.4 cm below the palm, and the fingertips: larger objects meet the thumb on the way down and are not enclosed,
-which makes a critical size of about 7 cm (10-11 cm for spheres, which the fingers wrap).
+open; the palm descends slowly towards just above the object's top and stops there or at the first touch, the
+fingers and the thumb close until their motors' torque holds what they meet, the palm rises LIFT_HEIGHT and
+holds still for HOLD_TIME; a held object is then carried PLACE_SHIFT to the robot's left and lowered until it
+rests on the table, and the hand opens (an object not held is left where it is: the hand opens above it). An
+object fits the open hand if it passes between the thumb, which hangs 6.4 cm below the palm, and the
+fingertips: larger objects meet the thumb on the way down and are not enclosed, which makes a critical size.
 """
 
 from __future__ import annotations
@@ -314,11 +316,16 @@ GRASP_CENTRE_HAND = (0.03, -0.025)
 GRASP_GAP, GRASP_HEIGHT_RANGE = 0.005, 0.01
 #: Shift of the object across the hand (along the palm's y axis) at action[1] = +-1 [m].
 GRASP_LATERAL_RANGE = 0.015
-#: Time to close the hand at action[2] = 0 [s], and the factor by which action[2] = -1 / +1 lengthens / shortens it.
-CLOSE_TIME_CANONICAL, CLOSE_TIME_FACTOR = 0.4, 2.0
-#: Height of the approach pose above the grasp pose [m]: the open hand's lowest point, the thumb's tip, hangs
-#: 6.4 cm below the palm.
-GRASP_APPROACH_HEIGHT = 0.08
+#: The fingers close at this share of their motors' speed limit at action[2] = 0, and action[2] = +-1 adds or takes
+#: CLOSE_SPEED_RANGE of it.
+CLOSE_SPEED_CANONICAL, CLOSE_SPEED_RANGE = 0.75, 0.25
+#: How far the open hand's lowest point, the thumb's tip, hangs below the palm [m].
+OPEN_HAND_DEPTH = 0.058
+#: Clearance between the open hand's lowest point and the object's top at the approach pose [m], from which the
+#: hand descends slowly: nothing can touch before.
+GRASP_GUARD_CLEARANCE = 0.01
+#: Height of the retreat above where the hand opened [m].
+GRASP_RETREAT_HEIGHT = 0.08
 #: The palm rises this much [m] with the closed hand, and holds still there for HOLD_TIME [s].
 LIFT_HEIGHT, HOLD_TIME = 0.08, 1.0
 #: Where the object is put down, relative to where it was [m] (world x, y): to the robot's left, towards the
@@ -340,20 +347,29 @@ HAND_CLOSED: dict[str, float] = {
 }
 
 
+#: Driven finger joints [rad] of the hand that lets go: the open hand's, with the thumb turned out from under the
+#: object (opposition 0.3 rad: its tip 6.5 cm from the object's axis instead of 4.3), so that the hand rises from an
+#: object it has put down without touching it.
+HAND_RELEASE: dict[str, float] = {**HAND_OPEN, "l_hand_metacarpus_joint": 0.3}
+
+
 @dataclass(frozen=True)
 class GraspPlan:
     """Cartesian plan of one grasp: palm positions (``l_hand_dh_frame`` origin, world frame) [m].
 
     Attributes:
-        p_above: Above the grasp pose, high enough that the open hand clears the object; reached first.
+        p_above: Above the grasp pose, the open hand's lowest point GRASP_GUARD_CLEARANCE above the object's top;
+            reached first, and the slow descent starts there.
         p_grasp: Where the hand closes: the palm just above the object's top.
         p_lift: Where the closed hand holds the object: LIFT_HEIGHT above ``p_grasp``.
         p_place: Where the hand opens: PLACE_SHIFT beside ``p_grasp`` and PLACE_CLEARANCE above it.
-        p_retreat: Above ``p_place``, where the open hand withdraws before going home.
+        p_retreat: GRASP_RETREAT_HEIGHT above ``p_place``: the open hand withdraws upward this far before going
+            home.
         R_world_hand: Palm orientation throughout.
-        close_time: Duration of the closing ramp [s].
+        close_speed: Speed of the closing fingers, a share of their motors' speed limit.
         hold_time: How long the lifted object is held still [s].
-        hand_open, hand_closed: Targets of the driven finger joints [rad], by joint name.
+        hand_open, hand_closed, hand_release: Targets of the driven finger joints [rad], by joint name: the
+            open hand of the approach, the closed hand, and the hand that lets go.
     """
 
     p_above: np.ndarray
@@ -362,10 +378,11 @@ class GraspPlan:
     p_place: np.ndarray
     p_retreat: np.ndarray
     R_world_hand: np.ndarray
-    close_time: float
+    close_speed: float
     hold_time: float
     hand_open: dict[str, float]
     hand_closed: dict[str, float]
+    hand_release: dict[str, float]
 
 
 def plan_grasp(
@@ -392,14 +409,15 @@ def plan_grasp(
     p_grasp[2] = top + GRASP_GAP + a[0] * GRASP_HEIGHT_RANGE
     p_place = p_grasp + np.array([PLACE_SHIFT[0], PLACE_SHIFT[1], PLACE_CLEARANCE])
     return GraspPlan(
-        p_above=p_grasp + np.array([0.0, 0.0, GRASP_APPROACH_HEIGHT]),
+        p_above=np.array([p_grasp[0], p_grasp[1], max(p_grasp[2], top + OPEN_HAND_DEPTH + GRASP_GUARD_CLEARANCE)]),
         p_grasp=p_grasp,
         p_lift=p_grasp + np.array([0.0, 0.0, LIFT_HEIGHT]),
         p_place=p_place,
-        p_retreat=p_place + np.array([0.0, 0.0, GRASP_APPROACH_HEIGHT]),
+        p_retreat=p_place + np.array([0.0, 0.0, GRASP_RETREAT_HEIGHT]),
         R_world_hand=R,
-        close_time=float(CLOSE_TIME_CANONICAL / CLOSE_TIME_FACTOR ** a[2]),
+        close_speed=float(CLOSE_SPEED_CANONICAL + CLOSE_SPEED_RANGE * a[2]),
         hold_time=HOLD_TIME,
         hand_open=dict(HAND_OPEN),
         hand_closed=dict(HAND_CLOSED),
+        hand_release=dict(HAND_RELEASE),
     )

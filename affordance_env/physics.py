@@ -63,6 +63,7 @@ class TapPhysics:
         joint = _id(model, obj.mjOBJ_JOINT, "object_free")
         self.object_qpos = int(model.jnt_qposadr[joint])
         self.object_qvel = int(model.jnt_dofadr[joint])
+        self._joint_ids = np.array([_id(model, obj.mjOBJ_JOINT, n) for n in joints])
         self.robot_qpos = np.array([model.jnt_qposadr[_id(model, obj.mjOBJ_JOINT, n)] for n in joints])
         self.robot_qvel = np.array([model.jnt_dofadr[_id(model, obj.mjOBJ_JOINT, n)] for n in joints])
         actuated = self.variant.actuated_joints
@@ -86,6 +87,10 @@ class TapPhysics:
         self._is_hand_geom = np.zeros(model.ngeom, dtype=bool)
         self._is_hand_geom[self.hand_geoms] = True
         self._hand_geom_list = self.hand_geoms.tolist()
+        self._hand_rbound = model.geom_rbound[self.hand_geoms].copy()
+        #: Torque limit of each active joint's motor [N m] (inf for a joint without a motor of its own).
+        self.torque_limit = np.where(model.jnt_actfrclimited[self._joint_ids], model.jnt_actfrcrange[self._joint_ids, 1],
+                                     np.inf)
         #: Servo stiffness kp [N m/rad] and kv / kp [s] per active joint (a coupled joint has no servo: infinite
         #: stiffness, no lead). A target led by kv / kp times the reference velocity cancels the servo's damping
         #: lag, so the joint follows a moving reference (velocity feedforward).
@@ -144,6 +149,20 @@ class TapPhysics:
         """Robot joint velocities in active-joint order [rad/s]."""
         return self.data.qvel[self._qvel].copy()
 
+    def joint_torques(self) -> np.ndarray:
+        """Motor torques at the robot's joints in active-joint order [N m], gravity compensation included (the
+        actuators carry it)."""
+        return self.data.qfrc_actuator[self._qvel].copy()
+
+    def limit_torques(self, joints: np.ndarray, limit: np.ndarray | float | None) -> None:
+        """Let the motors of ``joints`` (indices in active-joint order) give at most ``limit`` [N m], at most their
+        own limits (a current limit set by the controller); None: their own limits again."""
+        ids = self._joint_ids[joints]
+        own = self.torque_limit[joints]
+        value = own if limit is None else np.minimum(own, limit)
+        self.model.jnt_actfrcrange[ids, 0] = -value
+        self.model.jnt_actfrcrange[ids, 1] = value
+
     def set_joint_targets(self, q: np.ndarray) -> None:
         """Command the position servos to ``q`` [rad] (active-joint order), clipped to the joint ranges; the values
         of coupled joints, which have no servo, are ignored."""
@@ -198,6 +217,14 @@ class TapPhysics:
                 links.add(self.body_names[self.model.geom_bodyid[g1]])
         return links
 
+    def hand_touches_table(self) -> bool:
+        """Whether any contact joins the hand (or wrist, forearm, fingers) and the table top."""
+        table, hand = self.table_geom, self._is_hand_geom
+        for g1, g2 in self.data.contact.geom[: self.data.ncon].tolist():
+            if (g1 == table and hand[g2]) or (g2 == table and hand[g1]):
+                return True
+        return False
+
     def object_touches_table(self) -> bool:
         """Whether any contact joins the object and the table top."""
         pair = {self.active_geom, self.table_geom}
@@ -208,6 +235,19 @@ class TapPhysics:
         step (MuJoCo's ``mj_geomDistance``); ``max_distance`` if they are at least that far apart."""
         model, data, obj = self.model, self.data, self.active_geom
         return min(mujoco.mj_geomDistance(model, data, g, obj, max_distance, None) for g in self._hand_geom_list)
+
+    def arm_object_distance(self, max_distance: float) -> float:
+        """Smallest distance between the robot's geoms that touch the world (hand, fingers, wrist, forearm) and
+        the object [m]; ``max_distance`` if they are at least that far apart. Geoms whose bounding spheres are that
+        far from the object's are not measured further."""
+        data, obj = self.data, self.active_geom
+        gap = (np.linalg.norm(data.geom_xpos[self.hand_geoms] - data.geom_xpos[obj], axis=1)
+               - self._hand_rbound - self.model.geom_rbound[obj])
+        near = self.hand_geoms[gap < max_distance]
+        if near.size == 0:
+            return max_distance
+        model = self.model
+        return min(mujoco.mj_geomDistance(model, data, int(g), obj, max_distance, None) for g in near)
 
     def hand_touches_object(self) -> bool:
         """Whether any contact joins the hand (or wrist, forearm) and the object."""

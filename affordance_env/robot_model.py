@@ -94,7 +94,7 @@ HAND_COUPLINGS: dict[str, tuple[str, tuple[float, ...]]] = {
 #: metacarpus, thumb opposition, at 1.1 rad: at 0 the thumb lies in the palm's plane, pointing away from the
 #: fingers' side; the grasp turns it further as it closes).
 HAND_OPEN: dict[str, float] = {
-    "l_hand_metacarpus_joint": 1.1,
+    "l_hand_metacarpus_joint": 0.9,
     "l_hand_thumb_rotation_joint": 0.0,
     "l_hand_thumb_proximal_joint": 0.0,
     "l_hand_index_adduction_joint": 0.0,
@@ -136,6 +136,16 @@ def coupled_position(distal: str, q_proximal: float | np.ndarray) -> float | np.
     for c in reversed(HAND_COUPLINGS[distal][1]):  # Horner's scheme
         angle = angle * q + c
     return angle
+
+
+def coupled_slope_max(distal: str) -> float:
+    """Largest rate of the coupled ``distal`` joint per unit rate of its proximal joint, over the proximal joint's
+    range (0 to 95 degrees): how much faster than its motor's joint the linkage can turn it."""
+    if distal not in HAND_COUPLINGS:
+        raise ValueError(f"{distal!r} is not a coupled joint. Coupled joints: {', '.join(HAND_COUPLINGS)}.")
+    c = HAND_COUPLINGS[distal][1]
+    q = np.linspace(0.0, np.radians(95.0), 200)
+    return float(np.max(np.abs(sum(i * c[i] * q ** (i - 1) for i in range(1, len(c))))))
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@ import numpy as np
 
 from affordance_env.assets_path import assets_dir
 from affordance_env.model_cache import cached_model
+from affordance_env.motor_limits import torque_limits
 from affordance_env.robot_model import (
     CAMERA_VISIBLE_LINKS,  # noqa: F401 (the tap variant's, named here beside the geom groups as before)
     HAND_COUPLINGS,
@@ -47,6 +48,23 @@ ROBOT_GEOM_GROUP, SEEN_ROBOT_GEOM_GROUP = 1, 2
 
 #: Sliding friction of the hand's contact geoms (they take priority over the object's friction).
 HAND_FRICTION = 0.3
+#: Contact stiffness of every robot geom that touches the world (they take priority over the object's and the
+#: table's, so their values govern hand-object and hand-table contacts): MuJoCo's solref (time constant [s],
+#: damping ratio) and solimp. 10 ms, the shortest time constant that MuJoCo resolves stably at the interactions'
+#: 5 ms timestep (two steps), and an impedance of 0.99, nearly hard: a finger pressing with its motor's full
+#: torque sinks about a millimetre into what it holds, where MuJoCo's default (20 ms, 0.9-0.95) let it sink 3-15
+#: mm. Critically damped for the fingers (they squeeze, they do not strike); the tapping hand's damping ratio
+#: sets the palm's restitution on a struck object (PALM_RESTITUTION).
+CONTACT_SOLREF = (0.01, 1.0)
+CONTACT_SOLIMP = (0.995, 0.995, 0.001, 0.5, 2.0)
+#: Coefficient of restitution of an object struck by the palm of the tapping hand (or its back): the share of its
+#: approach speed a ball takes away from a still palm. The iCub's palm is its plastic shell under the tactile
+#: skin, a few millimetres of soft silicone over the sensors; a hard ball on such an elastomer-covered pad
+#: rebounds with 0.2-0.4 of its speed (a bare plastic shell: 0.6-0.8). PALM_SOLREF gives it: its damping ratio
+#: 0.4 returns 0.27-0.31 of the speed at 0.06-0.54 m/s at the stroke's 2 ms timestep (``tests/test_scene.py``
+#: measures it). At 1 (critical damping) a ball would keep a tenth of its speed, as on a lump of clay.
+PALM_RESTITUTION = 0.3
+PALM_SOLREF = (0.01, 0.4)
 #: Friction of the fingered hand's geoms (grasp variant): sliding, torsional [m], rolling [m]. The mk3 hand's
 #: fingertips and palm carry the iCub's tactile skin under a silicone cover; silicone rubber on wood or plastic
 #: has a sliding friction coefficient of about 1 (0.8-1.2 in handbook tables), which is what lets a hand hold
@@ -95,6 +113,11 @@ HAND_KP, HAND_DAMPING, HAND_ARMATURE = 1.0, 0.03, 1e-3
 #: says why): a grasp takes 667 steps, 2065 at 2 ms, and costs about 1.7 taps on one core
 #: (``benchmarks/env.py --behavior tap grasp``). It divides the 10 ms control tick.
 GRASP_TIMESTEP = 0.005
+#: Ratio of the frictional to the normal constraints' impedance (MuJoCo's ``impratio``, elliptic cones) of the
+#: grasp variant: friction as hard as the grip's normal forces, so that a held object does not creep in the
+#: fingers (the tap scene's 10 let it creep at up to 2 mm/s under a steady squeeze; at 300, 0.1-0.6 mm/s) without
+#: raising the friction coefficients themselves.
+GRASP_IMPRATIO = 300.0
 #: Coupling of the distal finger joints to their proximal joints (MuJoCo ``equality joint``): the linkage is
 #: stiff, so the constraint is solved with a time constant of 10 ms (2 timesteps of the grasp variant, MuJoCo's
 #: stable minimum) and critical damping.
@@ -108,7 +131,10 @@ RANGE_CAMERA_QUAT_HEAD = (0.0, 0.0, 1.0, 0.0)
 RANGE_CAMERA_FOVY_DEG = 50.0
 
 #: The ``home`` keyframe: arm raised above the table beside the workspace, head looking down at the table; the
-#: wrist yawed as every stroke holds it (``behaviors.FOREARM_RAISED``), so reaching does not swing it.
+#: wrist yawed as every stroke holds it (``behaviors.FOREARM_RAISED``), so reaching does not swing it. The
+#: forearm's lowest point is 14.8 cm above the table top, so an object of any size (at most 10 cm) that rolls under
+#: the arm waiting at home passes beneath it (at the earlier 5.8 cm, large lying cylinders tapped back towards
+#: home came to rest against the forearm).
 HOME_QPOS: dict[str, float] = {
     "torso_pitch": 0.4,
     "torso_roll": 0.0,
@@ -116,10 +142,10 @@ HOME_QPOS: dict[str, float] = {
     "neck_pitch": -0.5,
     "neck_roll": 0.0,
     "neck_yaw": 0.0,
-    "r_shoulder_pitch": -1.0,
-    "r_shoulder_roll": 0.45,
+    "r_shoulder_pitch": -1.4,
+    "r_shoulder_roll": 0.6,
     "r_shoulder_yaw": 0.0,
-    "r_elbow": 1.2,
+    "r_elbow": 1.5,
     "r_wrist_prosup": 0.0,
     "r_wrist_pitch": 0.0,
     "r_wrist_yaw": -0.33,
@@ -131,10 +157,10 @@ HOME_QPOS: dict[str, float] = {
 #: (HAND_OPEN: the thumb opposed to the fingers) and each distal joint where its coupling puts it.
 GRASP_HOME_QPOS: dict[str, float] = {
     **{name: HOME_QPOS[name] for name in TORSO_JOINTS + NECK_JOINTS},
-    "l_shoulder_pitch": -1.0,
-    "l_shoulder_roll": 0.45,
+    "l_shoulder_pitch": -1.4,
+    "l_shoulder_roll": 0.6,
     "l_shoulder_yaw": 0.0,
-    "l_elbow": 1.2,
+    "l_elbow": 1.5,
     "l_wrist_prosup": 0.0,
     "l_wrist_pitch": 0.0,
     "l_wrist_yaw": 0.0,
@@ -221,10 +247,12 @@ def phalanx_capsules() -> dict[str, tuple[tuple[float, float, float], float, flo
     return capsules
 
 
-def _contact_geom(geom: mujoco.MjsGeom) -> None:
+def _contact_geom(geom: mujoco.MjsGeom, solref: tuple[float, float] = CONTACT_SOLREF) -> None:
     geom.contype = ROBOT_CONTYPE
     geom.conaffinity = ROBOT_CONAFFINITY
     geom.priority = 1
+    geom.solref = list(solref)
+    geom.solimp = list(CONTACT_SOLIMP)
 
 
 def hand_spec() -> mujoco.MjSpec:
@@ -281,14 +309,14 @@ def robot_spec(variant: str = "tap") -> mujoco.MjSpec:
         for i, geom in enumerate(body.geoms):
             geom.name = f"{body.name}_collision" + (f"_{i}" if i else "")
             contact = body.name in contact_links
-            geom.contype = ROBOT_CONTYPE if contact else 0
-            geom.conaffinity = ROBOT_CONAFFINITY if contact else 0
+            geom.contype = 0
+            geom.conaffinity = 0
             geom.rgba = [0.75, 0.75, 0.78, 1.0]
             geom.group = SEEN_ROBOT_GEOM_GROUP if body.name in visible_links else ROBOT_GEOM_GROUP
             if contact:
                 # The hand's shell is smooth plastic: low friction, and it wins over the object's friction.
                 geom.friction = [HAND_FRICTION, 0.005, 0.0001]
-                geom.priority = 1
+                _contact_geom(geom, PALM_SOLREF)
         # 3. Gravity compensation on every link, as the iCub's own controllers do.
         if body.name != "world":
             body.gravcomp = 1.0
@@ -350,15 +378,25 @@ def build_spec(variant: str = "tap") -> mujoco.MjSpec:
                 element.name = element.name.removeprefix(_PREFIX)
     # 6. Position actuators on every actuated joint. (No sensors: a touch sensor on the palm cost 4-9 % of every
     #    step, and the contacts between hand and object are read from the contact list when needed.)
+    #    Each motor's torque is limited (motor_limits), gravity compensation included: it is routed through the
+    #    actuators, as the iCub's controllers compensate gravity with the same motors.
+    torque_limit = dict(zip(variant_.actuated_joints, torque_limits(variant_.actuated_joints), strict=True))
+    for joint in spec.joints:
+        if joint.name in variant_.active_joints:
+            joint.actgravcomp = True
+            joint.actfrclimited = False  # the URDF's placeholder effort (50 000); a motor's limit below
     for name in variant_.actuated_joints:
         joint = spec.joint(name)
         act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         act.set_to_position(kp=_servo_kp(name), dampratio=1.0)
         act.ctrlrange = joint.range
         act.ctrllimited = True
+        joint.actfrcrange = [-torque_limit[name], torque_limit[name]]
+        joint.actfrclimited = True
     # 6b. The fingered hand's coupling: each distal joint follows its proximal joint; its timestep.
     if variant_.fingered:
         spec.option.timestep = GRASP_TIMESTEP
+        spec.option.impratio = GRASP_IMPRATIO
     for distal, (proximal, coefficients) in HAND_COUPLINGS.items() if variant_.fingered else ():
         equality = spec.add_equality(name=f"{distal}_coupling", type=mujoco.mjtEq.mjEQ_JOINT, name1=distal,
                                      name2=proximal, objtype=mujoco.mjtObj.mjOBJ_JOINT, solref=list(COUPLING_SOLREF))

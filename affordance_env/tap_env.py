@@ -54,9 +54,11 @@ REST_SPEED, REST_ANGULAR_SPEED = 1e-3, 1e-2
 MAX_START_ERROR, MAX_OBJECT_MOVED_BEFORE = 0.01, 0.003
 
 
-def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: tuple[bool, bool]) -> str | None:
+def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: tuple[bool, bool],
+                    touched_on_way_home: bool = False) -> str | None:
     """Why an interaction cannot be used, or None; see the class docstring. ``stroke``: a StrokeOutcome or a
-    GraspOutcome; ``still``: whether the robot was still for the initial and for the final snapshot."""
+    GraspOutcome; ``still``: whether the robot was still for the initial and for the final snapshot;
+    ``touched_on_way_home``: the arm touched the object again after it had been clear of it."""
     if fault is not None:
         return f"physics: {fault}"
     for snapshot, was_still in zip(("initial", "final"), still, strict=True):
@@ -69,6 +71,8 @@ def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: t
     if not stroke.ik_success:
         return (f"ik: the {what} was not reachable (position error {stroke.ik_position_error * 1e3:.1f} mm, "
                 f"orientation error {stroke.ik_orientation_error:.2f} rad)")
+    if touched_on_way_home:
+        return "home: the arm touched the object on its way home"
     if what == "grasp":  # the hand meets the object on its way down, and may miss it: that is the grasp's outcome
         return None
     if stroke.object_moved > MAX_OBJECT_MOVED_BEFORE:
@@ -459,7 +463,7 @@ class TapAffordanceEnv(gym.Env):
         try:
             stroke = self.motion.grasp(plan) if grasping else self.motion.stroke(plan)
             with self._free_stepping():
-                still = self.motion.go_home(self._q_home, via=None if grasping else stroke.q_withdraw)
+                home = self.motion.go_home(self._q_home, via=stroke.q_retreat if grasping else stroke.q_withdraw)
                 # The outcome is awaited from the first touch of a stroke, or from the release of a grasp.
                 since = stroke.release_time if grasping else (
                     stroke.contact_time if stroke.contact else physics.data.time)
@@ -479,7 +483,7 @@ class TapAffordanceEnv(gym.Env):
             final_features = NOT_VISIBLE_VALUES
             final_pose = np.full(7, np.nan)
             visible = False
-        failure = _failure_reason(fault, initial["visible"], stroke, (initial["still"], still))
+        failure = _failure_reason(fault, initial["visible"], stroke, (initial["still"], home.still), home.touched)
         # Travel on the table: to where the object rests, or to where it left the table (not where it fell).
         p_end = monitor.exit_position if monitor.left_table else final_pose
         displacement = 0.0 if fault else float(np.linalg.norm(p_end[:2] - initial["pose"][:2]))
