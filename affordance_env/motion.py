@@ -28,6 +28,9 @@ from affordance_env.trajectory import JointTrajectory, line_profile, minimum_jer
 
 #: Period of the servo set-point updates [s].
 CONTROL_DT = 0.01
+#: Moves are planned for this share of the joints' velocity limits: the servos follow a plan to within a few per
+#: cent, and overshoot it by up to 5 % where a move starts, stops or meets contact (``benchmarks/physics_audit.py``).
+PLANNED_SPEED_SHARE = 0.95
 #: Shortest move [s]: three control ticks, so that even a tiny correction is a smooth profile.
 MIN_MOVE_TIME = 0.03
 #: The hand must be this close to the pre-stroke pose before the stroke starts [m], waiting at most
@@ -60,7 +63,7 @@ IK_POSITION_TOLERANCE, IK_ORIENTATION_TOLERANCE = 0.005, 0.35
 LINE_RAMP = 0.1
 #: The stroke reaches its speed in this time [s] from rest, within the first 3 cm (the clearance before the
 #: object) even at its fastest.
-STROKE_RAMP = 0.05
+STROKE_RAMP = 0.1
 #: Speed of the grasp's guarded moves [m/s]: the hand's final approach to the object, with its lowest point
 #: within GUARD_CLEARANCE of the object's top, and the put-down of a held object. A careful robot's speed near
 #: what it touches: the first touch is at most this fast, and stops the move (the fingertips' and palm's tactile
@@ -232,12 +235,13 @@ class LinePath:
         spans = len(self._s_ik) - 1 if check_waypoints is None else min(check_waypoints, len(self._s_ik) - 1)
         rates = [np.abs(self._waypoint(k) - self._waypoint(k - 1)) / (self._s_ik[k] - self._s_ik[k - 1])
                  for k in range(1, spans + 1)]  # joint rates per metre of the palm [rad/m]
-        limit = executor.velocity_limit
+        limit = executor.planned_speed
         cap = min(float(np.min(limit / np.maximum(rate, 1e-12))) for rate in rates)
         #: Cruise speed of the palm [m/s]: the one asked for, or the most the joints allow.
         self.speed = min(float(speed), cap)
         profile = line_profile(length, self.speed, CONTROL_DT, ramp=ramp, to_rest=to_rest)
         self._s, self._v = profile[:, 0], profile[:, 1]
+        self._a = np.diff(self._v, prepend=0.0) / CONTROL_DT  # the palm's acceleration along the line [m/s^2]
 
     def __len__(self) -> int:
         return len(self._s)
@@ -251,14 +255,14 @@ class LinePath:
             self._q_ik.append(result.q)
         return self._q_ik[k]
 
-    def target(self, i: int) -> tuple[np.ndarray, np.ndarray]:
-        """Joint targets [rad] and velocities [rad/s] of tick ``i``."""
+    def target(self, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Joint targets [rad], velocities [rad/s] and accelerations [rad/s^2] of tick ``i``."""
         s = self._s[i]
         k = min(max(int(np.searchsorted(self._s_ik, s)), 1), len(self._s_ik) - 1)
         q0, q1 = self._waypoint(k - 1), self._waypoint(k)
         span = self._s_ik[k] - self._s_ik[k - 1]
         rate = (q1 - q0) / span
-        return q0 + (s - self._s_ik[k - 1]) * rate, rate * self._v[i]
+        return q0 + (s - self._s_ik[k - 1]) * rate, rate * self._v[i], rate * self._a[i]
 
 
 class MotionExecutor:
@@ -275,8 +279,10 @@ class MotionExecutor:
         self.kinematics = kinematics
         self._opt = physics.model.opt  # MuJoCo's options, read at every tick: the wrapper is made once
         self._tick_timestep, self._steps_per_tick = 0.0, 1  # the last timestep seen, and its steps per tick
-        #: Velocity limit of every active joint [rad/s] (:mod:`affordance_env.motor_limits`).
+        #: Velocity limit of every active joint [rad/s] (:mod:`affordance_env.motor_limits`) ...
         self.velocity_limit = velocity_limits(physics.variant.active_joints)
+        #: ... and the speeds moves are planned for [rad/s]: PLANNED_SPEED_SHARE of it.
+        self.planned_speed = PLANNED_SPEED_SHARE * self.velocity_limit
         #: Timestep [s] of a tap interaction outside its stroke (FREE_TIMESTEP); the scene's own (2 ms) steps the
         #: whole interaction as finely as the stroke (``benchmarks/timestep.py`` compares the two).
         self.free_timestep = free_timestep
@@ -346,7 +352,7 @@ class MotionExecutor:
                      until: Callable[[], bool] | None = None) -> bool:
         """Move through ``waypoints`` (joint targets) to the last one, without stopping at the ones before
         (:func:`~affordance_env.trajectory.minimum_jerk`); see :meth:`follow` for ``until``."""
-        trajectory = minimum_jerk(self.physics.joint_targets(), waypoints, self.velocity_limit, CONTROL_DT,
+        trajectory = minimum_jerk(self.physics.joint_targets(), waypoints, self.planned_speed, CONTROL_DT,
                                   duration=duration, min_duration=MIN_MOVE_TIME)
         return self.follow(trajectory, until)
 
@@ -427,11 +433,12 @@ class MotionExecutor:
         p_touch, time, speed = palm.copy(), float("nan"), 0.0
         touched_yet = done = False
         for i in range(len(path)):
-            q, qd = path.target(i)
-            physics.set_joint_targets(q + lead * qd)
+            q, qd, qdd = path.target(i)
+            q_led = q + lead * qd  # velocity feedforward, and the inertial feedforward of the line's acceleration
             if touched is None:
-                physics.step(n_steps)
+                physics.step_toward(q_led, qdd, n_steps)
                 continue
+            physics.set_joint_targets(q_led + physics.inertial_lead(qdd))
             fine = per_step and (touched_yet or physics.hand_object_distance(CONTACT_WATCH_DISTANCE)
                                  < CONTACT_WATCH_DISTANCE)
             if not fine:  # whole ticks: the touch to the tick
@@ -483,9 +490,9 @@ class MotionExecutor:
         physics = self.physics
         above, start = self.plan_approach(plan)
         length = float(np.dot(plan.p_end - plan.p_start, plan.direction))
-        # The joint speeds of the first two spans (the clearance and the contact) cap the stroke's speed.
+        # The joint speeds along the whole line cap the stroke's speed.
         path = LinePath(self, plan.p_start, plan.direction, length, plan, plan.speed, start.q, ramp=STROKE_RAMP,
-                        to_rest=False, check_waypoints=2)
+                        to_rest=False)
         p_object_before = physics.object_pose()[:3]
         self.phase = "reach"
         with self.stepping(self.free_timestep):  # the object rests and the hand moves in free space
@@ -516,7 +523,7 @@ class MotionExecutor:
         its motor's full torque (the closing of a hand that has stalled on what it holds)."""
         physics = self.physics
         q_to = self._with_hand(physics.joint_targets(), hand)
-        trajectory = minimum_jerk(physics.joint_targets(), [q_to], self.velocity_limit * speed_scale,
+        trajectory = minimum_jerk(physics.joint_targets(), [q_to], self.planned_speed * speed_scale,
                                   CONTROL_DT, min_duration=MIN_MOVE_TIME)
         fingers = np.array([self.kinematics.joint_names.index(name) for name in hand])
         target = q_to[fingers]
