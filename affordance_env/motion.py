@@ -79,16 +79,14 @@ FINGER_STALL_SPEED, FINGER_ARRIVED = 0.05, 0.02
 #: arrived (a current limit of the hand's controller, a third of its motors' limit): a light touch that finds the
 #: object without sweeping it away. Then they squeeze with their motors' full torque.
 CLOSING_TORQUE = 0.1
+#: Share of their speed limit at which the fingers open to let down an object that does not touch the table yet.
+RELEASE_SPEED_SHARE = 0.25
 #: Once the closing fingers hold, their grip rises to the motors' full torque over this time [s].
 GRASP_SQUEEZE_TIME = 0.1
-#: Timestep [s] of the simulation while the hand carries what it holds: the lift, the 1 s hold and the carry to
-#: above where it is put down. The grasp's contacts, where they form and break (the descent, the closing, the
-#: put-down, the opening), step at the scene's 5 ms (``scene.GRASP_TIMESTEP``).
-GRASP_CARRY_TIMESTEP = 0.005
 #: The carry brings a held object to this height above where it would touch the table [m]; the guarded
 #: put-down goes on from there until it does (or PLACE_OVERTRAVEL lower).
 PLACE_APPROACH = 0.02
-PLACE_OVERTRAVEL = 0.01
+PLACE_OVERTRAVEL = 0.02
 #: Way home: the arm that comes within HOME_CLEARANCE [m] of the object stops and waits for the object to
 #: come to rest (at most HOME_WAIT [s]), then goes home through a pose HOME_RAISE [m] higher above it.
 HOME_CLEARANCE, HOME_WAIT, HOME_RAISE = 0.015, 3.0, 0.06
@@ -527,7 +525,7 @@ class MotionExecutor:
                                   CONTROL_DT, min_duration=MIN_MOVE_TIME)
         fingers = np.array([self.kinematics.joint_names.index(name) for name in hand])
         target = q_to[fingers]
-        limit = np.minimum(physics.torque_limit[fingers], CLOSING_TORQUE) if until_held else physics.torque_limit[fingers]
+        limit = np.minimum(physics.torque_limit[fingers], CLOSING_TORQUE)
 
         def held() -> bool:
             q, qd, torque = physics.joint_positions(), physics.joint_velocities(), physics.joint_torques()
@@ -542,6 +540,7 @@ class MotionExecutor:
         try:
             self.follow(trajectory, held)
             # ... then the grip rises to the motors' full torque over GRASP_SQUEEZE_TIME, without a jolt
+            self.phase = "squeeze"
             full = physics.torque_limit[fingers]
             n = max(1, round(GRASP_SQUEEZE_TIME / CONTROL_DT))
             for k in range(1, n + 1):
@@ -553,7 +552,7 @@ class MotionExecutor:
     def grasp(self, plan: GraspPlan) -> GraspOutcome:
         """Reach above the object with the open hand, descend slowly until the hand touches it or is at the grasp
         pose, close the hand, lift, hold; if the object is held, carry it beside and put it down until it rests on
-        the table; open the hand, and retreat upward. Not the way home."""
+        the table; open the hand once the object rests. Not the way home, which rises first (``q_retreat``)."""
         physics = self.physics
         q_open = self._with_hand(physics.joint_targets(), plan.hand_open)
         results = [self._ik(plan.p_above, q_open, plan)]
@@ -572,38 +571,47 @@ class MotionExecutor:
         # Close: the fingers at the plan's share of their speed limit, until their motors' torque holds the object.
         self.phase = "close"
         self._fingers(plan.hand_closed, plan.close_speed, until_held=True)
-        with self.stepping(GRASP_CARRY_TIMESTEP):
-            self.phase = "lift"
-            p_from = physics.hand_position()
-            lift = self.line(p_from, p_from + (plan.p_lift - plan.p_grasp), plan, LIFT_SPEED)
-            results += lift.results
-            self.follow_line(lift)
-            self.phase = "hold"
-            self.hold(plan.hold_time)
-            rise = float(physics.object_pose()[2]) - z_start
-            holding = tuple(sorted(physics.links_touching_object()))
-            on_table = physics.object_touches_table()
-            held = rise > 0.5 * (plan.p_lift[2] - plan.p_grasp[2]) and bool(holding) and not on_table
-            placed = False
-            if held:  # carry it to above where it is put down: as high above the table as it was lifted
-                self.phase = "carry"
-                # where the object would touch the table, from how far it has risen with the hand
-                z_touch = physics.hand_position()[2] - (float(physics.object_pose()[2]) - z_start)
-                p_carry = np.array([plan.p_place[0], plan.p_place[1], z_touch + PLACE_APPROACH])
-                carry = self._ik(p_carry, physics.joint_targets(), plan)
-                results.append(carry)
-                self.move_through([carry.q])
-        if held:
-            self.phase = "place"  # down until the object touches the table (sensed as the arm's load leaving it)
+        self.phase = "lift"
+        p_from = physics.hand_position()
+        lift = self.line(p_from, p_from + (plan.p_lift - plan.p_grasp), plan, LIFT_SPEED)
+        results += lift.results
+        self.follow_line(lift)
+        self.phase = "hold"
+        self.hold(plan.hold_time)
+        rise = float(physics.object_pose()[2]) - z_start
+        holding = tuple(sorted(physics.links_touching_object()))
+        on_table = physics.object_touches_table()
+        held = rise > 0.5 * (plan.p_lift[2] - plan.p_grasp[2]) and bool(holding) and not on_table
+        placed = False
+        if held:  # carry it to above where it is put down: as high above the table as it was lifted
+            self.phase = "carry"
+            # where the object would touch the table, from how far it has risen with the hand
+            z_touch = physics.hand_position()[2] - (float(physics.object_pose()[2]) - z_start)
+            p_carry = np.array([plan.p_place[0], plan.p_place[1], z_touch + PLACE_APPROACH])
+            carry = self._ik(p_carry, physics.joint_targets(), plan)
+            results.append(carry)
+            self.move_through([carry.q])
+            # Place: down until the object meets the table (sensed as the arm's load leaving it), then still until
+            # it rests. Fingertips curled under a small object meet the table first: the grip loosens to the
+            # closing's light touch, and the fingers yield and spread on the table as the hand goes on down.
+            self.phase = "place"
             p_hand = physics.hand_position()
             p_low = p_hand - np.array([0.0, 0.0, PLACE_APPROACH + PLACE_OVERTRAVEL])
             down = self.line(p_hand, p_low, plan, GUARDED_SPEED)
-            # down until the object or the hand (fingers curled under it) meets the table
             placed = self.follow_line(down, lambda: physics.object_touches_table()
-                                      or physics.hand_touches_table()).touched
+                                      or physics.hand_touches_table()).touched and physics.object_touches_table()
+            if not placed:  # the fingers under the object met the table: they loosen and yield as the hand goes on
+                fingers = np.array([self.kinematics.joint_names.index(name) for name in plan.hand_closed])
+                physics.limit_torques(fingers, CLOSING_TORQUE)
+                p_hand = physics.hand_position()
+                on_down = self.line(p_hand, p_hand - np.array([0.0, 0.0, PLACE_OVERTRAVEL]), plan, GUARDED_SPEED)
+                placed = self.follow_line(on_down, physics.object_touches_table).touched
+                physics.limit_torques(fingers, None)
             self.hold_still(also=_object_at_rest)
         self.phase = "open"
-        self._fingers(plan.hand_release)
+        # A held object the hand could not set down (the thumb under a small one met the table first) is let down
+        # slowly: the fingers open at a quarter of their speed, and it slides down them onto the table.
+        self._fingers(plan.hand_release, 1.0 if placed or not held else RELEASE_SPEED_SHARE)
         self.hold_still(also=_object_at_rest)
         release_time = float(physics.data.time)
         # The way home rises first: straight up from where the hand let go.

@@ -89,8 +89,8 @@ class TapPhysics:
         self._hand_geom_list = self.hand_geoms.tolist()
         self._hand_rbound = model.geom_rbound[self.hand_geoms].copy()
         #: Torque limit of each active joint's motor [N m] (inf for a joint without a motor of its own).
-        self.torque_limit = np.where(model.jnt_actfrclimited[self._joint_ids], model.jnt_actfrcrange[self._joint_ids, 1],
-                                     np.inf)
+        ids = self._joint_ids
+        self.torque_limit = np.where(model.jnt_actfrclimited[ids], model.jnt_actfrcrange[ids, 1], np.inf)
         #: Servo stiffness kp [N m/rad] and kv / kp [s] per active joint (a coupled joint has no servo: infinite
         #: stiffness, no lead). A target led by kv / kp times the reference velocity cancels the servo's damping
         #: lag, so the joint follows a moving reference (velocity feedforward).

@@ -60,6 +60,7 @@ class Trace:
         self.grip_max_contact = 0.0
         self.slip: list[float] = []
         self.table_touch_speed: float | None = None
+        self.table_touch_phase = ""
         self.after_release = False
         self._clear_after_release = False
         self.after_release_what: tuple[str, list[str]] | None = None
@@ -111,8 +112,10 @@ class Trace:
             R = d.site_xmat[ph.palm_site].reshape(3, 3)
             p_rel = R.T @ (d.qpos[ph.object_qpos:ph.object_qpos + 3] - d.site_xpos[ph.palm_site])
             self.slip.append(p_rel.copy())
-        if phase == "place" and table_touch and not self._was_on_table and self.table_touch_speed is None:
+        if (phase in ("carry", "place", "open", "home") and table_touch and not self._was_on_table
+                and self.table_touch_speed is None):
             self.table_touch_speed = abs(float(d.qvel[ph.object_qvel + 2]))
+            self.table_touch_phase = phase
         if phase in ("retreat", "home") and not hand_touch:
             self._clear_after_release = True
         if phase in ("retreat", "home") and hand_touch and self._clear_after_release and not self.after_release:
@@ -126,7 +129,8 @@ class Trace:
     def _palm_speed(self, d: mujoco.MjData) -> float:
         if self._p_palm is None:
             return 0.0
-        return float(np.linalg.norm(d.site_xpos[self.physics.palm_site] - self._p_palm) / self.physics.model.opt.timestep)
+        p_palm = d.site_xpos[self.physics.palm_site]
+        return float(np.linalg.norm(p_palm - self._p_palm) / self.physics.model.opt.timestep)
 
     def slip_speed(self, dt: float) -> float:
         """Median speed of the object in the palm's frame during the hold [m/s]."""
@@ -150,7 +154,6 @@ import gymnasium as gym  # noqa: E402
 
 import affordance_env  # noqa: E402,F401
 from affordance_env.registration import ENV_ID  # noqa: E402
-
 
 _OLD_GRASP_PHASES = ("reach", "descend", "close", "squeeze", "lift", "hold", "place", "open", "retreat")
 
@@ -262,9 +265,13 @@ def report(result: dict) -> None:
         print(f"slip in the hand during the hold: median {np.nanmedian(slip):.2f}, max {np.nanmax(slip):.2f} mm/s")
         put = [r["trace"].table_touch_speed for r in held if r["trace"].table_touch_speed is not None]
         if put:
-            print(f"put-down: object meets the table at median {np.median(put):.3f}, max {max(put):.3f} m/s "
-                  f"({len(put)}/{len(held)} put down)")
-    print(f"touches after the hand opened and was clear of the object: {sum(r['trace'].after_release for r in rows)}/{len(rows)} "
+            phases: dict[str, int] = {}
+            for r in held:
+                phases[r["trace"].table_touch_phase] = phases.get(r["trace"].table_touch_phase, 0) + 1
+            print(f"put-down: a held object meets the table at median {np.median(put):.3f}, max {max(put):.3f} m/s; "
+                  f"in phase {phases}")
+    touched = sum(r["trace"].after_release for r in rows)
+    print(f"touches after the hand opened and was clear of the object: {touched}/{len(rows)} "
           + str([(r["info"]["object"]["type"], round(r["size"], 3), r["success"], r["trace"].after_release_what)
                  for r in rows if r["trace"].after_release][:4]))
     failed = [r["disp"] for r in rows if not r["success"]]
