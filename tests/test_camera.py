@@ -147,8 +147,13 @@ def test_the_hand_occludes_the_object_as_on_a_real_camera():
 
 def test_an_arm_that_hides_nothing_changes_nothing():
     env = TapAffordanceEnv(camera_width=80, camera_height=60)
-    obs, _ = env.reset(seed=0, options={"object_type": "sphere", "size": 0.06})
+    env.reset(seed=0, options={"object_type": "sphere", "size": 0.06})
     physics = env.physics
+    # the arm lowered into view beside the object (home holds it out of view)
+    for name, value in (("r_shoulder_pitch", -1.0), ("r_shoulder_roll", 0.45), ("r_elbow", 1.2)):
+        physics.data.qpos[physics.model.jnt_qposadr[physics.model.joint(name).id]] = value
+    mujoco.mj_forward(physics.model, physics.data)
+    obs, _ = env._snapshot()
     everywhere = env.camera.capture(physics.data)
     blind = RangeCamera(physics.model, width=80, height=60, fovy_deg=57.4, geom_groups=(0,)).capture(physics.data)
     assert (everywhere.geom_ids != blind.geom_ids).any()  # the arm is in view at home, beside the object ...
@@ -187,7 +192,7 @@ def test_the_table_face_in_closed_form_gives_mujocos_image():
     env = TapAffordanceEnv(camera_width=80, camera_height=60)
     mujoco_only = RangeCamera(env.physics.model, width=80, height=60, fovy_deg=57.4)
     interactions = [({"object_type": "box"}, np.zeros(3)), ({"object_type": "sphere"}, np.array([1.0, -1.0, 0.5])),
-                    ({"object_type": "sphere", "size": 0.08, "position": (-0.3, 0.05)}, np.array([0.0, 0.0, 1.0]))]
+                    ({"object_type": "sphere", "size": 0.08, "position": (-0.3, -0.1)}, np.array([0.0, 0.0, 1.0]))]
     states = _images_along_interactions(env, interactions)
     data = env.physics.data
     assert not env.physics.object_on_table()  # the ball left the table ...
