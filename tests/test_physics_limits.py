@@ -1,0 +1,149 @@
+"""Physics a roboticist would believe: the motors' torque and speed limits, stiff contacts, the palm's restitution,
+and a way home that never strikes the object."""
+
+import mujoco
+import numpy as np
+import pytest
+
+from affordance_env.motor_limits import JOINT_TORQUE_LIMITS, torque_limits, velocity_limits
+from affordance_env.robot_model import VARIANTS
+from affordance_env.scene import CONTACT_SOLIMP, HAND_FRICTION, PALM_RESTITUTION, PALM_SOLREF, build_model
+from affordance_env.tap_env import TapAffordanceEnv
+
+
+@pytest.mark.parametrize("variant", list(VARIANTS))
+def test_every_motor_has_its_torque_limit_and_carries_gravity_compensation(variant):
+    model = build_model(variant)
+    robot = VARIANTS[variant]
+    limits = torque_limits(robot.actuated_joints)
+    for name, limit in zip(robot.actuated_joints, limits, strict=True):
+        j = model.joint(name).id
+        assert model.jnt_actfrclimited[j], name
+        np.testing.assert_allclose(model.jnt_actfrcrange[j], [-limit, limit], err_msg=name)
+        assert model.jnt_actgravcomp[j], name  # gravity compensation counts against the motor's torque
+    assert np.all(limits <= 20.0) and set(JOINT_TORQUE_LIMITS.values()) <= {20.0, 5.0, 2.0, 0.3}
+
+
+def test_velocity_limits_name_every_joint_and_follow_the_finger_linkage():
+    grasp = VARIANTS["grasp"]
+    limits = dict(zip(grasp.active_joints, velocity_limits(grasp.active_joints), strict=True))
+    assert limits["l_elbow"] == pytest.approx(np.radians(100.0))
+    assert limits["l_hand_index_proximal_joint"] == pytest.approx(np.radians(180.0))
+    assert limits["l_hand_index_distal_joint"] > limits["l_hand_index_proximal_joint"]  # the linkage gears it up
+    with pytest.raises(ValueError, match="No velocity limit for joint 'r_knee'"):
+        velocity_limits(["r_knee"])
+
+
+def _restitution(speed: float, timestep: float = 0.002) -> float:
+    """Share of its approach speed a wooden ball takes away from a still surface with the palm's contact
+    parameters (the surface does not move: the arm is thousands of times heavier than the ball's contact)."""
+    solimp = " ".join(str(v) for v in CONTACT_SOLIMP)
+    xml = f"""<mujoco><option timestep="{timestep}" gravity="0 0 0" cone="elliptic" impratio="10"/>
+      <worldbody><geom type="box" size="0.05 0.05 0.01" priority="1" solref="{PALM_SOLREF[0]} {PALM_SOLREF[1]}"
+                       solimp="{solimp}" friction="{HAND_FRICTION} 0.005 0.0001"/>
+        <body pos="0 0 0.045"><freejoint/><geom type="sphere" size="0.03" density="300" condim="6"/></body>
+      </worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    data.qvel[2] = -speed
+    mujoco.mj_step(model, data, round(0.2 / timestep))
+    return float(data.qvel[2] / speed)
+
+
+@pytest.mark.parametrize("speed", [0.06, 0.18, 0.54])
+def test_the_palm_returns_the_stated_share_of_a_struck_balls_speed(speed):
+    assert _restitution(speed) == pytest.approx(PALM_RESTITUTION, abs=0.05)
+
+
+class _PerStep:
+    """Samples the simulation after every physics step of an environment's interactions."""
+
+    def __init__(self, env):
+        self.env, self.physics = env, env.physics
+        self.speed_ratio = 0.0
+        self.penetration = 0.0
+
+    def __call__(self, model, data):
+        physics = self.physics
+        qd = np.abs(data.qvel[physics.robot_qvel])
+        arm = self.arm
+        self.speed_ratio = max(self.speed_ratio, float(np.max(qd[arm] / self.limit[arm])))
+        for i in range(data.ncon):
+            g1, g2 = data.contact.geom[i]
+            if physics.active_geom in (g1, g2):
+                self.penetration = max(self.penetration, -float(data.contact.dist[i]))
+
+    def run(self, monkeypatch, seed, action, options=None):
+        self.limit = self.env.motion.velocity_limit
+        joints = self.physics.variant.active_joints
+        self.arm = np.array([i for i, n in enumerate(joints) if not n.startswith(("l_hand", "neck"))])
+        self.speed_ratio = self.penetration = 0.0
+        real_step = mujoco.mj_step
+
+        def stepping(model, data, nstep=1):
+            for _ in range(nstep):
+                real_step(model, data)
+                self(model, data)
+
+        self.env.reset(seed=seed, options=options)
+        monkeypatch.setattr(mujoco, "mj_step", stepping)
+        try:
+            info = self.env.step(np.asarray(action, dtype=float))[4]
+        finally:
+            monkeypatch.setattr(mujoco, "mj_step", real_step)
+        return info
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("behavior", ["tap", "tap_back", "push", "grasp"])
+def test_joints_stay_within_their_speed_limits_and_nothing_sinks(behavior, monkeypatch):
+    """At every physics step of canonical and of the hardest interactions: no arm or torso joint faster than its
+    limit, and no contact of the object (with the hand, the fingers, the arm or the table) deeper than 2 mm, half
+    of them within 1 mm."""
+    env = TapAffordanceEnv(behavior=behavior, camera_width=32, camera_height=24)
+    probe = _PerStep(env)
+    depths = []
+    for seed, action in [(0, (0, 0, 0)), (1, (0, 0, 0)), (2, (0, 0, 0)), (3, (0, 0, 1)), (4, (1, -1, 1))]:
+        info = probe.run(monkeypatch, seed, action)
+        assert info["failure"] is None, (seed, info["failure"])
+        assert probe.speed_ratio <= 1.0, (seed, action, probe.speed_ratio)
+        depths.append(probe.penetration)
+    assert max(depths) <= 2e-3 and np.median(depths) <= 1e-3, depths
+    env.close()
+
+
+@pytest.mark.slow
+def test_the_hardest_stroke_goes_as_fast_as_the_joints_allow():
+    env = TapAffordanceEnv(camera_width=32, camera_height=24)
+    env.reset(seed=3, options={"object_type": "sphere", "size": 0.06})
+    info = env.step(np.array([0.0, 0.0, 1.0]))[4]
+    asked = 0.18 * 3.0
+    assert info["stroke_speed"] < asked and info["stroke_speed"] > 0.18  # capped by a joint, still fast
+    env.reset(seed=3, options={"object_type": "sphere", "size": 0.06})
+    assert env.step(np.zeros(3))[4]["stroke_speed"] == pytest.approx(0.18)  # the canonical tap is not capped
+    env.close()
+
+
+@pytest.mark.slow
+def test_the_way_home_never_strikes_large_lying_cylinders_tapped_back_towards_it():
+    """Lying cylinders of 8 cm and more tapped back roll towards the arm's home; the arm waits above them, or goes
+    over them, and never touches them after it has let go of them."""
+    env = TapAffordanceEnv(behavior="tap_back", camera_width=32, camera_height=24)
+    go_home, outcomes = env.motion.go_home, []
+
+    def recording(*args, **kwargs):
+        outcomes.append(go_home(*args, **kwargs))
+        return outcomes[-1]
+
+    env.motion.go_home = recording
+    rng = np.random.default_rng(18)
+    towards_home = 0
+    for seed in range(18):
+        env.reset(seed=seed, options={"object_type": "horizontal_cylinder", "size": float(rng.uniform(0.08, 0.10))})
+        info = env.step(np.zeros(3))[4]
+        assert info["failure"] is None, (seed, info["failure"])
+        assert not outcomes[-1].touched and not env.physics.hand_touches_object(), seed
+        travel = info["object"]["final_pose"][:2] - info["object"]["initial_pose"][:2]
+        towards_home += bool(travel[1] > 0.08)
+    assert towards_home >= 12  # the case that used to strike: rolled at least 8 cm towards home
+    env.close()
