@@ -37,8 +37,8 @@ def test_every_episode_equals_its_row(taps, minari_home):
     assert dataset.total_episodes == exported.total_episodes == len(frame)
     initial = frame[[f"initial_{n}" for n in FEATURE_NAMES]].to_numpy(np.float32)
     final = frame[[f"final_{n}" for n in FEATURE_NAMES]].to_numpy(np.float32)
-    ranges = {s: images(frame, f"{s}_range") for s in ("initial", "final")}
-    masks = {s: images(frame, f"{s}_mask") for s in ("initial", "final")}
+    ranges = {s: images(frame, f"image_{s}_range") for s in ("initial", "final")}
+    masks = {s: images(frame, f"image_{s}_mask") for s in ("initial", "final")}
     for i, episode in enumerate(dataset.iterate_episodes()):
         np.testing.assert_array_equal(episode.observations["features"], np.stack([initial[i], final[i]]))
         np.testing.assert_array_equal(episode.observations["range"], np.stack([ranges["initial"][i],

@@ -87,7 +87,7 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
     stages = {stage: frame[[f"{stage}_{n}" for n in FEATURE_NAMES]].to_numpy(np.float32)
               for stage in ("initial", "final")}
     if with_images:
-        decoded = {f"{stage}_{kind}": images(frame, f"{stage}_{kind}")
+        decoded = {f"{stage}_{kind}": images(frame, f"image_{stage}_{kind}")
                    for stage in ("initial", "final") for kind in ("range", "mask")}
     actions = frame[[f"action_{j}" for j in range(3)]].to_numpy(np.float32)
     rewards = frame["displacement"].to_numpy(np.float64)
