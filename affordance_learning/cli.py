@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -89,8 +90,10 @@ def _train_default(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     from affordance_env.collect_cli import add_collect_parser, add_export_parser
+    from affordance_learning import __version__
 
     parser = argparse.ArgumentParser(prog="affordance", description=__doc__)
+    parser.add_argument("--version", action="version", version=f"%(prog)s (tap-affordance) {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="tap a few objects with the canonical tap and print what happened")
     demo.add_argument("--episodes", type=int, default=8, help="number of interactions (default 8)")
@@ -138,14 +141,39 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as a shell reports it.
+INTERRUPTED = 130
+
+
+def _one_line(exc: BaseException) -> str:
+    """What went wrong, for a person, on one line: a file system error names the path and the reason."""
+    if isinstance(exc, OSError) and exc.strerror and exc.filename is not None:
+        return f"{exc.filename}: {exc.strerror}"
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``affordance`` console script."""
+    """Entry point of the ``affordance`` console script.
+
+    A user error (a bad option, a path that cannot be used or written, a dataset that cannot be read or
+    extended, a missing optional package) is one line on stderr and exit status 2; Ctrl-C is one line and
+    status 130, and what was finished is kept (a dataset's chunks: the same command resumes it). Anything else
+    is a bug and keeps its traceback.
+    """
     args = build_parser().parse_args(argv)
-    try:
-        return args.func(args)
-    except (ValueError, FileNotFoundError, ImportError) as exc:
-        print(f"affordance: error: {exc}", file=sys.stderr)
-        return 2
+    with warnings.catch_warnings():
+        # joblib's note, on Ctrl-C, that the chunks its workers held were cancelled: the line below says it
+        warnings.filterwarnings("ignore", message=".*tasks which were still being processed by the workers",
+                                category=UserWarning)
+        try:
+            return args.func(args)
+        except KeyboardInterrupt:
+            print("affordance: interrupted; what was finished is kept (the same command resumes a collection "
+                  "from its last finished chunk)", file=sys.stderr)
+            return INTERRUPTED
+        except (ValueError, OSError, ImportError) as exc:  # FileNotFoundError, PermissionError: OSErrors
+            print(f"affordance: error: {_one_line(exc)}", file=sys.stderr)
+            return 2
 
 
 if __name__ == "__main__":

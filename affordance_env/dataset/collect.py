@@ -19,6 +19,7 @@ import contextlib
 import dataclasses
 import json
 import os
+import signal
 import sys
 import threading
 import warnings
@@ -340,8 +341,16 @@ def _run(tasks: list[tuple], scheduler: str, workers: int, address: str | None) 
         from joblib import Parallel, delayed
 
         yield from Parallel(n_jobs=workers, return_as="generator_unordered", batch_size=1)(
-            delayed(_collect_chunk)(*task) for task in tasks
+            delayed(_collect_chunk_in_worker)(*task) for task in tasks
         )
+
+
+def _collect_chunk_in_worker(*task) -> tuple[int, int, dict, str]:
+    """:func:`_collect_chunk` in a worker process of this machine, which leaves Ctrl-C to the coordinating
+    process: that one stops the workers (whole chunks stay, as always) and says so once, instead of every worker
+    printing a traceback."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    return _collect_chunk(*task)
 
 
 def _run_dask(tasks: list[tuple], workers: int, address: str | None) -> Iterator[tuple]:
