@@ -177,11 +177,13 @@ def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, dict[str, Any]]:
 def summary(results: dict, report: Path) -> str:
     """The headline numbers of one behaviour's reproduction, and where its report is, in a few lines."""
     from affordance_learning.claims import AGREES, claims_scope, evaluate_claims, results_behavior
+    from affordance_learning.results import current_results
 
+    results = current_results(results)
     behavior = results_behavior(results)
     config = results.get("config", {})
     effects = results.get("effects", {})
-    uniformity = {int(k): v["mean"] for k, v in results["uniformity"].items() if v["mean"] is not None}
+    uniformity = {int(k): 100.0 * v["mean"] for k, v in results["uniformity"].items() if v["mean"] is not None}
     accuracy = results["svm_accuracy"].get("0.4") or next(iter(results["svm_accuracy"].values()))
     acc = {int(k): v["mean"] for k, v in accuracy.items() if v["mean"] is not None}
     claims = evaluate_claims(results)

@@ -91,6 +91,11 @@ def test_purity_rand_and_cross_validated_svm() -> None:
         svm_cv_accuracy(X, np.zeros(300))
 
 
+def intercept_over_slope(found: dict) -> float:
+    """Where the logistic fit crosses 50 % [m] (with the sign of intercept / slope)."""
+    return found["logistic"]["intercept"] / found["logistic"]["slope"]
+
+
 def test_size_success_finds_where_success_turns_to_failure() -> None:
     rng = np.random.default_rng(0)
     sizes = rng.uniform(0.03, 0.09, 2000)
@@ -104,6 +109,12 @@ def test_size_success_finds_where_success_turns_to_failure() -> None:
     # success independent of size (90 % everywhere): a fit, but no crossing of 50 % among the sizes seen
     coin = size_success(sizes, rng.random(2000) < 0.9)
     assert coin["logistic"] is not None and coin["critical_size"] is None and coin["below"] is None
+    assert found["test"]["depends_on_size"] and found["test"]["p_value"] < 1e-10 and found["test"]["span"] < -0.9
+    # a drift that crosses 50 % within the sizes, as the tap's rolled share from 47 % to 56 %: significant
+    # perhaps, but success does not depend on size, so no critical size
+    drift = size_success(sizes, rng.random(2000) < 0.45 + 0.12 * (sizes - 0.03) / 0.06)
+    assert drift["logistic"] is not None and not drift["test"]["depends_on_size"]
+    assert 0.03 < -intercept_over_slope(drift) < 0.09 and drift["critical_size"] is None and drift["below"] is None
     # one outcome only: nothing to fit
     always = size_success(sizes, np.ones(2000, dtype=bool))
     assert always["logistic"] is None and always["critical_size"] is None
