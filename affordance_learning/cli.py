@@ -70,7 +70,7 @@ def _reproduce(args: argparse.Namespace) -> int:
 def _train_default(args: argparse.Namespace) -> int:
     from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
     from affordance_learning.behaviors import check_behavior, check_env_offers
-    from affordance_learning.default_model import model_path, train_default_model
+    from affordance_learning.default_model import train_default_model, user_model_path
 
     behavior = check_behavior(args.behavior)
     dataset = args.dataset or Path("default-taps" if behavior == "tap" else f"default-{behavior}")
@@ -81,7 +81,7 @@ def _train_default(args: argparse.Namespace) -> int:
                              f"dataset of {behavior} interactions, or a new directory to collect them into.")
     check_env_offers([behavior])
     collect(dataset, 1000, seed=0, workers=args.workers, env_options={"behavior": behavior})
-    out = args.out or model_path(behavior)
+    out = args.out or user_model_path(behavior)
     model = train_default_model(load_dataset(dataset), out, behavior=behavior)
     print(f"default {behavior} model ({model.n_clusters} categories, {len(model.selected_features_)} features "
           f"selected: {', '.join(model.selected_feature_names_)}) written to {out}")
@@ -136,7 +136,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="where the behaviour's 1000 canonical interactions (seed 0) are collected, or reused "
                        "(default ./default-taps for the tap, ./default-BEHAVIOR otherwise)")
     train.add_argument("--workers", type=int, default=2)
-    train.add_argument("--out", type=Path, default=None, help="model file (default: the package's own)")
+    train.add_argument("--out", type=Path, default=None,
+                       help="model file (default: BEHAVIOR_model.joblib in the user's data directory, "
+                       "$TAP_AFFORDANCE_DATA or ~/.local/share/tap-affordance, where predict_effect finds it)")
     train.set_defaults(func=_train_default)
     return parser
 

@@ -384,7 +384,7 @@ def run_protocol(
     svm_C: float = 1.0,
     svm_gamma: float | str = "scale",
     case_study_ks: Iterable[int] = CASE_STUDY_KS,
-    progress: bool = False,
+    progress: bool | None = False,
     behavior: str | None = None,
 ) -> dict[str, Any]:
     """Run the paper's protocol (module docstring) on a dataset frame; returns a JSON-ready results dict.
@@ -403,7 +403,8 @@ def run_protocol(
         svm_C: SVM regularisation.
         svm_gamma: SVM RBF coefficient.
         case_study_ks: Map sizes whose clusters of the first trial are described in ``case_studies``.
-        progress: Draw a progress bar over the trials.
+        progress: Draw a progress bar over the trials; None: a bar on a terminal, else a line every 10 s
+            (:func:`affordance_env.progress.progress_bar`).
         behavior: The behaviour of the interactions; by default the frame's ``behavior`` column says it (and
             when given, it must agree with that column); needed for a frame without the column.
 
@@ -472,11 +473,14 @@ def run_protocol(
         )
         for t in range(n_trials)
     )
-    from tqdm.auto import tqdm
+    from affordance_env.progress import progress_bar
 
     # in trial order whatever the workers: the results do not depend on n_jobs
-    trials = list(tqdm(Parallel(n_jobs=n_jobs, return_as="generator")(jobs), total=n_trials, unit="trial",
-                       desc="learning trials", disable=not progress, dynamic_ncols=True))
+    with progress_bar(progress, total=n_trials, unit="trial", desc="learning trials") as bar:
+        trials = []
+        for trial in Parallel(n_jobs=n_jobs, return_as="generator")(jobs):
+            trials.append(trial)
+            bar.update()
 
     def per_k(key: str) -> dict[str, dict[str, float | None]]:
         return {str(k): _stats(trial[key][k] for trial in trials) for k in ks}

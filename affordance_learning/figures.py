@@ -283,14 +283,14 @@ def _cluster(clusters: list[Mapping[str, Any]], c: int) -> Mapping[str, Any] | N
     return next((cl for cl in clusters if cl.get("cluster") == c), None)
 
 
-def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: bool = False) -> list[Path]:
+def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: bool | None = False) -> list[Path]:
     """Write the figures of a results dict into ``out_dir`` (created if needed); returns their paths.
 
     Args:
         results: The dict returned by :func:`affordance_learning.experiment.run_protocol` (or read back from
             its JSON).
         out_dir: Directory for the PNG files.
-        progress: Draw a progress bar over the figures.
+        progress: Draw a progress bar over the figures; None: a bar on a terminal, else a line every 10 s.
     """
     results = current_results(results)
     missing = [key for key in _REQUIRED if key not in results]
@@ -311,7 +311,11 @@ def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: boo
         drawings.append((_clusters_vs_type, results, out / "clusters_vs_type.png"))
     if results.get("prototypes") and "feature_names" in results:
         drawings.append((_prototypes, results, out / "prototypes.png"))
-    from tqdm.auto import tqdm
+    from affordance_env.progress import progress_bar
 
-    return [draw(what, path) for draw, what, path in tqdm(drawings, unit="figure", desc="figures",
-                                                            disable=not progress, dynamic_ncols=True)]
+    with progress_bar(progress, total=len(drawings), unit="figure", desc="figures") as bar:
+        written = []
+        for draw, what, path in drawings:
+            written.append(draw(what, path))
+            bar.update()
+    return written

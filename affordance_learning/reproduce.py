@@ -73,7 +73,8 @@ def reproduce(
         seed: Seed of the datasets and of the trials.
         workers: Processes for the collection and the trials.
         datasets: Dataset directory per behaviour (default ``out/<behavior>/dataset``).
-        progress: Draw progress bars; by default on a terminal when ``CI`` is not set.
+        progress: Draw progress bars; by default on a terminal when ``CI`` is not set, and otherwise write a
+            progress line every 10 s; False: nothing.
         range_noise: Collect with the range camera's noise model on (for example ``"kinect_v1"``).
 
     Returns:
@@ -118,7 +119,7 @@ def reproduce(
 def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: int, trials: int, seed: int,
                    workers: int, progress: bool | None, range_noise: str | None) -> dict[str, Any]:
     """Collect, learn and report one behaviour into ``out/<behavior>``; returns its results."""
-    from affordance_env.dataset import collect, failure_summary, load_dataset, show_progress
+    from affordance_env.dataset import collect, failure_summary, load_dataset
     from affordance_learning.experiment import run_protocol
     from affordance_learning.figures import write_figures
     from affordance_learning.report import write_report
@@ -140,8 +141,7 @@ def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: 
           f"{f' ({failure_summary({str(k): v for k, v in failures.items()})})' if failures else ''} "
           f"({collected - start:.1f} s)")
     print(f"[{behavior} 2/3] learning protocol: k = 2..10, r in 0.0..0.8, {trials} trials")
-    bars = show_progress(progress)
-    results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers, progress=bars,
+    results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers, progress=progress,
                            behavior=behavior)
     results["config"].update(
         {"episodes": int(len(frame)), "dataset": _shown_path(dataset, where), "seed": seed, "trials": trials,
@@ -151,7 +151,7 @@ def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: 
     print(f"      done ({learned - collected:.1f} s)")
     print(f"[{behavior} 3/3] writing results.json, figures and REPORT.md into {where}")
     (where / "results.json").write_text(json.dumps(_jsonable(results), indent=2))
-    figures = write_figures(results, where, progress=bars)
+    figures = write_figures(results, where, progress=progress)
     write_report(results, where)
     print(f"      results.json, {len(figures)} figures and REPORT.md ({time.perf_counter() - learned:.1f} s)")
     return results

@@ -542,3 +542,16 @@ def test_a_local_dask_cluster_collects_the_same_dataset(reference, tmp_path):
     assert_same_dataset(tmp_path / "dask", reference)
     collect(tmp_path / "local-dask", 24, scheduler="dask", workers=2, **RUN)  # a cluster of its own
     assert_same_dataset(tmp_path / "local-dask", reference)
+
+
+def test_without_a_terminal_progress_is_a_plain_line_every_10_s(tmp_path, monkeypatch, capsys):
+    import affordance_env.progress as progress
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: False)
+    monkeypatch.setattr(progress, "LOG_INTERVAL", 0.0)  # every update, to see the lines
+    collect(tmp_path / "d", 4, **{**RUN, "chunk_size": 2, "progress": None})
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) >= 3 and "\r" not in "".join(lines)  # the start, each chunk, the end
+    assert lines[-1].startswith("d: 100%") and "4/4" in lines[-1]
+    collect(tmp_path / "e", 2, **{**RUN, "chunk_size": 2, "progress": False})
+    assert capsys.readouterr().err == ""

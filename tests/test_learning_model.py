@@ -515,24 +515,35 @@ def test_default_model_refuses_missing_corrupt_and_stale_files(stored_model: tup
         load_default_model(stale)
 
 
-def test_default_model_path_is_in_the_package() -> None:
+def test_default_models_are_the_packages_until_the_user_rebuilds_one(tmp_path, monkeypatch) -> None:
     assert default_model_module.DEFAULT_MODEL_PATH.parent.name == "data"
     assert default_model_module.DEFAULT_MODEL_PATH.parent.parent.name == "affordance_learning"
+    monkeypatch.setenv("TAP_AFFORDANCE_DATA", str(tmp_path / "mine"))
     assert default_model_module.model_path() == default_model_module.DEFAULT_MODEL_PATH
     assert default_model_module.model_path("grasp") == default_model_module.MODEL_DIR / "grasp_model.joblib"
+    assert default_model_module.user_model_path("push") == tmp_path / "mine" / "push_model.joblib"
+    assert default_model_module.model_path("push") == tmp_path / "mine" / "push_model.joblib"  # none shipped
+    monkeypatch.delenv("TAP_AFFORDANCE_DATA")
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "xdg"))
+    assert default_model_module.user_model_dir() == tmp_path / "xdg" / "tap-affordance"
+    monkeypatch.delenv("XDG_DATA_HOME")
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    assert default_model_module.user_model_dir() == tmp_path / "home" / ".local" / "share" / "tap-affordance"
 
 
 def test_each_behaviour_has_its_own_default_model(tmp_path: object, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(default_model_module, "MODEL_DIR", tmp_path)  # the package's data directory, elsewhere
+    monkeypatch.setattr(default_model_module, "MODEL_DIR", tmp_path / "package")  # shipping no model
+    monkeypatch.setenv("TAP_AFFORDANCE_DATA", str(tmp_path))  # the user's data directory
     grasps = make_synthetic_frame(160, random_state=5, behavior="grasp")
     features = grasps[[c for c in grasps.columns if c.startswith("initial_")]].to_numpy()
     # not built yet: the error says how to build it
     with pytest.raises(DefaultModelMissingError, match=r"grasp model .* missing.*affordance train-default "
-                                                        r"--behavior grasp.*1000 canonical grasp interactions"):
+                                                        r"--behavior grasp.*1000 canonical grasp interactions.*"
+                                                        r"user's data directory"):
         predict_effect(features[:2], "grasp")
-    model = train_default_model(grasps, behavior="grasp")  # into the behaviour's file
-    assert (tmp_path / "grasp_model.joblib").exists() and joblib.load(tmp_path / "grasp_model.joblib")[
-        "behavior"] == "grasp"
+    model = train_default_model(grasps, behavior="grasp")  # into the behaviour's file, the user's
+    assert not (tmp_path / "package").exists()
+    assert joblib.load(tmp_path / "grasp_model.joblib")["behavior"] == "grasp"
     prediction = predict_effect(features[:5], "grasp")
     np.testing.assert_array_equal(
         prediction.category, model.predict(pd.DataFrame(features[:5], columns=model.feature_names_in_)))

@@ -20,7 +20,6 @@ import dataclasses
 import json
 import os
 import signal
-import sys
 import threading
 import warnings
 from collections.abc import Iterator
@@ -52,6 +51,7 @@ from affordance_env.dataset.format import (
     write_manifest,
 )
 from affordance_env.options import EnvOptions
+from affordance_env.progress import progress_bar, show_progress  # noqa: F401  (show_progress: re-exported)
 
 ACTIONS = ("canonical", "random")
 SCHEDULERS = ("joblib", "dask")
@@ -154,13 +154,6 @@ def _exclusive(out: Path) -> Iterator[None]:
         yield
 
 
-def show_progress(progress: bool | None) -> bool:
-    """Whether to draw the progress bar: as asked, or by default on a terminal when ``CI`` is not set."""
-    if progress is not None:
-        return bool(progress)
-    return sys.stderr.isatty() and not os.environ.get("CI")
-
-
 def collect(
     out: str | os.PathLike,
     episodes: int,
@@ -189,7 +182,8 @@ def collect(
             camera_width, camera_height, camera_fovy, roll_threshold, settle_timeout); the others keep the
             env's defaults, which are recorded too.
         chunk_size: Interactions per file: the most a crash can lose, per worker.
-        progress: Draw a progress bar; by default on a terminal when ``CI`` is not set.
+        progress: Draw a progress bar; by default on a terminal when ``CI`` is not set, and otherwise write a
+            progress line every 10 s (:func:`~affordance_env.progress.progress_bar`); False: nothing.
         scheduler: ``"joblib"`` (processes on this machine) or ``"dask"`` (Dask distributed: the cluster at
             ``dask_address``, or a local cluster of ``workers`` processes).
         dask_address: A Dask scheduler (``"tcp://host:8786"``); implies ``scheduler="dask"``. Its workers need
@@ -244,10 +238,8 @@ def collect(
         tasks = [(str(out), i, start, stop, header)
                  for i, (start, stop) in enumerate(ranges) if i not in done]
         n_failed = sum(len(f) for _, f, _ in done.values())
-        from tqdm.auto import tqdm
-
-        with tqdm(total=episodes, initial=sum(n for n, _, _ in done.values()), unit="interaction", desc=out.name,
-                  disable=not show_progress(progress), smoothing=0.05, dynamic_ncols=True) as bar:
+        with progress_bar(progress, total=episodes, initial=sum(n for n, _, _ in done.values()),
+                          unit="interaction", desc=out.name, smoothing=0.05) as bar:
             bar.set_postfix(failed=n_failed)
             for index, n, failures, digest in _run(tasks, scheduler, workers, dask_address):
                 if not (out / chunk_name(index)).exists():
