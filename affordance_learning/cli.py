@@ -88,6 +88,23 @@ def _train_default(args: argparse.Namespace) -> int:
     return 0
 
 
+def _fingerprint(args: argparse.Namespace) -> int:
+    from affordance_learning.reproduce import check_fingerprint, write_reference_fingerprint
+
+    drifted = 0
+    for where in args.reproduction:
+        if not args.check:
+            print(f"{write_reference_fingerprint(where, args.workers)} written")
+            continue
+        problems = check_fingerprint(where, args.workers)
+        drifted += bool(problems)
+        print(f"{where}: " + ("the same interactions, bit for bit" if not problems else
+                              f"{len(problems)} difference(s) from its fingerprint.json:"))
+        for problem in problems:
+            print(f"  {problem}")
+    return 1 if drifted else 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from affordance_env.collect_cli import add_collect_parser, add_export_parser
     from affordance_learning import __version__
@@ -128,6 +145,20 @@ def build_parser() -> argparse.ArgumentParser:
     reproduce.add_argument("--range-noise", default=None, choices=("kinect_v1",),
                            help="collect with the range camera's depth noise model (default: exact ranges)")
     reproduce.set_defaults(func=_reproduce)
+
+    fingerprint = sub.add_parser(
+        "fingerprint", help="pin down (or check) the first interactions behind a reproduction's results.json",
+        description="For each reproduction directory (one behaviour's, holding results.json, e.g. "
+        "docs/reproduction/tap), collect again the first 30 interactions that `affordance reproduce` collects for "
+        "it (its behaviour, seed and range noise) and write their fingerprint.json (a SHA-256 per part of each "
+        "row), or with --check compare them with it bit for bit (exit status 1 if they differ). Rewrite the "
+        "fingerprints whenever the results are regenerated: affordance fingerprint docs/reproduction/*/",
+    )
+    fingerprint.add_argument("reproduction", nargs="+", type=Path, metavar="DIR",
+                             help="a behaviour's reproduction directory, e.g. docs/reproduction/tap")
+    fingerprint.add_argument("--check", action="store_true", help="compare instead of writing")
+    fingerprint.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+    fingerprint.set_defaults(func=_fingerprint)
 
     train = sub.add_parser("train-default", help="rebuild a behaviour's default model behind predict_effect")
     train.add_argument("--behavior", default="tap", metavar="NAME",

@@ -35,6 +35,9 @@ def test_reproduce_writes_results_figures_and_a_report_per_behaviour(tmp_path, c
         assert config["behavior"] == behavior and config["success_label"] == success
         assert config["episodes"] == 40 and config["dataset"] == "dataset"
         assert (out / behavior / "dataset" / "manifest.json").exists()
+        pinned = json.loads((out / behavior / "fingerprint.json").read_text())  # its first 30 interactions
+        assert pinned["settings"]["env_options"]["behavior"] == behavior
+        assert len(pinned["interactions"]) + len(pinned["failures"]) == 30
         for name in ("uniformity.png", "selected_features.png", "case_study_k2.png", "case_study_k3.png",
                      "case_study_k4.png", "svm_accuracy.png", "size_success.png", "REPORT.md"):
             assert (out / behavior / name).stat().st_size > 1000, (behavior, name)
