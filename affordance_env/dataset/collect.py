@@ -240,7 +240,7 @@ def collect(
         n_failed = sum(len(f) for _, f, _ in done.values())
         with progress_bar(progress, total=episodes, initial=sum(n for n, _, _ in done.values()),
                           unit="interaction", desc=out.name, smoothing=0.05) as bar:
-            bar.set_postfix(failed=n_failed)
+            bar.set_postfix(failed=n_failed, refresh=False)
             for index, n, failures, digest in _run(tasks, scheduler, workers, dask_address):
                 if not (out / chunk_name(index)).exists():
                     raise DatasetError(f"a worker wrote {chunk_name(index)} where this process cannot see "

@@ -178,15 +178,19 @@ def collect_command(path: str | os.PathLike, manifest: dict) -> str:
 
     from affordance_env.options import EnvOptions
 
-    settings = manifest["settings"]
-    words = ["affordance", "collect", "--out", str(path), "--episodes", str(manifest["episodes"]),
-             "--seed", str(settings["seed"]), "--chunk-size", str(settings["chunk_size"])]
+    settings = manifest.get("settings") or {}
+    words = ["affordance", "collect", "--out", str(path)]
+    for flag, value in (("--episodes", manifest.get("episodes")), ("--seed", settings.get("seed")),
+                        ("--chunk-size", settings.get("chunk_size"))):
+        if value is not None:  # a manifest that lacks it: the collection's own default
+            words += [flag, str(value)]
     if settings.get("action", "canonical") != "canonical":
         words += ["--action", str(settings["action"])]
     if settings.get("save_images"):
         words.append("--save-images")
     defaults = json.loads(json.dumps({f.name: f.default for f in dataclasses.fields(EnvOptions)}, default=list))
-    for name, value in (settings.get("env_options") or {}).items():
+    options = settings.get("env_options")
+    for name, value in (options if isinstance(options, dict) else {}).items():
         if value is None or value == defaults.get(name):
             continue
         values = value if isinstance(value, list | tuple) else [value]
