@@ -107,19 +107,26 @@ def add_export_parser(subparsers: argparse._SubParsersAction) -> argparse.Argume
     parser.add_argument("--data-format", choices=("arrow", "hdf5"), default="arrow",
                         help="Minari storage format (default arrow; hdf5 needs h5py)")
     parser.add_argument("--author", default="tap-affordance", help="recorded in the Minari metadata")
-    parser.add_argument("--author-email", default=None, help="recorded in the Minari metadata")
+    parser.add_argument("--author-email", default=None, help="recorded in the Minari metadata (default: none)")
+    parser.add_argument("--code-permalink", default=None, metavar="URL",
+                        help="link to the versioned code that made the data, recorded in the Minari metadata "
+                             "(default: none)")
     parser.set_defaults(func=run_export)
     return parser
 
 
 def run_export(args: argparse.Namespace) -> int:
     """Run ``affordance export``."""
-    from affordance_env.dataset.minari_export import export_minari
+    from affordance_env.dataset import read_manifest
+    from affordance_env.dataset.minari_export import export_minari, left_out
 
     start = time.perf_counter()
     exported = export_minari(args.dataset, args.minari, data_format=args.data_format, author=args.author,
-                             author_email=args.author_email)
+                             author_email=args.author_email, code_permalink=args.code_permalink)
     print(f"{args.dataset} -> Minari dataset {args.minari!r}: {exported.total_episodes} episodes in "
           f"{time.perf_counter() - start:.1f} s; load it with minari.load_dataset({args.minari!r})")
+    dropped = left_out(bool(read_manifest(args.dataset)["settings"].get("save_images")))
+    print("  observations: the environment's without " + "; ".join(f"{k} ({why})" for k, why in dropped.items())
+          + "; infos: each interaction's ground truth (type, size, success, ...)")
     return 0
 

@@ -36,8 +36,11 @@ def check_object_type(object_type: str) -> str:
 
 def check_size(size: float) -> float:
     """Return ``size`` [m] as float if it is finite and within :data:`SIZE_LIMITS`, else raise ValueError."""
-    size_f = float(size)
-    if not np.isfinite(size_f) or size_f <= 0:
+    try:
+        size_f = float(size)
+    except (TypeError, ValueError):
+        size_f = float("nan")
+    if isinstance(size, bool | str) or not np.isfinite(size_f) or size_f <= 0:
         raise ValueError(f"Object size must be a positive length in metres, got {size!r}.")
     if not SIZE_LIMITS[0] <= size_f <= SIZE_LIMITS[1]:
         raise ValueError(

@@ -46,10 +46,15 @@ class EnvOptions:
         size_range = self.size_range
         if isinstance(size_range, str) or not isinstance(size_range, Sequence) or len(size_range) != 2:
             raise ValueError(f"size_range must be (low, high) in metres, got {size_range!r}.")
-        low, high = (check_size(s) for s in size_range)
+        try:
+            low, high = (check_size(s) for s in size_range)
+        except ValueError as exc:
+            raise ValueError(f"size_range must be (low, high) in metres, got {size_range!r}: {exc}") from None
         if low > high:
             raise ValueError(f"size_range must be (low, high) with low <= high, got {size_range!r}.")
         normalised["size_range"] = (low, high)
+        if isinstance(self.camera_fovy, bool) or not isinstance(self.camera_fovy, numbers.Real):
+            raise ValueError(f"camera_fovy must be a vertical field of view in degrees, got {self.camera_fovy!r}.")
         Intrinsics.from_fovy(self.camera_width, self.camera_height, self.camera_fovy)
         for name in ("roll_threshold", "settle_timeout"):
             value = getattr(self, name)

@@ -5,7 +5,8 @@ from __future__ import annotations
 import contextlib
 import dataclasses
 import inspect
-from collections.abc import Callable, Sequence
+import numbers
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import gymnasium as gym
@@ -228,7 +229,8 @@ class TapAffordanceEnv(gym.Env):
     | ``reward_fn`` | displacement | ``callable(info) -> float`` |
     | ``render_mode`` | None | ``"rgb_array"``: a picture from an outside camera (headless EGL/OSMesa);
       ``"rgb_array_list"``: every frame of the interaction, for a video (Gymnasium's ``RecordVideo`` keeps one
-      frame per step, so for one-step episodes use this mode and write the frames yourself) |
+      frame per step, so for one-step episodes use this mode and write the frames yourself); any other mode
+      (``"human"`` too) is refused with a ValueError naming these |
 
     ## Version History
     * v0: initial release.
@@ -370,6 +372,8 @@ class TapAffordanceEnv(gym.Env):
         size = float(rng.uniform(*self.size_range))
         xy = PLACEMENT_CENTRE + rng.uniform(-1.0, 1.0, 2) * PLACEMENT_HALF_WIDTH
         yaw = float(rng.uniform(-YAW_JITTER, YAW_JITTER))
+        if options is not None and not isinstance(options, Mapping):
+            raise ValueError(f"options must be a dict with keys among {RESET_OPTIONS}, got {options!r}.")
         options = dict(options or {})
         unknown = sorted(set(options) - set(RESET_OPTIONS))
         if unknown:
@@ -377,7 +381,10 @@ class TapAffordanceEnv(gym.Env):
         if "object_type" in options:
             object_type = check_object_type(options["object_type"])
         if "size" in options:
-            size = check_size(options["size"])
+            try:
+                size = check_size(options["size"])
+            except ValueError as exc:
+                raise ValueError(f"reset option 'size': {exc}") from None
         if object_type in ("sphere", "vertical_cylinder"):
             yaw = 0.0
         if "position" in options:
@@ -387,7 +394,8 @@ class TapAffordanceEnv(gym.Env):
                 raise ValueError(f"position must be (x, y) on the table top, x in [{low[0]:.2f}, {high[0]:.2f}] and "
                                  f"y in [{low[1]:.2f}, {high[1]:.2f}] m, got {options['position']!r}.")
         if "yaw" in options:
-            yaw = float(options["yaw"])
+            real = isinstance(options["yaw"], numbers.Real) and not isinstance(options["yaw"], bool)
+            yaw = float(options["yaw"]) if real else float("nan")
             if not np.isfinite(yaw):
                 raise ValueError(f"yaw must be a finite angle [rad], got {options['yaw']!r}.")
         return object_type, size, xy, yaw

@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from affordance_learning.results import current_results
+
 AGREES = "agrees"
 DISAGREES = "disagrees"
 NOT_COMPUTABLE = "not computable"
@@ -102,13 +104,19 @@ def _fmt(values: Sequence[float], digits: int = 1) -> str:
     return ", ".join(f"{v:.{digits}f}" for v in values)
 
 
-def _uniformity_average(results: Mapping[str, Any]) -> tuple[str, bool]:
+def _uniformity_curve(results: Mapping[str, Any]) -> tuple[list[int], np.ndarray]:
+    """k and the mean uniformity per k, in percent (the results hold fractions), as the paper states it."""
     ks, u = _curve(_section(results, "uniformity"))
+    return ks, 100.0 * u
+
+
+def _uniformity_average(results: Mapping[str, Any]) -> tuple[str, bool]:
+    ks, u = _uniformity_curve(results)
     return f"mean over k = {ks[0]}..{ks[-1]}: {u.mean():.1f} % (per k: {_fmt(u)})", bool(u.mean() > 80.0)
 
 
 def _uniformity_rises(results: Mapping[str, Any]) -> tuple[str, bool]:
-    ks, u = _curve(_section(results, "uniformity"))
+    ks, u = _uniformity_curve(results)
     rho = _rho(ks, u)
     if np.ptp(u) == 0:
         return f"U is {u[0]:.1f} % for every k: no rise (rho taken as 0)", False
@@ -119,7 +127,7 @@ def _uniformity_rises(results: Mapping[str, Any]) -> tuple[str, bool]:
 
 
 def _uniformity_peak(results: Mapping[str, Any]) -> tuple[str, bool]:
-    ks, u = _curve(_section(results, "uniformity"))
+    ks, u = _uniformity_curve(results)
     best = int(np.argmax(u))
     return f"highest mean uniformity {u[best]:.1f} % at k = {ks[best]}", bool(u[best] >= 90.0)
 
@@ -295,22 +303,26 @@ CRITICAL_SIZE_CONTRAST = 0.5
 
 
 def _grasp_uniformity_average(results: Mapping[str, Any]) -> tuple[str, bool]:
-    ks, u = _curve(_section(results, "uniformity"))
+    ks, u = _uniformity_curve(results)
     low, high = GRASP_UNIFORMITY
     return f"mean over k = {ks[0]}..{ks[-1]}: {u.mean():.1f} % (per k: {_fmt(u)})", bool(low < u.mean() <= high)
 
 
 def _fall_at_three(results: Mapping[str, Any]) -> tuple[str, bool]:
     section = _section(results, "uniformity")
-    u2, u3, u4 = (_mean(section, k) for k in (2, 3, 4))
+    u2, u3, u4 = (100.0 * _mean(section, k) for k in (2, 3, 4))
     return f"mean uniformity at k = 2, 3, 4: {u2:.1f}, {u3:.1f}, {u4:.1f} %", u3 < u2 and u3 < u4
 
 
 def _critical_size(results: Mapping[str, Any]) -> tuple[str, bool]:
     section = _section(results, "size_success")
-    fit, critical = section.get("logistic"), section.get("critical_size")
+    fit, critical, test = section.get("logistic"), section.get("critical_size"), section.get("test")
     if fit is None:
         return "one outcome only: no size separates success from failure", False
+    if test is not None and not test["depends_on_size"]:
+        return (f"success does not depend on size: the fit (slope {fit['slope'] / 100:+.2f} per cm of logit) changes "
+                f"the share of successes by {100 * test['span']:+.0f} points across the sizes seen "
+                f"(likelihood-ratio test p = {test['p_value']:.2g})", False)
     if critical is None:
         return (f"the logistic fit (slope {fit['slope'] / 100:+.2f} per cm of logit) does not cross 50 % within "
                 "the sizes seen", False)
@@ -327,7 +339,8 @@ def _critical_size(results: Mapping[str, Any]) -> tuple[str, bool]:
 def _straddling_cluster(results: Mapping[str, Any]) -> tuple[str, bool]:
     critical = _section(results, "size_success").get("critical_size")
     if critical is None:
-        raise _Missing("no critical size: the fit of success on size does not cross 50 % within the sizes seen")
+        raise _Missing("no critical size: success does not depend on size, or the fit of success on size does not "
+                       "cross 50 % within the sizes seen")
     success_label, fail_label = _outcome_words(results)
     parts, straddling = [], []
     clusters = _case(results, 3)
@@ -533,6 +546,7 @@ def evaluate_claims(results: Mapping[str, Any], behavior: str | None = None) -> 
         results: The dict of :func:`affordance_learning.experiment.run_protocol` (or its JSON), or part of it.
         behavior: Whose claims to check; by default the results' own (:func:`results_behavior`).
     """
+    results = current_results(results)
     claims = []
     for topic, paper, rule, judge in claims_for(results_behavior(results) if behavior is None else behavior):
         try:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -69,7 +70,7 @@ def _reproduce(args: argparse.Namespace) -> int:
 def _train_default(args: argparse.Namespace) -> int:
     from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
     from affordance_learning.behaviors import check_behavior, check_env_offers
-    from affordance_learning.default_model import model_path, train_default_model
+    from affordance_learning.default_model import train_default_model, user_model_path
 
     behavior = check_behavior(args.behavior)
     dataset = args.dataset or Path("default-taps" if behavior == "tap" else f"default-{behavior}")
@@ -80,17 +81,36 @@ def _train_default(args: argparse.Namespace) -> int:
                              f"dataset of {behavior} interactions, or a new directory to collect them into.")
     check_env_offers([behavior])
     collect(dataset, 1000, seed=0, workers=args.workers, env_options={"behavior": behavior})
-    out = args.out or model_path(behavior)
+    out = args.out or user_model_path(behavior)
     model = train_default_model(load_dataset(dataset), out, behavior=behavior)
     print(f"default {behavior} model ({model.n_clusters} categories, {len(model.selected_features_)} features "
           f"selected: {', '.join(model.selected_feature_names_)}) written to {out}")
     return 0
 
 
+def _fingerprint(args: argparse.Namespace) -> int:
+    from affordance_learning.reproduce import check_fingerprint, write_reference_fingerprint
+
+    drifted = 0
+    for where in args.reproduction:
+        if not args.check:
+            print(f"{write_reference_fingerprint(where, args.workers)} written")
+            continue
+        problems = check_fingerprint(where, args.workers)
+        drifted += bool(problems)
+        print(f"{where}: " + ("the same interactions, bit for bit" if not problems else
+                              f"{len(problems)} difference(s) from its fingerprint.json:"))
+        for problem in problems:
+            print(f"  {problem}")
+    return 1 if drifted else 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     from affordance_env.collect_cli import add_collect_parser, add_export_parser
+    from affordance_learning import __version__
 
     parser = argparse.ArgumentParser(prog="affordance", description=__doc__)
+    parser.add_argument("--version", action="version", version=f"%(prog)s (tap-affordance) {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="tap a few objects with the canonical tap and print what happened")
     demo.add_argument("--episodes", type=int, default=8, help="number of interactions (default 8)")
@@ -126,6 +146,20 @@ def build_parser() -> argparse.ArgumentParser:
                            help="collect with the range camera's depth noise model (default: exact ranges)")
     reproduce.set_defaults(func=_reproduce)
 
+    fingerprint = sub.add_parser(
+        "fingerprint", help="pin down (or check) the first interactions behind a reproduction's results.json",
+        description="For each reproduction directory (one behaviour's, holding results.json, e.g. "
+        "docs/reproduction/tap), collect again the first 30 interactions that `affordance reproduce` collects for "
+        "it (its behaviour, seed and range noise) and write their fingerprint.json (a SHA-256 per part of each "
+        "row), or with --check compare them with it bit for bit (exit status 1 if they differ). Rewrite the "
+        "fingerprints whenever the results are regenerated: affordance fingerprint docs/reproduction/*/",
+    )
+    fingerprint.add_argument("reproduction", nargs="+", type=Path, metavar="DIR",
+                             help="a behaviour's reproduction directory, e.g. docs/reproduction/tap")
+    fingerprint.add_argument("--check", action="store_true", help="compare instead of writing")
+    fingerprint.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+    fingerprint.set_defaults(func=_fingerprint)
+
     train = sub.add_parser("train-default", help="rebuild a behaviour's default model behind predict_effect")
     train.add_argument("--behavior", default="tap", metavar="NAME",
                        help="whose model: tap (default, shipped), grasp, tap_back or push")
@@ -133,19 +167,46 @@ def build_parser() -> argparse.ArgumentParser:
                        help="where the behaviour's 1000 canonical interactions (seed 0) are collected, or reused "
                        "(default ./default-taps for the tap, ./default-BEHAVIOR otherwise)")
     train.add_argument("--workers", type=int, default=2)
-    train.add_argument("--out", type=Path, default=None, help="model file (default: the package's own)")
+    train.add_argument("--out", type=Path, default=None,
+                       help="model file (default: BEHAVIOR_model.joblib in the user's data directory, "
+                       "$TAP_AFFORDANCE_DATA or ~/.local/share/tap-affordance, where predict_effect finds it)")
     train.set_defaults(func=_train_default)
     return parser
 
 
+#: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as a shell reports it.
+INTERRUPTED = 130
+
+
+def _one_line(exc: BaseException) -> str:
+    """What went wrong, for a person, on one line: a file system error names the path and the reason."""
+    if isinstance(exc, OSError) and exc.strerror and exc.filename is not None:
+        return f"{exc.filename}: {exc.strerror}"
+    return " ".join(str(exc).split()) or type(exc).__name__
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the ``affordance`` console script."""
+    """Entry point of the ``affordance`` console script.
+
+    A user error (a bad option, a path that cannot be used or written, a dataset that cannot be read or
+    extended, a missing optional package) is one line on stderr and exit status 2; Ctrl-C is one line and
+    status 130, and what was finished is kept (a dataset's chunks: the same command resumes it). Anything else
+    is a bug and keeps its traceback.
+    """
     args = build_parser().parse_args(argv)
-    try:
-        return args.func(args)
-    except (ValueError, FileNotFoundError, ImportError) as exc:
-        print(f"affordance: error: {exc}", file=sys.stderr)
-        return 2
+    with warnings.catch_warnings():
+        # joblib's note, on Ctrl-C, that the chunks its workers held were cancelled: the line below says it
+        warnings.filterwarnings("ignore", message=".*tasks which were still being processed by the workers",
+                                category=UserWarning)
+        try:
+            return args.func(args)
+        except KeyboardInterrupt:
+            print("affordance: interrupted; what was finished is kept (the same command resumes a collection "
+                  "from its last finished chunk)", file=sys.stderr)
+            return INTERRUPTED
+        except (ValueError, OSError, ImportError) as exc:  # FileNotFoundError, PermissionError: OSErrors
+            print(f"affordance: error: {_one_line(exc)}", file=sys.stderr)
+            return 2
 
 
 if __name__ == "__main__":

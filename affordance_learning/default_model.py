@@ -3,10 +3,15 @@
 One default model per behaviour, as the paper proposes ("a separate SOM and SVM for each behavior"). Each is
 an :class:`AffordanceModel` (1 x 4 map, r = 0.4: the paper's case-study setting and its best relevancy)
 trained by :func:`train_default_model` on a dataset of that behaviour's canonical interactions (the command
-``affordance train-default --behavior NAME`` builds it) and stored at
-``affordance_learning/data/<behavior>_model.joblib`` (:func:`model_path`) with the behaviour, the bundle
-format, this package's version, scikit-learn's version and NumPy's major version. The package ships the tap's;
-bundles stored before the behaviour was recorded are the tap's.
+``affordance train-default --behavior NAME`` builds it) and stored with the behaviour, the bundle format, this
+package's version, scikit-learn's version and NumPy's major version. Bundles stored before the behaviour was
+recorded are the tap's.
+
+Where they are: the package ships the tap's and the grasp's in ``affordance_learning/data/`` (read only: an
+installed package is not written to). A model built by ``affordance train-default`` goes to the user's data
+directory (:func:`user_model_dir`: ``$TAP_AFFORDANCE_DATA``, else ``$XDG_DATA_HOME/tap-affordance``, else
+``~/.local/share/tap-affordance``), and :func:`predict_effect` uses it there, before the package's
+(:func:`model_path`).
 
 :func:`load_default_model` refuses a file that is missing (:class:`DefaultModelMissingError`, a
 ``FileNotFoundError``), unreadable, not a bundle of the current :data:`FORMAT`, a model of another behaviour,
@@ -32,10 +37,12 @@ from affordance_learning.behaviors import check_behavior
 from affordance_learning.model import AffordanceModel, EffectPrediction
 from affordance_learning.validation import first_non_finite
 
-#: Where the default models are stored, one file per behaviour.
+#: Where the package's own default models are, one file per behaviour (read only).
 MODEL_DIR = Path(__file__).resolve().parent / "data"
-#: Where the default tap model is stored.
+#: The package's default tap model.
 DEFAULT_MODEL_PATH = MODEL_DIR / "tap_model.joblib"
+#: Environment variable naming the user's data directory, where rebuilt default models go.
+DATA_ENV = "TAP_AFFORDANCE_DATA"
 #: Map size and relevancy threshold of the default model.
 DEFAULT_N_CLUSTERS = 4
 DEFAULT_RELEVANCY = 0.4
@@ -61,10 +68,27 @@ class DefaultModelMissingError(DefaultModelError, FileNotFoundError):
     """A default model file does not exist."""
 
 
+def user_model_dir() -> Path:
+    """The user's directory of default models: ``$TAP_AFFORDANCE_DATA``, else ``$XDG_DATA_HOME/tap-affordance``,
+    else ``~/.local/share/tap-affordance`` (the XDG convention for a user's application data)."""
+    setting = os.environ.get(DATA_ENV)
+    if setting:
+        return Path(setting).expanduser()
+    base = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
+    return Path(base) / "tap-affordance"
+
+
+def user_model_path(behavior: str = "tap") -> Path:
+    """Where ``affordance train-default`` stores the default model of ``behavior`` (:func:`user_model_dir`)."""
+    return user_model_dir() / f"{check_behavior(behavior)}_model.joblib"
+
+
 def model_path(behavior: str = "tap") -> Path:
-    """Where the package's default model of ``behavior`` is stored; raises ValueError for an unknown
-    behaviour, naming the valid ones."""
-    return MODEL_DIR / f"{check_behavior(behavior)}_model.joblib"
+    """The default model of ``behavior`` that :func:`predict_effect` uses: the user's (rebuilt by ``affordance
+    train-default``) if there is one, else the package's; where the user's would be if neither exists. Raises
+    ValueError for an unknown behaviour, naming the valid ones."""
+    user, packaged = user_model_path(behavior), MODEL_DIR / f"{check_behavior(behavior)}_model.joblib"
+    return user if user.exists() or not packaged.exists() else packaged
 
 
 def rebuild_command(behavior: str = "tap") -> str:
@@ -113,9 +137,9 @@ def train_default_model(
         df: Interactions of ``behavior`` in the dataset schema: ``initial_<name>`` and ``effect_<name>`` for
             each of the 49 feature names (``affordance_env.features.FEATURE_NAMES``); its ``behavior`` column,
             if it has one, must name ``behavior`` only.
-        path: Where to write the model (the directory is created; default: the package's file of the
-            behaviour, :func:`model_path`); written to a temporary file first and moved into place, so a
-            reader never sees half a file.
+        path: Where to write the model (the directory is created; default: the user's file of the behaviour,
+            :func:`user_model_path`, which :func:`predict_effect` then uses); written to a temporary file first
+            and moved into place, so a reader never sees half a file.
         behavior: The behaviour of the interactions, one of :data:`affordance_learning.behaviors.BEHAVIORS`.
         n_clusters: Effect categories (map size), in [2, 10].
         relevancy: Relevancy threshold of the feature selection, in [0, 1].
@@ -130,7 +154,7 @@ def train_default_model(
     """
     from affordance_learning.experiment import frame_behavior
 
-    path = model_path(behavior) if path is None else path
+    path = user_model_path(behavior) if path is None else path
     frame_behavior(df, check_behavior(behavior))
     names = _feature_names()
     missing = [c for n in names for c in (f"initial_{n}", f"effect_{n}") if c not in df.columns]
@@ -164,7 +188,8 @@ def _problem(path: Path | str, problem: str, behavior: str) -> str:
     what = "taps" if behavior == "tap" else f"{behavior} interactions"
     return (
         f"The default {behavior} model {path} {problem}. Rebuild it with `{rebuild_command(behavior)}` (it "
-        f"collects or reuses 1000 canonical {what}, trains the model and stores it there)."
+        f"collects or reuses 1000 canonical {what}, trains the model and stores it in the user's data directory, "
+        f"{user_model_path(behavior)}, where predict_effect finds it)."
     )
 
 
@@ -212,7 +237,8 @@ def load_default_model(path: str | Path | None = None, *, behavior: str = "tap")
     """The default model of a behaviour, checked against the installed library versions (cached).
 
     Args:
-        path: The stored model (default: the package's file of the behaviour, :func:`model_path`).
+        path: The stored model (default: the user's model of the behaviour, else the package's:
+            :func:`model_path`).
         behavior: The behaviour the model must be of, one of :data:`affordance_learning.behaviors.BEHAVIORS`.
 
     Raises:
@@ -238,7 +264,8 @@ def predict_effect(
             DataFrame with those columns (in any order; other columns are ignored); finite.
         behavior: Whose default model predicts: ``"tap"`` (shipped), ``"grasp"``, ``"tap_back"`` or
             ``"push"`` (built by ``affordance train-default --behavior NAME``).
-        path: The stored model (default: the package's file of the behaviour, :func:`model_path`).
+        path: The stored model (default: the user's model of the behaviour, else the package's:
+            :func:`model_path`).
 
     Returns:
         ``category`` (n,) int and ``effect`` (n, 49) float: the category's prototype effect (final minus

@@ -3,10 +3,11 @@
 Akgun et al. 2009, section V, on a pandas DataFrame in the project's dataset schema: for each feature name
 (``affordance_env.features.FEATURE_NAMES``) the columns ``initial_<name>``, ``final_<name>`` and
 ``effect_<name>``, the ``behavior`` and the ground truth ``type`` (sphere | box | horizontal_cylinder |
-vertical_cylinder), ``size`` [m], ``success`` (bool, the paper's hand label of the behaviour: the tap rolled the
-object, the grasp lifted and held it, ...; a tap or tap_back frame without it is evaluated against ``rolled``,
-their success) and ``displacement`` [m]. The ground truth is used only to evaluate, never to learn. One frame
-holds one behaviour's interactions: the paper learns "a separate SOM and SVM for each behavior".
+vertical_cylinder), ``size`` [m], ``success`` (bool, the paper's success/fail label of the behaviour, here
+measured by the simulator: the tap rolled the object, the grasp lifted and held it, ...; a tap or tap_back frame
+without it is evaluated against ``rolled``, their success) and ``displacement`` [m]. The ground truth is used
+only to evaluate, never to learn. One frame holds one behaviour's interactions: the paper learns "a separate SOM
+and SVM for each behavior".
 :func:`run_protocol` repeats, for every trial t and every number of clusters k:
 
 1. A 1 x k self-organising map, seeded from ``(random_state, t, k)``, clusters the standardised effects of
@@ -55,6 +56,7 @@ from affordance_learning.behaviors import ROLLED_IS_SUCCESS, outcome_words
 from affordance_learning.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
 from affordance_learning.model import _check_int, select_features
 from affordance_learning.relieff import MULTICLASS_THRESHOLD, ReliefFScorer
+from affordance_learning.results import RESULTS_FORMAT, UNITS
 from affordance_learning.som import SOMClustering
 from affordance_learning.validation import first_non_finite
 
@@ -132,6 +134,7 @@ class _Data:
     success: np.ndarray  # (n,) bool
     types: np.ndarray  # (n,) str
     sizes: np.ndarray  # (n,) float [m]
+    left_view: np.ndarray  # (n,) bool: the object was not seen in the final snapshot (left the view or the table)
     effect_mean: np.ndarray  # (d,) the standardisation of the effects, to turn prototypes back into units
     effect_scale: np.ndarray  # (d,)
 
@@ -218,13 +221,17 @@ def _frame_data(frame: pd.DataFrame) -> _Data:
         success=success,
         types=frame["type"].astype(str).to_numpy(),
         sizes=sizes,
+        left_view=(~frame["visible_final"].to_numpy(dtype=bool) if "visible_final" in frame.columns
+                   else np.zeros(len(frame), dtype=bool)),
         effect_mean=scaler.mean_,
         effect_scale=scaler.scale_,
     )
 
 
 def _case_study(labels: np.ndarray, k: int, data: _Data, types: Sequence[str]) -> list[dict[str, Any]]:
-    """Per map node: success and fail counts, object type counts, object sizes [m] (sorted)."""
+    """Per map node: success and fail counts, object type counts, object sizes [m] (sorted), and how many of its
+    objects were not seen in the final snapshot (``left_view``: their effect is minus their initial features,
+    not a motion)."""
     clusters = []
     for c in range(k):
         members = labels == c
@@ -235,6 +242,7 @@ def _case_study(labels: np.ndarray, k: int, data: _Data, types: Sequence[str]) -
                 "fail": int(np.sum(~data.success[members])),
                 "types": {t: int(np.sum(data.types[members] == t)) for t in types},
                 "sizes": [round(float(s), 6) for s in np.sort(data.sizes[members])],
+                "left_view": int(np.sum(data.left_view[members])),
             }
         )
     return clusters
@@ -279,7 +287,7 @@ def _run_trial(
         seed = np.random.SeedSequence([random_state, trial, k]).generate_state(1)[0]
         som = SOMClustering(n_clusters=k, n_iterations=som_iterations, random_state=int(seed)).fit(data.Z)
         labels = som.labels_
-        out["uniformity"][k] = uniformity(labels, data.success)
+        out["uniformity"][k] = uniformity(labels, data.success) / 100.0  # a fraction, as every share here
         out["purity"][k] = cluster_purity(labels, data.types)
         out["ari"][k] = adjusted_rand(labels, data.types)
         out["n_categories"][k] = int(np.unique(labels).size)
@@ -376,7 +384,7 @@ def run_protocol(
     svm_C: float = 1.0,
     svm_gamma: float | str = "scale",
     case_study_ks: Iterable[int] = CASE_STUDY_KS,
-    progress: bool = False,
+    progress: bool | None = False,
     behavior: str | None = None,
 ) -> dict[str, Any]:
     """Run the paper's protocol (module docstring) on a dataset frame; returns a JSON-ready results dict.
@@ -395,16 +403,19 @@ def run_protocol(
         svm_C: SVM regularisation.
         svm_gamma: SVM RBF coefficient.
         case_study_ks: Map sizes whose clusters of the first trial are described in ``case_studies``.
-        progress: Draw a progress bar over the trials.
+        progress: Draw a progress bar over the trials; None: a bar on a terminal, else a line every 10 s
+            (:func:`affordance_env.progress.progress_bar`).
         behavior: The behaviour of the interactions; by default the frame's ``behavior`` column says it (and
             when given, it must agree with that column); needed for a frame without the column.
 
     Returns:
-        ``{"uniformity": {"<k>": {"mean", "std"}}`` [%] (against the success/fail labels),
+        ``{"uniformity": {"<k>": {"mean", "std"}}`` [0, 1] (against the success/fail labels; a fraction like
+        every share here, :data:`affordance_learning.results.UNITS`),
         ``"svm_accuracy": {"<r>": {"<k>": {"mean", "std"}}}`` [0, 1], ``"shape_fraction"`` and
         ``"size_fraction"`` (same keys; shares of shape and size features among the selected ones) [0, 1],
         ``"n_selected"`` (same keys), ``"case_studies": {"<k>": [{"cluster", "success", "fail", "types":
-        {type: count}, "sizes": [m, ...]}]}``, ``"prototypes": {"<k>": [[effect per feature], ...]}``,
+        {type: count}, "sizes": [m, ...], "left_view": count}]}``, ``"prototypes": {"<k>": [[effect per
+        feature], ...]}``,
         ``"feature_names"``, ``"effects"`` (:func:`effect_summary`), ``"size_success"``
         (:func:`affordance_learning.metrics.size_success`), ``"purity"``, ``"adjusted_rand"`` (against the
         object type), ``"n_categories"`` (non-empty clusters), ``"svm_baseline"`` (majority-category
@@ -462,11 +473,14 @@ def run_protocol(
         )
         for t in range(n_trials)
     )
-    from tqdm.auto import tqdm
+    from affordance_env.progress import progress_bar
 
     # in trial order whatever the workers: the results do not depend on n_jobs
-    trials = list(tqdm(Parallel(n_jobs=n_jobs, return_as="generator")(jobs), total=n_trials, unit="trial",
-                       desc="learning trials", disable=not progress, dynamic_ncols=True))
+    with progress_bar(progress, total=n_trials, unit="trial", desc="learning trials") as bar:
+        trials = []
+        for trial in Parallel(n_jobs=n_jobs, return_as="generator")(jobs):
+            trials.append(trial)
+            bar.update()
 
     def per_k(key: str) -> dict[str, dict[str, float | None]]:
         return {str(k): _stats(trial[key][k] for trial in trials) for k in ks}
@@ -478,6 +492,7 @@ def run_protocol(
 
     groups = feature_groups(data.names)
     return {
+        "results_format": RESULTS_FORMAT,
         "uniformity": per_k("uniformity"),
         "svm_accuracy": per_rk("accuracy"),
         "shape_fraction": per_rk("shape_fraction"),
@@ -526,6 +541,7 @@ def run_protocol(
             "case_study_ks": list(case_study_ks),
             "case_study_trial": 0,
             "std": "population standard deviation over trials (ddof=0)",
+            "units": UNITS,
         },
     }
 

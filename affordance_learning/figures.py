@@ -7,8 +7,8 @@ Drawn with matplotlib's object API on the Agg canvas (no pyplot, no display, no 
 - ``selected_features.png`` (Fig. 8): shares of shape and of size features among the selected ones, and their
   number, versus k, one line per relevancy threshold r.
 - ``case_study_k2.png``, ``case_study_k3.png``, ``case_study_k4.png`` (Figs. 9, 10; k = 3 for the grasp): per
-  cluster of the 1 x k maps, the success/fail counts, the object types and the spread of object sizes, with
-  the critical size of the grasp when there is one.
+  cluster of the 1 x k maps, the success/fail counts (measured by the simulator), the object types and the
+  spread of object sizes, with the critical size where success depends on size (the grasp's).
 - ``size_success.png`` (not in the paper): the share of successes per object size, with the logistic fit and
   the critical size where it crosses 50 %.
 - ``svm_accuracy.png`` (Fig. 11): SVM accuracy on held-out interactions versus k, one line per r, with the
@@ -17,7 +17,9 @@ Drawn with matplotlib's object API on the Agg canvas (no pyplot, no display, no 
   object type versus k.
 - ``prototypes.png`` (not in the paper): what each effect category of the 1 x 2 and 1 x 4 maps is, as its
   prototype effect in feature units: the motion of the object's mean point [cm], the change of its pixel count,
-  and the change of its normal histograms.
+  and the change of its normal histograms. A category whose objects mostly left the view has no motion to show
+  (its effect is minus the initial features, the not-visible features being zeros): it is marked as such, not
+  drawn as centimetres of motion.
 """
 
 from __future__ import annotations
@@ -29,6 +31,8 @@ from typing import Any
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+
+from affordance_learning.results import current_results
 
 _REQUIRED = ("uniformity", "svm_accuracy", "shape_fraction", "size_fraction", "n_selected", "case_studies")
 _TYPE_COLOURS = {
@@ -73,7 +77,7 @@ def _uniformity(results: Mapping[str, Any], path: Path) -> Path:
     fig, (ax,) = _new_figure(5.5, 3.8)
     behavior, success, fail = _words(results)
     k, mean, std = _series(results["uniformity"])
-    ax.errorbar(k, mean, yerr=std, marker="o", capsize=3, label="ours (mean ± std over trials)")
+    ax.errorbar(k, 100.0 * mean, yerr=100.0 * std, marker="o", capsize=3, label="ours (mean ± std over trials)")
     if behavior in _PAPER_UNIFORMITY:
         average, peak = _PAPER_UNIFORMITY[behavior]
         ax.axhline(average, color="grey", linestyle="--", linewidth=1,
@@ -127,7 +131,7 @@ def _case_study(results: Mapping[str, Any], k: str, path: Path) -> Path:
     fail = np.array([c["fail"] for c in clusters])
     ax_label.bar(index, success, color="tab:green", label=f"{success_label} (success)")
     ax_label.bar(index, fail, bottom=success, color="tab:gray", label=f"{fail_label} (fail)")
-    ax_label.set(xlabel="cluster", ylabel="interactions", title="(a) hand labels")
+    ax_label.set(xlabel="cluster", ylabel="interactions", title="(a) outcomes measured by the simulator")
     ax_label.legend(fontsize="small")
 
     types = list(dict.fromkeys(t for c in clusters for t in c["types"]))
@@ -214,6 +218,10 @@ def _clusters_vs_type(results: Mapping[str, Any], path: Path) -> Path:
     return _save(fig, path)
 
 
+#: A category is drawn as "left the view" when more than this share of its objects was not seen at the end.
+LEFT_VIEW_SHARE = 0.5
+
+
 def _prototypes(results: Mapping[str, Any], path: Path) -> Path:
     maps = sorted(results["prototypes"].items(), key=lambda item: int(item[0]))
     names = list(results["feature_names"])
@@ -227,23 +235,38 @@ def _prototypes(results: Mapping[str, Any], path: Path) -> Path:
     for row, (k, prototypes) in enumerate(maps):
         P = np.asarray(prototypes, dtype=float)
         clusters = results.get("case_studies", {}).get(k, [])
-        labels = [f"{c} ({cl['success']} {success} / {cl['fail']} {fail})" if (cl := _cluster(clusters, c))
-                  else str(c) for c in range(len(P))]
+        gone = np.zeros(len(P), dtype=bool)  # categories whose objects mostly left the view
+        labels = []
+        for c in range(len(P)):
+            cl = _cluster(clusters, c)
+            if cl is None:
+                labels.append(str(c))
+                continue
+            n = cl["success"] + cl["fail"]
+            gone[c] = n > 0 and cl.get("left_view", 0) > LEFT_VIEW_SHARE * n
+            labels.append(f"{c} ({cl['success']} {success} / {cl['fail']} {fail})"
+                          + (f", {cl['left_view']} left the view" if gone[c] else ""))
         ax_move, ax_pix, ax_lat, ax_lon = axes[row]
         if None not in xyz:
             width = 0.8 / 3
+            seen = np.flatnonzero(~gone)
             for j, (i, axis) in enumerate(zip(xyz, "xyz", strict=True)):
-                ax_move.bar(np.arange(len(P)) - 0.4 + width * (j + 0.5), 100 * P[:, i], width,
-                            label=f"mean_{axis}")
+                ax_move.bar(seen - 0.4 + width * (j + 0.5), 100 * P[seen, i], width, label=f"mean_{axis}")
+            for c in np.flatnonzero(gone):  # no motion was seen: the object left the view
+                ax_move.axvspan(c - 0.45, c + 0.45, color="0.85", zorder=0)
+                ax_move.text(c, 0.5, "object left\nthe view:\nno motion\nseen", ha="center", va="center",
+                             fontsize="x-small", transform=ax_move.get_xaxis_transform())
             ax_move.legend(fontsize="x-small")
         ax_move.set(xlabel="cluster", ylabel="change [cm]", title=f"1 x {k}: motion of the mean point")
         if "pixel_count" in index:
-            ax_pix.bar(np.arange(len(P)), P[:, index["pixel_count"]], color="tab:gray")
+            ax_pix.bar(np.arange(len(P)), P[:, index["pixel_count"]],
+                       color=["0.8" if g else "tab:gray" for g in gone])
         ax_pix.set(xlabel="cluster", ylabel="change [pixels]", title="pixel count")
         for ax, cols, title in ((ax_lat, lat, "normal latitude histogram"),
                                 (ax_lon, lon, "normal longitude histogram")):
             for c in range(len(P)):
-                ax.plot(np.arange(len(cols)), P[c, cols], marker=".", label=labels[c])
+                ax.plot(np.arange(len(cols)), P[c, cols], marker=".", label=labels[c],
+                        linestyle=":" if gone[c] else "-")
             ax.axhline(0.0, color="grey", linewidth=0.8)
             ax.set(xlabel="bin", ylabel="change [fraction]", title=title)
         ax_lon.legend(fontsize="x-small")
@@ -260,15 +283,16 @@ def _cluster(clusters: list[Mapping[str, Any]], c: int) -> Mapping[str, Any] | N
     return next((cl for cl in clusters if cl.get("cluster") == c), None)
 
 
-def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: bool = False) -> list[Path]:
+def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: bool | None = False) -> list[Path]:
     """Write the figures of a results dict into ``out_dir`` (created if needed); returns their paths.
 
     Args:
         results: The dict returned by :func:`affordance_learning.experiment.run_protocol` (or read back from
             its JSON).
         out_dir: Directory for the PNG files.
-        progress: Draw a progress bar over the figures.
+        progress: Draw a progress bar over the figures; None: a bar on a terminal, else a line every 10 s.
     """
+    results = current_results(results)
     missing = [key for key in _REQUIRED if key not in results]
     if missing:
         raise ValueError(f"results lack {missing}; expected the dict returned by run_protocol.")
@@ -287,7 +311,11 @@ def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: boo
         drawings.append((_clusters_vs_type, results, out / "clusters_vs_type.png"))
     if results.get("prototypes") and "feature_names" in results:
         drawings.append((_prototypes, results, out / "prototypes.png"))
-    from tqdm.auto import tqdm
+    from affordance_env.progress import progress_bar
 
-    return [draw(what, path) for draw, what, path in tqdm(drawings, unit="figure", desc="figures",
-                                                            disable=not progress, dynamic_ncols=True)]
+    with progress_bar(progress, total=len(drawings), unit="figure", desc="figures") as bar:
+        written = []
+        for draw, what, path in drawings:
+            written.append(draw(what, path))
+            bar.update()
+    return written

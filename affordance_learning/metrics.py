@@ -133,13 +133,25 @@ def svm_cv_accuracy(
     return float(np.mean(cross_val_score(make_svm(C, gamma), X, y, cv=folds)))
 
 
+#: Success depends on object size when a likelihood-ratio test of the logistic fit against a constant rejects
+#: the constant at this level ...
+SIZE_TEST_ALPHA = 0.01
+#: ... and the fitted share of successes differs by at least this much between the smallest and the largest
+#: object seen (a fit that only drifts from 47 % to 56 % across the sizes gives no critical size).
+SIZE_MIN_SPAN = 0.5
+
+
 def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
-    """How success depends on object size: the share of successes per size bin, and a logistic fit.
+    """How success depends on object size: the share of successes per size bin, a logistic fit, a test of
+    whether success depends on size at all, and the critical size where it does.
 
     A behaviour whose outcome is decided by size (the paper's grasp: small objects are held, large ones are not)
     has a critical size where the chance of success crosses 50 %. It is estimated by a logistic regression of
     success on size (practically unregularised: ``C = 1e6`` on the standardised sizes), ``P(success) =
-    1 / (1 + exp(-(intercept + slope x size)))``, as ``-intercept / slope``.
+    1 / (1 + exp(-(intercept + slope x size)))``, as ``-intercept / slope``, and reported only where success
+    depends on size: the fit is significant (likelihood-ratio test against a constant share, p <
+    :data:`SIZE_TEST_ALPHA`) and large (the fitted share differs by at least :data:`SIZE_MIN_SPAN` between the
+    smallest and the largest object seen).
 
     Args:
         sizes: Object size of each interaction [m], (n,), finite.
@@ -148,11 +160,13 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
 
     Returns:
         ``{"bins": [{"low", "high" [m], "n", "success" (share, None for an empty bin)}], "logistic":
-        {"intercept", "slope" [1/m]} or None (only one outcome: nothing to fit), "critical_size": [m] or None
-        (no fit, or the fit does not cross 50 % within the sizes seen), "below", "above": {"n", "success"}
-        (the interactions with objects smaller, and not smaller, than the critical size, and their share of
-        successes; None without a critical size)}``.
+        {"intercept", "slope" [1/m]} or None (only one outcome: nothing to fit), "test": {"p_value", "span"
+        (fitted share at the largest size minus at the smallest), "depends_on_size", "rule"} or None (no fit),
+        "critical_size": [m] or None (success does not depend on size, or the fit does not cross 50 % within
+        the sizes seen), "below", "above": {"n", "success"} (the interactions with objects smaller, and not
+        smaller, than the critical size, and their share of successes; None without a critical size)}``.
     """
+    from scipy.stats import chi2
     from sklearn.linear_model import LogisticRegression
 
     sizes, success = _paired(np.asarray(sizes, dtype=np.float64), success, "success")
@@ -169,7 +183,7 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
         members = index == b
         bins.append({"low": float(edges[b]), "high": float(edges[b + 1]), "n": int(members.sum()),
                      "success": float(success[members].mean()) if members.any() else None})
-    out: dict = {"bins": bins, "logistic": None, "critical_size": None, "below": None, "above": None}
+    out: dict = {"bins": bins, "logistic": None, "test": None, "critical_size": None, "below": None, "above": None}
     if success.all() or not success.any() or high == low:
         return out
     mean, scale = sizes.mean(), sizes.std()
@@ -177,7 +191,20 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
     slope = float(fit.coef_[0, 0] / scale)
     intercept = float(fit.intercept_[0] - fit.coef_[0, 0] * mean / scale)
     out["logistic"] = {"intercept": intercept, "slope": slope}
-    if slope != 0.0 and low <= -intercept / slope <= high:
+
+    def log_likelihood(p: np.ndarray) -> float:
+        p = np.clip(p, 1e-12, 1.0 - 1e-12)
+        return float(np.sum(np.where(success, np.log(p), np.log1p(-p))))
+
+    fitted = 1.0 / (1.0 + np.exp(-(intercept + slope * np.array([low, high]))))
+    ratio = 2.0 * (log_likelihood(1.0 / (1.0 + np.exp(-(intercept + slope * sizes))))
+                   - log_likelihood(np.full(sizes.shape, success.mean())))
+    p_value, span = float(chi2.sf(max(ratio, 0.0), df=1)), float(fitted[1] - fitted[0])
+    depends = p_value < SIZE_TEST_ALPHA and abs(span) >= SIZE_MIN_SPAN
+    out["test"] = {"p_value": p_value, "span": span, "depends_on_size": bool(depends),
+                   "rule": f"likelihood-ratio test of the fit p < {SIZE_TEST_ALPHA:g} and the fitted share "
+                           f"changing by at least {100 * SIZE_MIN_SPAN:.0f} points across the sizes seen"}
+    if depends and slope != 0.0 and low <= -intercept / slope <= high:
         critical = float(-intercept / slope)
         out["critical_size"] = critical
         for side, members in (("below", sizes < critical), ("above", sizes >= critical)):

@@ -22,6 +22,7 @@ from affordance_learning.claims import (  # noqa: F401  (AGREES ... Claim: re-ex
     evaluate_claims,
     results_behavior,
 )
+from affordance_learning.results import UNIFORMITY_DEFINITION, UNITS, current_results
 
 
 def _cell(entry: Mapping[str, Any] | None, scale: float, digits: int) -> str:
@@ -55,16 +56,19 @@ def _case_tables(results: Mapping[str, Any]) -> list[str]:
     success_label, fail_label = _outcome_words(results)
     for k, clusters in sorted(results.get("case_studies", {}).items(), key=lambda item: int(item[0])):
         types = list(dict.fromkeys(t for c in clusters for t in c["types"]))
+        left = all("left_view" in c for c in clusters)  # results of format 1 did not count them
         lines += [f"### 1 x {k} map (first trial)", ""]
-        lines.append(f"| cluster | {success_label} | {fail_label} | " + " | ".join(types) + " | sizes [cm] |")
-        lines.append("|---" * (4 + len(types)) + "|")
+        lines.append(f"| cluster | {success_label} | {fail_label} | " + " | ".join(types) + " | sizes [cm] |"
+                     + (" object left the view |" if left else ""))
+        lines.append("|---" * (4 + len(types) + left) + "|")
         for c in clusters:
             sizes = np.asarray(c["sizes"], dtype=float) * 100
             spread = (
                 f"{sizes.min():.1f}-{sizes.max():.1f} (median {np.median(sizes):.1f})" if sizes.size else "-"
             )
             counts = " | ".join(str(c["types"].get(t, 0)) for t in types)
-            lines.append(f"| {c['cluster']} | {c['success']} | {c['fail']} | {counts} | {spread} |")
+            lines.append(f"| {c['cluster']} | {c['success']} | {c['fail']} | {counts} | {spread} |"
+                         + (f" {c['left_view']} |" if left else ""))
         lines.append("")
     return lines
 
@@ -123,9 +127,15 @@ def _size_section(results: Mapping[str, Any]) -> list[str]:
     if not section:
         return []
     success_label, _ = _outcome_words(results)
-    fit, critical = section.get("logistic"), section.get("critical_size")
+    fit, critical, test = section.get("logistic"), section.get("critical_size"), section.get("test")
     if fit is None:
         found = "Only one outcome: no logistic fit, no critical size."
+    elif test is not None and not test["depends_on_size"]:
+        found = (f"Success does not depend on object size: the logistic fit of success on size (slope "
+                 f"{fit['slope'] / 100:+.2f} per cm of logit) changes the share of successes by "
+                 f"{100 * test['span']:+.0f} points across the sizes seen (likelihood-ratio test p = "
+                 f"{test['p_value']:.2g}). A critical size is reported only where success depends on size "
+                 f"({test['rule']}): none here.")
     elif critical is None:
         found = (f"A logistic fit of success on size (slope {fit['slope'] / 100:+.2f} per cm of logit) does not "
                  "cross 50 % within the sizes seen: no critical size.")
@@ -144,6 +154,7 @@ def _size_section(results: Mapping[str, Any]) -> list[str]:
 
 def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> str:
     """The Markdown text of the report (see :func:`write_report`)."""
+    results = current_results(results)
     claims = evaluate_claims(results)
     tally = {v: sum(c.verdict == v for c in claims) for v in (AGREES, DISAGREES, NOT_COMPUTABLE)}
     config = results.get("config", {})
@@ -155,8 +166,11 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
         f"{config.get('n_rows', '?')} interactions, {config.get('n_trials', '?')} trials, "
         f"k = {config.get('ks', '?')}, r = {config.get('relevancies', '?')}, "
         f"seed {config.get('random_state', '?')}. Success/fail labels: {success_label} / {fail_label} "
-        f"(the {config.get('label', 'success')!r} column); {_pct(config.get('success_fraction'))} of the "
-        "interactions succeeded.",
+        f"(the {config.get('label', 'success')!r} column, measured by the simulator); "
+        f"{_pct(config.get('success_fraction'))} of the interactions succeeded.",
+        "",
+        f"{UNIFORMITY_DEFINITION} Shares are shown in percent here; `results.json` holds them as fractions "
+        f"({UNITS}).",
         "",
         f"**{tally[AGREES]} of {len(claims)} claims agree**, {tally[DISAGREES]} disagree, "
         f"{tally[NOT_COMPUTABLE]} could not be computed. Each verdict follows the rule beside it, applied to "
@@ -172,7 +186,7 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
     lines += _table_k(
         results,
         [
-            ("uniformity", "uniformity [%]", 1.0, 1),
+            ("uniformity", "uniformity [%]", 100.0, 1),
             ("purity", "purity vs object type", 1.0, 2),
             ("adjusted_rand", "adjusted Rand vs object type", 1.0, 2),
             ("n_categories", "non-empty clusters", 1.0, 1),
@@ -222,9 +236,11 @@ def write_report(results: Mapping[str, Any], out_dir: str | Path) -> Path:
 
 def _headline(results: Mapping[str, Any]) -> dict[str, str]:
     """One behaviour's headline numbers as short texts, for the overview."""
+    results = current_results(results)
     config = results.get("config", {})
     success_label, _ = _outcome_words(results)
-    uniformity = {int(k): v["mean"] for k, v in results.get("uniformity", {}).items() if v.get("mean") is not None}
+    uniformity = {int(k): 100.0 * v["mean"] for k, v in results.get("uniformity", {}).items()
+                  if v.get("mean") is not None}
     section = results.get("svm_accuracy", {})
     accuracy = section.get("0.4") or next(iter(section.values()), {})
     acc = {int(k): v["mean"] for k, v in accuracy.items() if v.get("mean") is not None}
@@ -255,6 +271,9 @@ def render_overview(runs: Mapping[str, Mapping[str, Any]],
         "behaviour's interactions are collected, clustered by their effects, weighed and learned on their own, "
         "and set beside what the paper says of that behaviour. Means over trials; the full numbers, tables and "
         "figures are in each behaviour's report.",
+        "",
+        UNIFORMITY_DEFINITION + " A critical size is shown only for a behaviour whose success depends on object "
+        "size (a test on the logistic fit of success on size, in each report).",
         "",
         "| behaviour | interactions | successes | uniformity, mean over k | highest uniformity | "
         "SVM accuracy at r = 0.4 | critical size (success crosses 50 %) | claims that agree |",

@@ -10,6 +10,11 @@ and grasping. For each behaviour asked (by default :data:`DEFAULT_BEHAVIORS`), i
    relevancy r in {0, 0.2, 0.4, 0.6, 0.8}, ``trials`` times.
 3. Write ``results.json``, the figures and ``REPORT.md``.
 
+Beside ``results.json``, ``fingerprint.json`` pins down the first 30 interactions of the dataset bit for bit
+(:func:`affordance_env.dataset.fingerprint.fingerprint`): :func:`check_fingerprint` collects them again with the
+current code, so that a shipped reproduction cannot silently stop being what the code gives, and
+:func:`write_reference_fingerprint` (``affordance fingerprint DIR``) rewrites it.
+
 Then ``out/REPORT.md`` sets the behaviours side by side (:func:`affordance_learning.report.write_overview`):
 those just run, and any other whose results an earlier run left in ``out/<behavior>/``. Every behaviour is
 checked against the environment before anything is collected, so a behaviour it does not offer stops the run
@@ -73,7 +78,8 @@ def reproduce(
         seed: Seed of the datasets and of the trials.
         workers: Processes for the collection and the trials.
         datasets: Dataset directory per behaviour (default ``out/<behavior>/dataset``).
-        progress: Draw progress bars; by default on a terminal when ``CI`` is not set.
+        progress: Draw progress bars; by default on a terminal when ``CI`` is not set, and otherwise write a
+            progress line every 10 s; False: nothing.
         range_noise: Collect with the range camera's noise model on (for example ``"kinect_v1"``).
 
     Returns:
@@ -118,7 +124,8 @@ def reproduce(
 def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: int, trials: int, seed: int,
                    workers: int, progress: bool | None, range_noise: str | None) -> dict[str, Any]:
     """Collect, learn and report one behaviour into ``out/<behavior>``; returns its results."""
-    from affordance_env.dataset import collect, failure_summary, load_dataset, show_progress
+    from affordance_env.dataset import collect, failure_summary, load_dataset
+    from affordance_env.dataset.fingerprint import fingerprint
     from affordance_learning.experiment import run_protocol
     from affordance_learning.figures import write_figures
     from affordance_learning.report import write_report
@@ -140,8 +147,7 @@ def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: 
           f"{f' ({failure_summary({str(k): v for k, v in failures.items()})})' if failures else ''} "
           f"({collected - start:.1f} s)")
     print(f"[{behavior} 2/3] learning protocol: k = 2..10, r in 0.0..0.8, {trials} trials")
-    bars = show_progress(progress)
-    results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers, progress=bars,
+    results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers, progress=progress,
                            behavior=behavior)
     results["config"].update(
         {"episodes": int(len(frame)), "dataset": _shown_path(dataset, where), "seed": seed, "trials": trials,
@@ -149,12 +155,71 @@ def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: 
     )
     learned = time.perf_counter()
     print(f"      done ({learned - collected:.1f} s)")
-    print(f"[{behavior} 3/3] writing results.json, figures and REPORT.md into {where}")
+    print(f"[{behavior} 3/3] writing results.json, {FINGERPRINT}, figures and REPORT.md into {where}")
     (where / "results.json").write_text(json.dumps(_jsonable(results), indent=2))
-    figures = write_figures(results, where, progress=bars)
+    _write_fingerprint(fingerprint(frame), where)
+    figures = write_figures(results, where, progress=progress)
     write_report(results, where)
     print(f"      results.json, {len(figures)} figures and REPORT.md ({time.perf_counter() - learned:.1f} s)")
     return results
+
+
+#: The file beside ``results.json`` that pins down the first interactions of its dataset.
+FINGERPRINT = "fingerprint.json"
+
+
+def _write_fingerprint(found: dict[str, Any], where: Path) -> Path:
+    path = where / FINGERPRINT
+    found = {"what": "the first interactions of the dataset behind results.json, one SHA-256 per part of each row; "
+                     "`affordance fingerprint DIR --check` collects them again and compares, `affordance "
+                     "fingerprint DIR` rewrites this file", **found}
+    path.write_text(json.dumps(found, indent=1) + "\n")
+    return path
+
+
+def _collect_reference(where: Path, workers: int = 1) -> dict[str, Any]:
+    """The fingerprint of the first interactions that ``affordance reproduce`` collects for the reproduction in
+    ``where``, collected now (with the settings of its ``results.json``: behaviour, seed, range noise)."""
+    import tempfile
+
+    from affordance_env.dataset import collect, load_dataset
+    from affordance_env.dataset.fingerprint import FINGERPRINT_EPISODES, fingerprint
+
+    try:
+        config = json.loads((where / "results.json").read_text())["config"]
+        behavior, seed = config["behavior"], int(config["seed"])
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise ValueError(f"{where} holds no results.json of `affordance reproduce` (with config.behavior and "
+                         f"config.seed): {exc}") from None
+    env_options: dict[str, Any] = {"behavior": behavior}
+    if config.get("range_noise", "none") != "none":
+        env_options["range_noise"] = config["range_noise"]
+    with tempfile.TemporaryDirectory(prefix="tap-affordance-reference-") as tmp:
+        dataset = Path(tmp) / "dataset"
+        collect(dataset, FINGERPRINT_EPISODES, seed=seed, workers=workers, env_options=env_options,
+                progress=False, max_failure_share=1.0)
+        return fingerprint(load_dataset(dataset), FINGERPRINT_EPISODES)
+
+
+def write_reference_fingerprint(where: str | Path, workers: int = 1) -> Path:
+    """Collect the first interactions of the reproduction in ``where`` again and write its ``fingerprint.json``
+    (after the simulation changed on purpose, with its results regenerated)."""
+    where = Path(where)
+    return _write_fingerprint(_collect_reference(where, workers), where)
+
+
+def check_fingerprint(where: str | Path, workers: int = 1) -> list[str]:
+    """How the first interactions that ``affordance reproduce`` collects now differ from those pinned down by the
+    ``fingerprint.json`` of the reproduction in ``where``; empty when they are the same, bit for bit."""
+    from affordance_env.dataset.fingerprint import fingerprint_differences
+
+    where = Path(where)
+    try:
+        expected = json.loads((where / FINGERPRINT).read_text())
+    except (OSError, ValueError) as exc:
+        raise ValueError(f"{where / FINGERPRINT} cannot be read ({exc}); write it with `affordance fingerprint "
+                         f"{where}`.") from None
+    return fingerprint_differences(expected, _collect_reference(where, workers))
 
 
 def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, dict[str, Any]]:
@@ -177,11 +242,13 @@ def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, dict[str, Any]]:
 def summary(results: dict, report: Path) -> str:
     """The headline numbers of one behaviour's reproduction, and where its report is, in a few lines."""
     from affordance_learning.claims import AGREES, claims_scope, evaluate_claims, results_behavior
+    from affordance_learning.results import current_results
 
+    results = current_results(results)
     behavior = results_behavior(results)
     config = results.get("config", {})
     effects = results.get("effects", {})
-    uniformity = {int(k): v["mean"] for k, v in results["uniformity"].items() if v["mean"] is not None}
+    uniformity = {int(k): 100.0 * v["mean"] for k, v in results["uniformity"].items() if v["mean"] is not None}
     accuracy = results["svm_accuracy"].get("0.4") or next(iter(results["svm_accuracy"].values()))
     acc = {int(k): v["mean"] for k, v in accuracy.items() if v["mean"] is not None}
     claims = evaluate_claims(results)

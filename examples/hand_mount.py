@@ -1,6 +1,9 @@
 """Picture of the mk3 hand's mount: the fingered hand over the V2.5 hand mesh it replaces, in three views.
 
-    python examples/hand_mount.py [--out docs/hand_mount.png] [--offset X Y Z]
+    python examples/hand_mount.py [--out hand_mount.png] [--offset X Y Z]
+
+Run from anywhere; it writes ``hand_mount.png`` in the current directory by default (the repository's
+``docs/hand_mount.png`` is this picture: ``--out docs/hand_mount.png`` from the repository root redraws it).
 
 The V2.5 model's left hand mesh (blue) and the ``left_hand_mk3`` hand (orange) with its palm link at ``--offset``
 (default: :data:`affordance_env.robot_model.HAND_MOUNT_POS`) in ``l_hand_dh_frame``, both half transparent,
@@ -14,6 +17,7 @@ coordinate the views are least sure of: the mesh vertices with x from 3 to 10 cm
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -85,7 +89,8 @@ def finger_band(model: mujoco.MjModel, data: mujoco.MjData) -> dict[str, tuple[f
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", default="docs/hand_mount.png")
+    parser.add_argument("--out", type=Path, default=Path("hand_mount.png"),
+                        help="picture to write (default ./hand_mount.png); its directory is created")
     parser.add_argument("--offset", type=float, nargs=3, default=HAND_MOUNT_POS, metavar=("X", "Y", "Z"),
                         help="palm link position in l_hand_dh_frame [m]")
     args = parser.parse_args()
@@ -111,6 +116,7 @@ def main() -> None:
     fig.suptitle(f"left_hand_mk3 (orange) over the V2.5 left hand (blue): palm link at ({x:.1f}, {y:.1f}, {z:.1f}) mm "
                  "in l_hand_dh_frame, unrotated; 20 cm views", fontsize=10)
     fig.tight_layout()
+    args.out.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(args.out, dpi=80)
     print(f"wrote {args.out}")
 

@@ -17,6 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from affordance_env.tap_env import TapAffordanceEnv  # noqa: E402
+from affordance_learning.behaviors import outcome_words  # noqa: E402
 
 
 def main() -> None:
@@ -52,7 +53,7 @@ def main() -> None:
     axes[1, 5].axis("off")
     axes[1, 5].text(0, 0.5, f"{info['object']['type']}, {info['object']['size'] * 100:.1f} cm\n"
                     f"moved {info['displacement'] * 100:.1f} cm ({info['outcome']})\nrolled: {info['rolled']}"
-                    + (f"\nheld: {info['success']}" if "success" in info else ""),
+                    f"\nsuccess ({outcome_words(args.behavior)[0]}): {info['success']}",
                     fontsize=12)
     for ax in axes.flat[:10]:
         ax.set_xticks([])

@@ -35,6 +35,9 @@ def test_reproduce_writes_results_figures_and_a_report_per_behaviour(tmp_path, c
         assert config["behavior"] == behavior and config["success_label"] == success
         assert config["episodes"] == 40 and config["dataset"] == "dataset"
         assert (out / behavior / "dataset" / "manifest.json").exists()
+        pinned = json.loads((out / behavior / "fingerprint.json").read_text())  # its first 30 interactions
+        assert pinned["settings"]["env_options"]["behavior"] == behavior
+        assert len(pinned["interactions"]) + len(pinned["failures"]) == 30
         for name in ("uniformity.png", "selected_features.png", "case_study_k2.png", "case_study_k3.png",
                      "case_study_k4.png", "svm_accuracy.png", "size_success.png", "REPORT.md"):
             assert (out / behavior / name).stat().st_size > 1000, (behavior, name)
@@ -107,3 +110,82 @@ def test_train_default_checks_the_behaviour_before_collecting(tmp_path, capsys, 
     assert main(["train-default", "--behavior", "grasp", "--dataset", str(new), "--out", str(tmp_path / "m")]) == 2
     assert "the environment has no 'grasp' behaviour" in capsys.readouterr().err
     assert not new.exists() and not (tmp_path / "m").exists()
+
+
+def test_version(capsys):
+    from affordance_learning import __version__
+
+    with pytest.raises(SystemExit) as exit_:
+        main(["--version"])
+    assert exit_.value.code == 0 and capsys.readouterr().out == f"affordance (tap-affordance) {__version__}\n"
+
+
+def _read_only(monkeypatch, directory):
+    """Make creating anything under ``directory`` fail as on a read-only file system (the tests may run as
+    root, whom file modes do not stop)."""
+    import pathlib
+
+    mkdir, open_ = pathlib.Path.mkdir, open
+
+    def refused(path):
+        return str(path).startswith(str(directory))
+
+    def guarded_mkdir(self, *args, **kwargs):
+        if refused(self):
+            raise PermissionError(30, "Read-only file system", str(self))
+        return mkdir(self, *args, **kwargs)
+
+    monkeypatch.setattr(pathlib.Path, "mkdir", guarded_mkdir)
+    monkeypatch.setattr("builtins.open", lambda file, *a, **k: (_ for _ in ()).throw(
+        PermissionError(30, "Read-only file system", str(file))) if refused(file) and "w" in (a[:1] or (k.get(
+            "mode", "r"),))[0] else open_(file, *a, **k))
+
+
+def test_paths_that_cannot_be_used_are_one_line_errors(tmp_path, capsys, monkeypatch):
+    a_file = tmp_path / "notes.txt"
+    a_file.write_text("mine")
+    small = ["--camera-width", "32", "--camera-height", "32"]
+    assert main(["collect", "--episodes", "2", "--out", str(a_file / "taps"), *small]) == 2
+    assert capsys.readouterr().err == f"affordance: error: {a_file / 'taps'}: Not a directory\n"
+    read_only = tmp_path / "read-only"
+    _read_only(monkeypatch, read_only)
+    assert main(["collect", "--episodes", "2", "--out", str(read_only / "taps"), *small]) == 2
+    assert capsys.readouterr().err == f"affordance: error: {read_only / 'taps'}: Read-only file system\n"
+    assert main(["reproduce", "--behavior", "tap", "--episodes", "20", "--out", str(read_only / "repro")]) == 2
+    assert capsys.readouterr().err == f"affordance: error: {read_only / 'repro'}: Read-only file system\n"
+    assert main(["export", str(tmp_path / "missing"), "--minari", "tap-affordance/y-v0"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "affordance: error:" in err and "missing" in err
+
+
+@pytest.mark.slow
+def test_ctrl_c_exits_130_in_one_line_and_keeps_the_finished_chunks(tmp_path):
+    import json
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "taps"
+    command = [sys.executable, "-c", "from affordance_learning.cli import main; raise SystemExit(main())", "collect",
+               "--episodes", "60", "--chunk-size", "2", "--out", str(out), "--camera-width", "32",
+               "--camera-height", "32", "--workers", "2"]
+    # a process group of its own with the default SIGINT handling, so that Ctrl-C reaches it and its workers as
+    # from a terminal (a test runner may have been started with SIGINT ignored)
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                               preexec_fn=lambda: (os.setpgrp(), signal.signal(signal.SIGINT, signal.SIG_DFL)))
+    deadline = time.time() + 120
+    while time.time() < deadline and len(list(out.glob("chunk-*.parquet"))) < 2:
+        time.sleep(0.05)
+    os.killpg(process.pid, signal.SIGINT)
+    _, err = process.communicate(timeout=60)
+    assert process.returncode == 130
+    lines = err.splitlines()  # progress lines (no terminal here), then one line about the interruption
+    assert lines[-1].startswith("affordance: interrupted; what was finished is kept"), err
+    assert all(line.startswith("taps: ") for line in lines[:-1]), err
+    kept = json.loads((out / "manifest.json").read_text())["chunk_sha256"]
+    assert 1 <= len(kept) < 30 and all((out / name).exists() for name in kept)
+    from affordance_env.dataset import load_dataset
+
+    assert len(load_dataset(out, allow_incomplete=True)) >= 1  # what was finished reads back, checked

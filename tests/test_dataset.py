@@ -2,6 +2,7 @@
 
 import argparse
 import contextlib
+import hashlib
 import json
 import os
 import signal
@@ -17,12 +18,15 @@ import pytest
 
 from affordance_env import FEATURE_GROUPS, FEATURE_NAMES, load_dataset
 from affordance_env.dataset import (
+    GROUND_TRUTH_COLUMNS,
+    POSE_COLUMNS,
     DatasetError,
     FailureShareError,
     collect,
     images,
     interaction_action,
     interaction_seed,
+    learning_data,
     read_manifest,
     show_progress,
 )
@@ -54,7 +58,7 @@ def reference(reference_dir):
 
 def test_schema_columns_and_metadata(reference, tmp_path):
     assert len(reference) + len(reference.attrs["failures"]) == 24
-    pose = [f"{stage}_{f}" for stage in ("initial", "final") for f in ("x", "y", "z", "qw", "qx", "qy", "qz")]
+    pose = [f"true_{stage}_{f}" for stage in ("initial", "final") for f in ("x", "y", "z", "qw", "qx", "qy", "qz")]
     required = ["action_0", "action_1", "action_2", "type", "size", *pose, "displacement", "rolled", "success",
                 "rolling_distance", "tilt", "toppled", "outcome", "outcome_time", "contact", "visible_initial",
                 "visible_final", "ik_success", "behavior", "episode", "seed"]
@@ -68,16 +72,88 @@ def test_schema_columns_and_metadata(reference, tmp_path):
     assert reference.success.dtype == bool and (reference.success == reference.rolled).all()  # tap: success = rolled
     manifest = reference.attrs["manifest"]
     assert manifest["feature_names"] == list(FEATURE_NAMES) and manifest["feature_groups"] == FEATURE_GROUPS
-    assert manifest["schema_version"] == 4 and manifest["complete"] and manifest["rows"] == len(reference)
+    assert manifest["schema_version"] == 5 and manifest["complete"] and manifest["rows"] == len(reference)
     assert manifest["settings"]["env_options"]["camera_width"] == 32
     assert manifest["settings"]["env_options"]["settle_timeout"] == 3.0  # defaults are recorded too
+
+
+def test_each_namespace_holds_only_its_own_columns(reference, tmp_path):
+    collect(tmp_path / "img", 2, seed=2, env_options=SMALL, chunk_size=2, progress=False, save_images=True)
+    for frame in (reference, load_dataset(tmp_path / "img", with_images=True)):
+        for prefix in ("initial_", "final_", "effect_"):
+            assert [c for c in frame if c.startswith(prefix)] == [f"{prefix}{n}" for n in FEATURE_NAMES]
+        assert [c for c in frame if c.startswith("true_")] == list(POSE_COLUMNS)
+        assert [c for c in frame if c.startswith("action_")] == ["action_0", "action_1", "action_2"]
+        assert set(GROUND_TRUTH_COLUMNS) <= set(frame.columns)
+    assert [c for c in frame if c.startswith("image_")] == ["image_initial_range", "image_initial_mask",
+                                                            "image_final_range", "image_final_mask"]
+
+
+def test_learning_data_gives_features_effects_and_labels_of_one_behaviour(reference):
+    X, E, labels = learning_data(reference, "tap")
+    assert list(X.columns) == list(E.columns) == list(FEATURE_NAMES)
+    np.testing.assert_array_equal(X.to_numpy(), reference[[f"initial_{n}" for n in FEATURE_NAMES]].to_numpy())
+    np.testing.assert_array_equal(E.to_numpy(), reference[[f"effect_{n}" for n in FEATURE_NAMES]].to_numpy())
+    assert {"type", "size", "success", "true_initial_x"} <= set(labels.columns)
+    assert not set(labels.columns) & {f"initial_{n}" for n in FEATURE_NAMES}
+    assert (labels.index == X.index).all() and (labels["success"] == reference["success"]).all()
+    mixed = pd.concat([reference, reference.assign(behavior="push")], ignore_index=True)
+    assert len(learning_data(mixed, "push")[0]) == len(reference)
+    with pytest.raises(ValueError, match=r"mixes the behaviours \['push', 'tap'\]; pass behavior="):
+        learning_data(mixed)
+    with pytest.raises(ValueError, match="holds no 'grasp' interactions"):
+        learning_data(reference, "grasp")
+    with pytest.raises(ValueError, match="lacks 1 feature column"):
+        learning_data(reference.drop(columns=f"effect_{FEATURE_NAMES[3]}"))
+
+
+def test_a_changed_byte_in_a_chunk_is_an_error_naming_it_and_the_command(reference, tmp_path):
+    out = tmp_path / "d"
+    collect(out, 16, workers=1, **RUN)
+    chunk = out / "chunk-00001.parquet"
+    good = chunk.read_bytes()
+    assert read_manifest(out)["chunk_sha256"]["chunk-00001.parquet"] == hashlib.sha256(good).hexdigest()
+    # a byte of a value inside a data page (snappy keeps random doubles as literals): pyarrow still reads the
+    # file, with that value changed
+    value = reference.loc[reference.episode >= 8, "true_initial_x"].iloc[0]
+    at = good.index(np.float64(value).tobytes())
+    data = bytearray(good)
+    data[at] ^= 0x01
+    chunk.write_bytes(bytes(data))
+    changed = pq.read_table(chunk).to_pandas()["true_initial_x"]
+    assert value not in changed.to_numpy() and (changed.to_numpy() != 0).all()
+    with pytest.raises(DatasetError) as error:
+        load_dataset(out)
+    message = str(error.value)
+    assert "chunk-00001.parquet has changed since it was written" in message
+    assert f"affordance collect --out {out} --episodes 16 --seed 5 --chunk-size 8 --camera-width 32" in message
+    with pytest.warns(UserWarning, match="collecting chunk-00001.parquet again: .* has changed"):
+        collect(out, 16, workers=1, **RUN)  # the command the message gives redoes it
+    assert chunk.read_bytes() == good
+    assert_same_dataset_prefix(out, reference, 16)
+
+
+def test_a_chunk_the_manifest_does_not_record_is_unfinished(reference, tmp_path):
+    # a run stopped between writing a chunk and recording it: the chunk is not read, and resuming records it
+    out = tmp_path / "d"
+    collect(out, 16, workers=1, **RUN)
+    manifest = json.loads((out / "manifest.json").read_text())
+    del manifest["chunk_sha256"]["chunk-00001.parquet"]
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(DatasetError, match="1 chunk\\(s\\) missing or unfinished \\(chunk-00001.parquet\\)"):
+        load_dataset(out)
+    assert set(load_dataset(out, allow_incomplete=True).episode) <= set(range(8))
+    before = (out / "chunk-00001.parquet").stat().st_mtime_ns
+    collect(out, 16, workers=1, **RUN)
+    assert (out / "chunk-00001.parquet").stat().st_mtime_ns == before  # checked and kept, not collected again
+    assert_same_dataset_prefix(out, reference, 16)
 
 
 def test_chunk_files(tmp_path, reference):
     collect(tmp_path / "d", 8, workers=1, **RUN)
     chunk = tmp_path / "d" / "chunk-00000.parquet"
     meta = json.loads(pq.read_schema(chunk).metadata[b"tap_affordance"])
-    assert meta["schema_version"] == 4 and meta["feature_names"] == list(FEATURE_NAMES)
+    assert meta["schema_version"] == 5 and meta["feature_names"] == list(FEATURE_NAMES)
     assert meta["package_version"] and meta["settings"]["env_options"]["camera_height"] == 32
     assert (meta["chunk"]["start"], meta["chunk"]["stop"]) == (0, 8)
     plain = pd.read_parquet(chunk)
@@ -176,7 +252,7 @@ def test_newer_schema_corrupt_and_half_written_chunks(reference, tmp_path):
     with pytest.raises(DatasetError, match="chunk-00000.parquet"):
         load_dataset(out / "chunk-00000.parquet")  # a chunk alone: load the directory
     chunk.write_bytes(good[: len(good) // 2])  # truncated under its final name (disk damage, not our writer)
-    with pytest.raises(DatasetError, match="chunk-00001.parquet is corrupt"):
+    with pytest.raises(DatasetError, match="chunk-00001.parquet (is corrupt|has changed).*affordance collect"):
         load_dataset(out)
     with pytest.warns(UserWarning, match="collecting chunk-00001.parquet again"):
         collect(out, 16, workers=1, **RUN)  # redoes the damaged chunk, removes the leftover
@@ -292,40 +368,53 @@ def test_a_second_collection_into_the_same_directory_is_refused(tmp_path):
 
 def test_saved_images_decode_to_the_observations(tmp_path):
     collect(tmp_path / "img", 3, seed=2, env_options=SMALL, chunk_size=3, progress=False, save_images=True)
-    assert "initial_range" not in load_dataset(tmp_path / "img").columns  # images only when asked for
+    assert "image_initial_range" not in load_dataset(tmp_path / "img").columns  # images only when asked for
     frame = load_dataset(tmp_path / "img", with_images=True)
-    ranges, masks = images(frame, "initial_range"), images(frame, "final_mask")
+    ranges, masks = images(frame, "image_initial_range"), images(frame, "image_final_mask")
     assert ranges.shape == (len(frame), 32, 32) and masks.dtype == bool
     obs, _ = TapAffordanceEnv(**SMALL).reset(seed=interaction_seed(2, int(frame.episode[0])))
-    np.testing.assert_array_equal(images(frame, "initial_mask")[0], obs["mask"].astype(bool))
+    np.testing.assert_array_equal(images(frame, "image_initial_mask")[0], obs["mask"].astype(bool))
     np.testing.assert_allclose(ranges[0], obs["range"], rtol=1e-3)  # float16 on disk
     with pytest.raises(ValueError, match="save_images"):
-        images(frame.drop(columns="final_mask"), "final_mask")
+        images(frame.drop(columns="image_final_mask"), "image_final_mask")
+
+
+def _old_column_names(version: int) -> dict[str, str]:
+    """Current column name -> the name a dataset of schema ``version`` (< 5) gave it."""
+    pose = {c: (f"object_{c.removeprefix('true_')}" if version == 1 else c.removeprefix("true_"))
+            for c in POSE_COLUMNS}
+    return {**pose, **{f"image_{s}_{k}": f"{s}_{k}" for s in ("initial", "final") for k in ("range", "mask")}}
 
 
 def test_schema_version_1_datasets_are_read(reference, tmp_path):
     out = tmp_path / "v1"
     out.mkdir()
-    pose = [f"{stage}_{f}" for stage in ("initial", "final") for f in ("x", "y", "z", "qw", "qx", "qy", "qz")]
-    old = reference[reference.episode < 8].rename(columns={p: f"object_{p}" for p in pose})
+    old = reference[reference.episode < 8].rename(columns=_old_column_names(1))
     old.to_parquet(out / "chunk-00000.parquet")
     manifest = {**reference.attrs["manifest"], "schema_version": 1, "episodes": 8}
+    del manifest["chunk_sha256"]
     (out / "manifest.json").write_text(json.dumps(manifest))
     frame = load_dataset(out)
-    assert "object_initial_x" in old.columns and "initial_x" in frame.columns
+    assert "object_initial_x" in old.columns and "true_initial_x" in frame.columns
+    pd.testing.assert_frame_equal(frame, reference[reference.episode < 8], check_exact=True)
     with pytest.raises(DatasetError, match="schema_version: dataset has 1"):
         collect(out, 8, workers=1, **RUN)
 
 
 def _as_old_version(source, out, version: int, dropped: list[str]) -> None:
-    """Rewrite the dataset ``source`` into ``out`` as schema ``version`` without the columns ``dropped``."""
+    """Rewrite the dataset ``source`` into ``out`` as the writer of schema ``version`` (2 to 4) wrote it: its
+    column names, no checksums, and without the columns ``dropped``."""
     out.mkdir()
     manifest = {**json.loads((source / "manifest.json").read_text()), "schema_version": version}
+    del manifest["chunk_sha256"]
+    names = _old_column_names(version)
     for chunk_file in sorted(source.glob("chunk-*.parquet")):
         chunk = pq.read_table(chunk_file)
         meta = json.loads(chunk.schema.metadata[b"tap_affordance"])
         meta["schema_version"] = version
-        chunk = chunk.drop_columns(dropped).replace_schema_metadata({b"tap_affordance": json.dumps(meta)})
+        chunk = chunk.drop_columns(dropped)
+        chunk = chunk.rename_columns([names.get(c, c) for c in chunk.column_names])
+        chunk = chunk.replace_schema_metadata({b"tap_affordance": json.dumps(meta)})
         pq.write_table(chunk, out / chunk_file.name)
     (out / "manifest.json").write_text(json.dumps(manifest))
 
@@ -334,6 +423,7 @@ def test_schema_version_2_datasets_are_read(reference, reference_dir, tmp_path):
     # Version 2 had no rolling_distance, tilt, toppled, outcome_time or success columns; success is derived.
     added = ["rolling_distance", "tilt", "toppled", "outcome_time"]
     _as_old_version(reference_dir, tmp_path / "v2", 2, [*added, "success"])
+    assert "initial_x" in pq.read_schema(tmp_path / "v2" / "chunk-00000.parquet").names
     frame = load_dataset(tmp_path / "v2")
     assert len(frame) == len(reference) and not set(added) & set(frame.columns)
     pd.testing.assert_frame_equal(frame, reference.drop(columns=added), check_exact=True)
@@ -341,18 +431,30 @@ def test_schema_version_2_datasets_are_read(reference, reference_dir, tmp_path):
 
 def test_schema_version_3_datasets_get_the_success_label_derived(tmp_path):
     # Version 3 stored no success column: it is derived by the env's rule, here push's (displacement beyond
-    # roll_threshold), and equals what a version 4 dataset stores. Extending such a dataset is refused.
+    # roll_threshold), and equals what a current dataset stores. Extending such a dataset is refused.
     run = {**RUN, "env_options": {**SMALL, "behavior": "push"}}
-    collect(tmp_path / "v4", 8, workers=1, **run)
-    stored = load_dataset(tmp_path / "v4")
+    collect(tmp_path / "v5", 8, workers=1, **run)
+    stored = load_dataset(tmp_path / "v5")
     assert stored.success.dtype == bool and stored.success.any() and not stored.success.all()
     assert (stored.success == (stored.displacement > 0.03)).all()
-    _as_old_version(tmp_path / "v4", tmp_path / "v3", 3, ["success"])
+    _as_old_version(tmp_path / "v5", tmp_path / "v3", 3, ["success"])
     derived = load_dataset(tmp_path / "v3")
     assert derived.attrs["manifest"]["schema_version"] == 3
     pd.testing.assert_frame_equal(derived, stored, check_exact=True)
     with pytest.raises(DatasetError, match="schema_version: dataset has 3"):
         collect(tmp_path / "v3", 8, workers=1, **run)
+
+
+def test_schema_version_4_datasets_load_with_the_new_names_images_too(tmp_path):
+    collect(tmp_path / "v5", 3, seed=2, env_options=SMALL, chunk_size=3, progress=False, save_images=True)
+    _as_old_version(tmp_path / "v5", tmp_path / "v4", 4, [])
+    assert {"initial_x", "initial_range"} <= set(pq.read_schema(tmp_path / "v4" / "chunk-00000.parquet").names)
+    old, new = (load_dataset(tmp_path / v, with_images=True) for v in ("v4", "v5"))
+    pd.testing.assert_frame_equal(old, new, check_exact=True)
+    np.testing.assert_array_equal(images(old, "image_final_mask"), images(new, "image_final_mask"))
+    assert "image_initial_range" not in load_dataset(tmp_path / "v4").columns
+    with pytest.raises(ValueError, match="'initial_range' is named 'image_initial_range' now"):
+        images(old, "initial_range")
 
 
 def test_progress_bar_only_on_a_terminal_and_not_in_ci(monkeypatch):
@@ -440,3 +542,16 @@ def test_a_local_dask_cluster_collects_the_same_dataset(reference, tmp_path):
     assert_same_dataset(tmp_path / "dask", reference)
     collect(tmp_path / "local-dask", 24, scheduler="dask", workers=2, **RUN)  # a cluster of its own
     assert_same_dataset(tmp_path / "local-dask", reference)
+
+
+def test_without_a_terminal_progress_is_a_plain_line_every_10_s(tmp_path, monkeypatch, capsys):
+    import affordance_env.progress as progress
+
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: False)
+    monkeypatch.setattr(progress, "LOG_INTERVAL", 0.0)  # every update, to see the lines
+    collect(tmp_path / "d", 4, **{**RUN, "chunk_size": 2, "progress": None})
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) >= 3 and "\r" not in "".join(lines)  # the start, each chunk, the end
+    assert lines[-1].startswith("d: 100%") and "4/4" in lines[-1]
+    collect(tmp_path / "e", 2, **{**RUN, "chunk_size": 2, "progress": False})
+    assert capsys.readouterr().err == ""

@@ -101,6 +101,8 @@ def test_bad_actions_get_clear_errors(env, action, match):
         ({"camera_width": 1}, "camera resolution"),
         ({"settle_timeout": 0.0}, "settle_timeout"),
         ({"range_noise": "lidar"}, "kinect_v1"),
+        ({"size_range": ("small", "big")}, r"size_range must be \(low, high\) in metres, got \('small', 'big'\)"),
+        ({"camera_fovy": "wide"}, "camera_fovy must be a vertical field of view in degrees, got 'wide'"),
     ],
 )
 def test_bad_options_get_clear_errors(kwargs, match, monkeypatch):
@@ -446,6 +448,19 @@ def test_reset_options_place_the_chosen_object_and_unknown_keys_are_refused():
         env.reset(seed=0, options={"position": (-2.0, 0.0)})
     with pytest.raises(ValueError, match="Valid types"):
         env.reset(seed=0, options={"object_type": "cube"})
+    with pytest.raises(ValueError, match=r"options must be a dict with keys among \('object_type', .*got 'sphere'"):
+        env.reset(seed=0, options="sphere")
+    with pytest.raises(ValueError, match="reset option 'size': .* got 'big'"):
+        env.reset(seed=0, options={"size": "big"})
+    with pytest.raises(ValueError, match="yaw must be a finite angle .* got 'left'"):
+        env.reset(seed=0, options={"yaw": "left"})
+
+
+def test_gym_make_refuses_a_render_mode_the_env_lacks_naming_those_it_has():
+    # not Gymnasium's HumanRendering wrapper (and its "pygame is not installed"): the env's own refusal
+    with pytest.raises(ValueError, match=r"render_mode must be None or one of \['rgb_array', 'rgb_array_list'\], "
+                                         "got 'human'"):
+        gym.make("TapAffordance-v0", render_mode="human")
 
 
 def test_range_noise_is_seeded_and_realistic():

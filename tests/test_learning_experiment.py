@@ -58,13 +58,17 @@ def test_results_follow_the_schema(results: dict, frame: pd.DataFrame) -> None:
             assert all(set(v) == {"mean", "std"} for v in results[key][r].values())
     for key in ("uniformity", "purity", "adjusted_rand", "n_categories", "svm_baseline", "feature_weights"):
         assert list(results[key]) == k_keys
-    assert all(0.0 <= v["mean"] <= 100.0 for v in results["uniformity"].values())
+    # one unit for every share: a fraction in [0, 1], as config["units"] says
+    assert results["results_format"] == 2 and "fractions in [0, 1]" in results["config"]["units"]
+    assert all(0.0 <= v["mean"] <= 1.0 for v in results["uniformity"].values())
+    assert all(0.0 <= v["mean"] <= 1.0 for v in results["purity"].values())
     assert all(0.0 <= v["mean"] <= 1.0 for r in r_keys for v in results["svm_accuracy"][r].values())
     assert all(1 <= v["mean"] <= 49 for r in r_keys for v in results["n_selected"][r].values())
     assert list(results["case_studies"]) == ["2", "3", "4"]
     for k, clusters in results["case_studies"].items():
         assert [c["cluster"] for c in clusters] == list(range(int(k)))
-        assert all(set(c) == {"cluster", "success", "fail", "types", "sizes"} for c in clusters)
+        assert all(set(c) == {"cluster", "success", "fail", "types", "sizes", "left_view"} for c in clusters)
+        assert sum(c["left_view"] for c in clusters) == (~frame["visible_final"]).sum()
         assert sum(c["success"] + c["fail"] for c in clusters) == len(frame)
         assert sum(c["success"] for c in clusters) == frame["success"].sum()
         assert sum(len(c["sizes"]) for c in clusters) == len(frame)
@@ -76,7 +80,7 @@ def test_results_follow_the_schema(results: dict, frame: pd.DataFrame) -> None:
     assert (config["success_label"], config["fail_label"]) == ("rolled", "did not roll")
     assert config["success_fraction"] == pytest.approx(frame["success"].mean())
     assert config["case_study_ks"] == [2, 3, 4]
-    assert set(results["size_success"]) == {"bins", "logistic", "critical_size", "below", "above"}
+    assert set(results["size_success"]) == {"bins", "logistic", "test", "critical_size", "below", "above"}
     assert sum(b["n"] for b in results["size_success"]["bins"]) == len(frame)
     assert set(results["effects"]["by_type"]["sphere"]) >= {"success", "visible_final"}
     assert json.loads(json.dumps(results, allow_nan=False)) == results
@@ -84,7 +88,7 @@ def test_results_follow_the_schema(results: dict, frame: pd.DataFrame) -> None:
 
 def test_protocol_finds_the_papers_structure_in_synthetic_taps(results: dict) -> None:
     # the synthetic taps roll by shape: clusters follow rolled/not rolled, and shape features are chosen
-    assert results["uniformity"]["3"]["mean"] > 70.0
+    assert results["uniformity"]["3"]["mean"] > 0.70
     assert results["shape_fraction"]["0.4"]["3"]["mean"] > 0.8
     assert results["n_selected"]["0.4"]["2"]["mean"] < results["n_selected"]["0.0"]["2"]["mean"]
     assert results["svm_accuracy"]["0.4"]["2"]["mean"] > results["svm_baseline"]["2"]["mean"]
@@ -229,7 +233,7 @@ def _paper_like(results: dict) -> dict:
     good = copy.deepcopy(results)
     ks = [str(k) for k in range(2, 11)]
     rs = ["0.0", "0.2", "0.4", "0.6", "0.8"]
-    good["uniformity"] = {k: {"mean": 80.0 + 1.5 * i, "std": 1.0} for i, k in enumerate(ks)}
+    good["uniformity"] = {k: {"mean": 0.80 + 0.015 * i, "std": 0.01} for i, k in enumerate(ks)}
     good["shape_fraction"] = {
         r: {k: {"mean": 0.45 + 0.1 * j, "std": 0.0} for k in ks} for j, r in enumerate(rs)
     }
@@ -270,7 +274,7 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
     verdicts = {c.topic: c.verdict for c in evaluate_claims(good)}
     assert set(verdicts.values()) == {AGREES}, verdicts
     bad = copy.deepcopy(good)
-    bad["uniformity"] = {k: {"mean": 60.0 - i, "std": 1.0} for i, k in enumerate(good["uniformity"])}
+    bad["uniformity"] = {k: {"mean": 0.60 - 0.01 * i, "std": 0.01} for i, k in enumerate(good["uniformity"])}
     bad["svm_accuracy"]["0.4"] = {k: {"mean": 0.5, "std": 0.0} for k in good["svm_accuracy"]["0.4"]}
     bad["case_studies"]["2"][0]["types"]["sphere"], bad["case_studies"]["2"][1]["types"]["sphere"] = 0, 250
     verdicts = {c.topic: c.verdict for c in evaluate_claims(bad)}
@@ -306,7 +310,7 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
         "Bump at k = 4",
     ):
         assert verdicts[topic] == DISAGREES, topic
-    partial = {"uniformity": good["uniformity"]}
+    partial = {"results_format": 2, "uniformity": good["uniformity"]}
     verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
     assert verdicts["Uniformity on average"] == AGREES and verdicts["Bump at k = 4"] == NOT_COMPUTABLE
 
@@ -316,8 +320,8 @@ def _grasp_like(results: dict) -> dict:
     good = _paper_like(results)
     good["config"] = {**good["config"], "behavior": "grasp", "success_label": "lifted and held",
                       "fail_label": "not held"}
-    u = {2: 66.0, 3: 60.0, 4: 70.0, 5: 72.0, 6: 75.0, 7: 78.0, 8: 80.0, 9: 84.0, 10: 90.0}  # mean 75
-    good["uniformity"] = {str(k): {"mean": v, "std": 1.0} for k, v in u.items()}
+    u = {2: 66.0, 3: 60.0, 4: 70.0, 5: 72.0, 6: 75.0, 7: 78.0, 8: 80.0, 9: 84.0, 10: 90.0}  # mean 75 %
+    good["uniformity"] = {str(k): {"mean": v / 100, "std": 0.01} for k, v in u.items()}
     good["size_fraction"] = {r: {k: {"mean": 0.7, "std": 0.0} for k in per_k}
                              for r, per_k in good["shape_fraction"].items()}
     good["size_success"] = {
@@ -347,7 +351,7 @@ def test_grasp_claims_are_computed_from_the_numbers(results: dict) -> None:
         "Fewer features as r rises", "Number constant in k", "SVM accuracy falls with k"]
     assert set(verdicts.values()) == {AGREES}, verdicts
     bad = copy.deepcopy(good)
-    bad["uniformity"] = {k: {"mean": 84.0 + int(k), "std": 1.0} for k in good["uniformity"]}  # no fall, >80
+    bad["uniformity"] = {k: {"mean": (84.0 + int(k)) / 100, "std": 0.01} for k in good["uniformity"]}  # >80 %
     bad["size_fraction"] = {r: {k: {"mean": 0.3, "std": 0.0} for k in per_k}
                             for r, per_k in good["size_fraction"].items()}
     bad["size_success"]["below"]["success"], bad["size_success"]["above"]["success"] = 0.6, 0.4  # too soft
@@ -357,7 +361,7 @@ def test_grasp_claims_are_computed_from_the_numbers(results: dict) -> None:
         assert verdicts[topic] == DISAGREES, topic
     # the average must be above 70 %, and not above the tap's 80 %
     low = copy.deepcopy(good)
-    low["uniformity"] = {k: {"mean": v["mean"] - 10.0, "std": 1.0} for k, v in good["uniformity"].items()}
+    low["uniformity"] = {k: {"mean": v["mean"] - 0.10, "std": 0.01} for k, v in good["uniformity"].items()}
     assert {c.topic: c.verdict for c in evaluate_claims(low)}["Uniformity on average"] == DISAGREES
     # the straddling cluster must hold objects on both sides of the critical size, not just both outcomes
     one_side = copy.deepcopy(good)
@@ -379,7 +383,7 @@ def test_grasp_claims_are_computed_from_the_numbers(results: dict) -> None:
     single = copy.deepcopy(none)
     single["size_success"]["logistic"] = None
     assert {c.topic: c.verdict for c in evaluate_claims(single)}["Critical size"] == DISAGREES
-    partial = {"uniformity": good["uniformity"], "config": {"behavior": "grasp"}}
+    partial = {"results_format": 2, "uniformity": good["uniformity"], "config": {"behavior": "grasp"}}
     verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
     assert verdicts["Fall at k = 3"] == AGREES and verdicts["Critical size"] == NOT_COMPUTABLE
 
@@ -412,3 +416,57 @@ def test_the_overview_sets_the_behaviours_side_by_side(results: dict, tmp_path: 
     assert verdicts == 14 + 10
     with pytest.raises(ValueError, match="runs must map each behaviour"):
         write_overview({}, tmp_path)
+
+
+def test_reports_define_uniformity_and_read_older_results_in_percent(results: dict, tmp_path: Path) -> None:
+    from affordance_learning.report import render_overview, render_report
+
+    text = render_report(results)
+    assert "U = sum over clusters c of |S_c - F_c| / T" in text and "fractions in [0, 1]" in text
+    assert "U = sum over clusters c of |S_c - F_c| / T" in render_overview({"tap": results})
+    u3 = 100 * results["uniformity"]["3"]["mean"]
+    assert f"| uniformity [%] | {100 * results['uniformity']['2']['mean']:.1f} ±" in text
+    older = copy.deepcopy(results)  # format 1: the uniformity in percent, no results_format
+    del older["results_format"]
+    for entry in older["uniformity"].values():
+        entry["mean"], entry["std"] = 100 * entry["mean"], 100 * entry["std"]
+    assert render_report(older) == text
+    assert [c.ours for c in evaluate_claims(older)] == [c.ours for c in evaluate_claims(results)]
+    assert f"{u3:.1f}" in next(c.ours for c in evaluate_claims(results) if c.topic == "Uniformity on average")
+    with pytest.raises(ValueError, match="results of format 3"):
+        render_report({**results, "results_format": 3})
+
+
+def test_no_critical_size_where_success_does_not_depend_on_size(results: dict, tmp_path: Path) -> None:
+    from affordance_learning.metrics import size_success
+    from affordance_learning.report import render_overview, render_report
+
+    rng = np.random.default_rng(3)
+    sizes = rng.uniform(0.04, 0.10, 1000)  # the tap's rolled share drifts from 47 % to 56 % across the sizes
+    drift = copy.deepcopy(results)
+    drift["size_success"] = size_success(sizes, rng.random(1000) < 0.47 + 0.09 * (sizes - 0.04) / 0.06)
+    assert drift["size_success"]["critical_size"] is None
+    text = render_report(drift)
+    assert "Success does not depend on object size" in text and "crosses 50 % at" not in text
+    overview_row = next(line for line in render_overview({"tap": drift}).splitlines() if line.startswith("| [tap]"))
+    assert overview_row.split(" | ")[6] == "-"  # the critical size column
+
+
+def test_prototypes_mark_categories_whose_objects_left_the_view(results: dict, tmp_path: Path, monkeypatch) -> None:
+    import affordance_learning.figures as figures
+
+    drawn = {}
+    monkeypatch.setattr(figures, "_save", lambda fig, path: drawn.setdefault(path.name, fig) and path)
+    gone = copy.deepcopy(results)
+    clusters = gone["case_studies"]["2"]
+    clusters[1]["left_view"] = clusters[1]["success"] + clusters[1]["fail"]  # every object of cluster 1 left
+    clusters[0]["left_view"] = 0
+    figures.write_figures(gone, tmp_path)
+    ax_move = drawn["prototypes.png"].axes[0]  # the 1 x 2 map's motion of the mean point
+    assert [t.get_text() for t in ax_move.texts] == ["object left\nthe view:\nno motion\nseen"]
+    bars = [bar for container in ax_move.containers for bar in container]
+    assert bars and all(abs(bar.get_x() + bar.get_width() / 2) < 0.5 for bar in bars)  # cluster 0's only
+    legend = [t.get_text() for t in drawn["prototypes.png"].axes[3].get_legend().get_texts()]
+    assert legend[1].endswith(f"{clusters[1]['left_view']} left the view") and "left" not in legend[0]
+    case = drawn["case_study_k2.png"].axes[0]
+    assert case.get_title() == "(a) outcomes measured by the simulator"

@@ -91,6 +91,11 @@ def test_purity_rand_and_cross_validated_svm() -> None:
         svm_cv_accuracy(X, np.zeros(300))
 
 
+def intercept_over_slope(found: dict) -> float:
+    """Where the logistic fit crosses 50 % [m] (with the sign of intercept / slope)."""
+    return found["logistic"]["intercept"] / found["logistic"]["slope"]
+
+
 def test_size_success_finds_where_success_turns_to_failure() -> None:
     rng = np.random.default_rng(0)
     sizes = rng.uniform(0.03, 0.09, 2000)
@@ -104,6 +109,12 @@ def test_size_success_finds_where_success_turns_to_failure() -> None:
     # success independent of size (90 % everywhere): a fit, but no crossing of 50 % among the sizes seen
     coin = size_success(sizes, rng.random(2000) < 0.9)
     assert coin["logistic"] is not None and coin["critical_size"] is None and coin["below"] is None
+    assert found["test"]["depends_on_size"] and found["test"]["p_value"] < 1e-10 and found["test"]["span"] < -0.9
+    # a drift that crosses 50 % within the sizes, as the tap's rolled share from 47 % to 56 %: significant
+    # perhaps, but success does not depend on size, so no critical size
+    drift = size_success(sizes, rng.random(2000) < 0.45 + 0.12 * (sizes - 0.03) / 0.06)
+    assert drift["logistic"] is not None and not drift["test"]["depends_on_size"]
+    assert 0.03 < -intercept_over_slope(drift) < 0.09 and drift["critical_size"] is None and drift["below"] is None
     # one outcome only: nothing to fit
     always = size_success(sizes, np.ones(2000, dtype=bool))
     assert always["logistic"] is None and always["critical_size"] is None
@@ -504,24 +515,35 @@ def test_default_model_refuses_missing_corrupt_and_stale_files(stored_model: tup
         load_default_model(stale)
 
 
-def test_default_model_path_is_in_the_package() -> None:
+def test_default_models_are_the_packages_until_the_user_rebuilds_one(tmp_path, monkeypatch) -> None:
     assert default_model_module.DEFAULT_MODEL_PATH.parent.name == "data"
     assert default_model_module.DEFAULT_MODEL_PATH.parent.parent.name == "affordance_learning"
+    monkeypatch.setenv("TAP_AFFORDANCE_DATA", str(tmp_path / "mine"))
     assert default_model_module.model_path() == default_model_module.DEFAULT_MODEL_PATH
     assert default_model_module.model_path("grasp") == default_model_module.MODEL_DIR / "grasp_model.joblib"
+    assert default_model_module.user_model_path("push") == tmp_path / "mine" / "push_model.joblib"
+    assert default_model_module.model_path("push") == tmp_path / "mine" / "push_model.joblib"  # none shipped
+    monkeypatch.delenv("TAP_AFFORDANCE_DATA")
+    monkeypatch.setenv("XDG_DATA_HOME", str(tmp_path / "xdg"))
+    assert default_model_module.user_model_dir() == tmp_path / "xdg" / "tap-affordance"
+    monkeypatch.delenv("XDG_DATA_HOME")
+    monkeypatch.setenv("HOME", str(tmp_path / "home"))
+    assert default_model_module.user_model_dir() == tmp_path / "home" / ".local" / "share" / "tap-affordance"
 
 
 def test_each_behaviour_has_its_own_default_model(tmp_path: object, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(default_model_module, "MODEL_DIR", tmp_path)  # the package's data directory, elsewhere
+    monkeypatch.setattr(default_model_module, "MODEL_DIR", tmp_path / "package")  # shipping no model
+    monkeypatch.setenv("TAP_AFFORDANCE_DATA", str(tmp_path))  # the user's data directory
     grasps = make_synthetic_frame(160, random_state=5, behavior="grasp")
     features = grasps[[c for c in grasps.columns if c.startswith("initial_")]].to_numpy()
     # not built yet: the error says how to build it
     with pytest.raises(DefaultModelMissingError, match=r"grasp model .* missing.*affordance train-default "
-                                                        r"--behavior grasp.*1000 canonical grasp interactions"):
+                                                        r"--behavior grasp.*1000 canonical grasp interactions.*"
+                                                        r"user's data directory"):
         predict_effect(features[:2], "grasp")
-    model = train_default_model(grasps, behavior="grasp")  # into the behaviour's file
-    assert (tmp_path / "grasp_model.joblib").exists() and joblib.load(tmp_path / "grasp_model.joblib")[
-        "behavior"] == "grasp"
+    model = train_default_model(grasps, behavior="grasp")  # into the behaviour's file, the user's
+    assert not (tmp_path / "package").exists()
+    assert joblib.load(tmp_path / "grasp_model.joblib")["behavior"] == "grasp"
     prediction = predict_effect(features[:5], "grasp")
     np.testing.assert_array_equal(
         prediction.category, model.predict(pd.DataFrame(features[:5], columns=model.feature_names_in_)))

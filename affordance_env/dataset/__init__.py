@@ -2,7 +2,8 @@
 
 - :mod:`.format`: what a dataset is on disk (schema, manifest, chunks) and how its files are checked.
 - :mod:`.collect`: :func:`collect` runs interactions into a dataset, resumably.
-- :mod:`.load`: :func:`load_dataset` reads one back; :func:`images` decodes its stored images.
+- :mod:`.load`: :func:`load_dataset` reads one back, every chunk checked against its SHA-256; :func:`images`
+  decodes its stored images; :func:`learning_data` gives a learner its X, E and the labels.
 - :mod:`.minari_export`: :func:`export_minari` writes one as a Minari dataset.
 """
 
@@ -17,18 +18,22 @@ from affordance_env.dataset.collect import (
     show_progress,
 )
 from affordance_env.dataset.format import (
+    FEATURE_PREFIXES,
     FORMAT,
+    GROUND_TRUTH_COLUMNS,
     IMAGE_COLUMNS,
     MANIFEST,
+    POSE_COLUMNS,
     POSE_FIELDS,
     SCHEMA_VERSION,
     DatasetError,
     arrow_schema,
     chunk_name,
+    collect_command,
     read_manifest,
 )
 
-_LAZY = {"images": "load", "load_dataset": "load", "export_minari": "minari_export"}
+_LAZY = {"images": "load", "load_dataset": "load", "learning_data": "load", "export_minari": "minari_export"}
 
 
 def __getattr__(name: str):
@@ -41,9 +46,12 @@ def __getattr__(name: str):
 
 __all__ = [
     "ACTIONS",
+    "FEATURE_PREFIXES",
     "FORMAT",
+    "GROUND_TRUTH_COLUMNS",
     "IMAGE_COLUMNS",
     "MANIFEST",
+    "POSE_COLUMNS",
     "POSE_FIELDS",
     "SCHEDULERS",
     "SCHEMA_VERSION",
@@ -52,11 +60,13 @@ __all__ = [
     "arrow_schema",
     "chunk_name",
     "collect",
+    "collect_command",
     "export_minari",
     "failure_summary",
     "images",
     "interaction_action",
     "interaction_seed",
+    "learning_data",
     "load_dataset",
     "read_manifest",
     "show_progress",

@@ -19,7 +19,7 @@ import contextlib
 import dataclasses
 import json
 import os
-import sys
+import signal
 import threading
 import warnings
 from collections.abc import Iterator
@@ -32,6 +32,7 @@ import pyarrow.parquet as pq
 
 from affordance_env.behaviors import ACTION_DIM
 from affordance_env.dataset.format import (
+    CHECKSUMS,
     IMAGE_COLUMNS,
     MANIFEST,
     METADATA_KEY,
@@ -42,6 +43,7 @@ from affordance_env.dataset.format import (
     chunk_name,
     chunk_ranges,
     dataset_header,
+    file_sha256,
     interaction_row,
     read_manifest,
     settings_differences,
@@ -49,6 +51,7 @@ from affordance_env.dataset.format import (
     write_manifest,
 )
 from affordance_env.options import EnvOptions
+from affordance_env.progress import progress_bar, show_progress  # noqa: F401  (show_progress: re-exported)
 
 ACTIONS = ("canonical", "random")
 SCHEDULERS = ("joblib", "dask")
@@ -83,8 +86,9 @@ def _worker_env(options_json: str):
     return envs[options_json]
 
 
-def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) -> tuple[int, int, dict]:
-    """Run interactions ``start .. stop-1``, write them as chunk ``index``; returns (index, n, failures)."""
+def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) -> tuple[int, int, dict, str]:
+    """Run interactions ``start .. stop-1``, write them as chunk ``index``; returns (index, n, failures, the
+    file's SHA-256)."""
     from affordance_env import __version__
 
     if __version__ != header["package_version"]:
@@ -113,9 +117,14 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) ->
     table = pa.Table.from_pydict(columns, schema=schema.with_metadata({METADATA_KEY: json.dumps(meta)}))
     # zstd for the images (small); snappy for the numbers: zstd saves little there and reads twice as slowly
     codecs = {name: "zstd" if name in IMAGE_COLUMNS else "snappy" for name in schema.names}
-    write_atomically(Path(out) / chunk_name(index),
-                      lambda tmp: pq.write_table(table, tmp, compression=codecs))
-    return index, stop - start, failures
+    digest = []
+
+    def write(tmp: Path) -> None:
+        pq.write_table(table, tmp, compression=codecs)
+        digest.append(file_sha256(tmp))  # of the bytes written, before anything else can touch them
+
+    write_atomically(Path(out) / chunk_name(index), write)
+    return index, stop - start, failures, digest[0]
 
 
 # --- the coordinator -------------------------------------------------------------------------------------
@@ -143,13 +152,6 @@ def _exclusive(out: Path) -> Iterator[None]:
             raise DatasetError(f"another collection is writing to {out} (it holds {out / '.lock'}); wait "
                                "for it to finish or use another --out.") from None
         yield
-
-
-def show_progress(progress: bool | None) -> bool:
-    """Whether to draw the progress bar: as asked, or by default on a terminal when ``CI`` is not set."""
-    if progress is not None:
-        return bool(progress)
-    return sys.stderr.isatty() and not os.environ.get("CI")
 
 
 def collect(
@@ -180,7 +182,8 @@ def collect(
             camera_width, camera_height, camera_fovy, roll_threshold, settle_timeout); the others keep the
             env's defaults, which are recorded too.
         chunk_size: Interactions per file: the most a crash can lose, per worker.
-        progress: Draw a progress bar; by default on a terminal when ``CI`` is not set.
+        progress: Draw a progress bar; by default on a terminal when ``CI`` is not set, and otherwise write a
+            progress line every 10 s (:func:`~affordance_env.progress.progress_bar`); False: nothing.
         scheduler: ``"joblib"`` (processes on this machine) or ``"dask"`` (Dask distributed: the cluster at
             ``dask_address``, or a local cluster of ``workers`` processes).
         dask_address: A Dask scheduler (``"tcp://host:8786"``); implies ``scheduler="dask"``. Its workers need
@@ -213,8 +216,9 @@ def collect(
     header = dataset_header(seed, action, chunk_size, options, save_images)
     out, episodes = Path(out), int(episodes)
 
+    stored: dict = {}
     if (out / MANIFEST).exists():
-        _check_resumable(out, header, episodes)
+        stored = _check_resumable(out, header, episodes)
     elif out.exists() and (not out.is_dir() or any(p.name != ".lock" for p in out.iterdir())):
         raise DatasetError(f"{out} exists and is not a TapAffordance dataset (no {MANIFEST}); choose an "
                            "empty or new directory.")
@@ -225,24 +229,23 @@ def collect(
         ranges = chunk_ranges(episodes, chunk_size)
         done = {}
         for index, (start, stop) in enumerate(ranges):
-            meta = _existing_chunk(out / chunk_name(index), header, start, stop)
-            if meta is not None:
-                done[index] = (stop - start, meta["chunk"]["failures"])
+            found = _existing_chunk(out / chunk_name(index), header, start, stop, stored)
+            if found is not None:
+                meta, digest = found
+                done[index] = (stop - start, meta["chunk"]["failures"], digest)
         write_manifest(out, header, episodes, done)
         _check_failure_share(done, max_failure_share, out)
         tasks = [(str(out), i, start, stop, header)
                  for i, (start, stop) in enumerate(ranges) if i not in done]
-        n_failed = sum(len(f) for _, f in done.values())
-        from tqdm.auto import tqdm
-
-        with tqdm(total=episodes, initial=sum(n for n, _ in done.values()), unit="interaction", desc=out.name,
-                  disable=not show_progress(progress), smoothing=0.05, dynamic_ncols=True) as bar:
-            bar.set_postfix(failed=n_failed)
-            for index, n, failures in _run(tasks, scheduler, workers, dask_address):
+        n_failed = sum(len(f) for _, f, _ in done.values())
+        with progress_bar(progress, total=episodes, initial=sum(n for n, _, _ in done.values()),
+                          unit="interaction", desc=out.name, smoothing=0.05) as bar:
+            bar.set_postfix(failed=n_failed, refresh=False)
+            for index, n, failures, digest in _run(tasks, scheduler, workers, dask_address):
                 if not (out / chunk_name(index)).exists():
                     raise DatasetError(f"a worker wrote {chunk_name(index)} where this process cannot see "
                                        f"it: the Dask workers must share {out} with this machine.")
-                done[index] = (n, failures)
+                done[index] = (n, failures, digest)
                 write_manifest(out, header, episodes, done)
                 n_failed += len(failures)
                 bar.set_postfix(failed=n_failed, refresh=False)
@@ -268,9 +271,9 @@ class FailureShareError(DatasetError):
     """More interactions failed than the collection was told to accept."""
 
 
-def _check_failure_share(done: dict[int, tuple[int, dict]], max_share: float, out: Path) -> None:
-    collected = sum(n for n, _ in done.values())
-    failures = {k: v for _, chunk in done.values() for k, v in chunk.items()}
+def _check_failure_share(done: dict[int, tuple[int, dict, str]], max_share: float, out: Path) -> None:
+    collected = sum(n for n, _, _ in done.values())
+    failures = {k: v for _, chunk, _ in done.values() for k, v in chunk.items()}
     if collected and len(failures) / collected > max_share:
         raise FailureShareError(
             f"{len(failures)} of the {collected} interactions collected so far failed "
@@ -280,7 +283,8 @@ def _check_failure_share(done: dict[int, tuple[int, dict]], max_share: float, ou
             "their cause.")
 
 
-def _check_resumable(out: Path, header: dict, episodes: int) -> None:
+def _check_resumable(out: Path, header: dict, episodes: int) -> dict:
+    """The manifest of the dataset in ``out``, checked to be resumable as ``header`` with ``episodes``."""
     stored = read_manifest(out)
     diffs = settings_differences(stored, header)
     if diffs:
@@ -290,14 +294,23 @@ def _check_resumable(out: Path, header: dict, episodes: int) -> None:
         raise DatasetError(f"{out} holds a dataset of {stored['episodes']} interactions, asked for "
                            f"{episodes}: a dataset can be resumed or extended, not shortened; load it and "
                            f"keep the first {episodes} episodes instead.")
+    return stored
 
 
-def _existing_chunk(path: Path, header: dict, start: int, stop: int) -> dict | None:
-    """The metadata of a finished chunk that matches; None if it is missing or must be collected again."""
+def _existing_chunk(path: Path, header: dict, start: int, stop: int, stored: dict) -> tuple[dict, str] | None:
+    """The metadata and SHA-256 of a finished chunk that matches; None if it is missing or must be collected
+    again (warning why, unless it is the short last chunk of a grown dataset). ``stored``: the manifest found."""
     if not path.exists():
         return None
     try:
-        return check_chunk(path, header, start, stop)
+        meta = check_chunk(path, header, start, stop)
+        digest = file_sha256(path)
+        recorded = (stored.get(CHECKSUMS) or {}).get(path.name)
+        if recorded is not None and recorded != digest:
+            raise DatasetError(f"{path} has changed since it was written (its SHA-256 is not the one the "
+                               f"{MANIFEST} recorded).")
+        # not recorded: written by a run stopped before its manifest was updated; checked above, so kept
+        return meta, digest
     except DatasetError as exc:
         with contextlib.suppress(DatasetError, AttributeError, KeyError, TypeError):
             chunk = chunk_metadata(path)[0]["chunk"]
@@ -320,8 +333,16 @@ def _run(tasks: list[tuple], scheduler: str, workers: int, address: str | None) 
         from joblib import Parallel, delayed
 
         yield from Parallel(n_jobs=workers, return_as="generator_unordered", batch_size=1)(
-            delayed(_collect_chunk)(*task) for task in tasks
+            delayed(_collect_chunk_in_worker)(*task) for task in tasks
         )
+
+
+def _collect_chunk_in_worker(*task) -> tuple[int, int, dict, str]:
+    """:func:`_collect_chunk` in a worker process of this machine, which leaves Ctrl-C to the coordinating
+    process: that one stops the workers (whole chunks stay, as always) and says so once, instead of every worker
+    printing a traceback."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    return _collect_chunk(*task)
 
 
 def _run_dask(tasks: list[tuple], workers: int, address: str | None) -> Iterator[tuple]:

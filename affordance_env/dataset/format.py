@@ -3,18 +3,30 @@
 A dataset is a directory::
 
     manifest.json          what the dataset is: settings, package version, feature names and groups, schema
-                           version, progress, and the interactions left out (count, kinds, episode -> reason)
+                           version, progress, the interactions left out (count, kinds, episode -> reason), and
+                           the SHA-256 of every finished chunk (``chunk_sha256``)
     chunk-00000.parquet    interactions 0 .. chunk_size-1, one row each (columns: :func:`arrow_schema`)
     chunk-00001.parquet    ...
     .lock                  held by the collection writing the dataset (empty)
 
 Each chunk also carries the dataset's description, its episode range and its failures in its Parquet key-value
 metadata (key ``tap_affordance``), so that a chunk can be checked on its own. Files are written to a temporary
-name and renamed when complete (:func:`write_atomically`).
+name and renamed when complete (:func:`write_atomically`). A chunk counts as finished once the manifest records
+its SHA-256; reading checks every chunk against it, so any changed byte is an error, never silently changed data.
+
+The columns fall in namespaces that cannot be confused (:func:`arrow_schema`):
+
+- features: ``initial_<f>``, ``final_<f>``, ``effect_<f>``, exactly one per name ``f`` of ``FEATURE_NAMES`` (49);
+- ground truth, measured by the simulator and never an input of the learner: ``true_initial_<p>`` and
+  ``true_final_<p>`` (the object's pose, ``p`` in :data:`POSE_FIELDS`) and the labels of
+  :data:`GROUND_TRUTH_COLUMNS` (``type``, ``size``, ``success``, ...);
+- the action: ``action_<j>``; the images: ``image_<stage>_<kind>`` (:data:`IMAGE_COLUMNS`);
+- bookkeeping: ``episode``, ``seed``, ``behavior``.
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 from collections import Counter
@@ -30,13 +42,27 @@ from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
 from affordance_env.fileio import write_atomically
 
 #: Version of the on-disk format; :func:`~affordance_env.dataset.load_dataset` reads versions 1 up to this one.
-#: Version 4 added the ``success`` column.
-SCHEMA_VERSION = 4
+#: Version 4 added the ``success`` column. Version 5 named the object's pose ``true_initial_x`` ... (it was
+#: ``initial_x``, beside the features) and the images ``image_initial_range`` ... (``initial_range``), and
+#: recorded each chunk's SHA-256 in the manifest.
+SCHEMA_VERSION = 5
 FORMAT = "tap-affordance-dataset"
 MANIFEST = "manifest.json"
 METADATA_KEY = b"tap_affordance"
 POSE_FIELDS = ("x", "y", "z", "qw", "qx", "qy", "qz")
-IMAGE_COLUMNS = ("initial_range", "initial_mask", "final_range", "final_mask")
+#: The stages of an interaction whose features (and images) are stored, and the prefix of its effects.
+STAGES = ("initial", "final")
+FEATURE_PREFIXES = ("initial_", "final_", "effect_")
+#: Prefix of the ground-truth pose columns: ``true_initial_x`` ... ``true_final_qz``.
+TRUE_PREFIX = "true_"
+POSE_COLUMNS = tuple(f"{TRUE_PREFIX}{stage}_{f}" for stage in STAGES for f in POSE_FIELDS)
+#: The ground truth besides the pose: measured by the simulator, for evaluating, never an input of a learner.
+GROUND_TRUTH_COLUMNS = ("type", "size", "displacement", "rolling_distance", "rolled", "success", "tilt",
+                        "toppled", "outcome", "outcome_time", "contact", "hand_speed", "visible_initial",
+                        "visible_final", "ik_success")
+IMAGE_COLUMNS = tuple(f"image_{stage}_{kind}" for stage in STAGES for kind in ("range", "mask"))
+#: The manifest's record of each finished chunk's SHA-256 (hex), by file name.
+CHECKSUMS = "chunk_sha256"
 
 
 class DatasetError(ValueError):
@@ -48,7 +74,7 @@ def arrow_schema(save_images: bool = False) -> pa.Schema:
     fields = [("episode", pa.int64()), ("seed", pa.int64()), ("behavior", pa.string()),
               ("type", pa.string()), ("size", pa.float64())]
     fields += [(f"action_{j}", pa.float32()) for j in range(ACTION_DIM)]
-    fields += [(f"{stage}_{f}", pa.float64()) for stage in ("initial", "final") for f in POSE_FIELDS]
+    fields += [(column, pa.float64()) for column in POSE_COLUMNS]
     fields += [("displacement", pa.float64()), ("rolling_distance", pa.float64()), ("rolled", pa.bool_()),
                ("success", pa.bool_()), ("tilt", pa.float64()), ("toppled", pa.bool_()), ("outcome", pa.string()),
                ("outcome_time", pa.float64()), ("contact", pa.bool_()), ("hand_speed", pa.float64()),
@@ -65,8 +91,9 @@ def _record(episode: int, env_seed: int, action: np.ndarray, reset_info: dict, i
     row: dict[str, Any] = {"episode": episode, "seed": env_seed, "behavior": info["behavior"],
                            "type": obj["type"], "size": float(obj["size"])}
     row.update({f"action_{j}": a for j, a in enumerate(action)})
-    for stage in ("initial", "final"):
-        row.update({f"{stage}_{f}": float(v) for f, v in zip(POSE_FIELDS, obj[f"{stage}_pose"], strict=True)})
+    for stage in STAGES:
+        row.update({f"{TRUE_PREFIX}{stage}_{f}": float(v)
+                    for f, v in zip(POSE_FIELDS, obj[f"{stage}_pose"], strict=True)})
     row.update(displacement=float(info["displacement"]), rolling_distance=float(info["rolling_distance"]),
                rolled=bool(info["rolled"]), success=bool(info["success"]), tilt=float(info["tilt"]),
                toppled=bool(info["toppled"]), outcome=info["outcome"], outcome_time=float(info["outcome_time"]),
@@ -94,8 +121,8 @@ def interaction_row(episode: int, env_seed: int, action: np.ndarray, reset: tupl
                            f"{len(bad)} non-finite value(s), e.g. {bad[:3]}; nothing of it was written.")
     if save_images:
         for stage, obs in (("initial", obs_initial), ("final", obs_final)):
-            row[f"{stage}_range"] = obs["range"].astype(np.float16).tobytes()
-            row[f"{stage}_mask"] = np.packbits(obs["mask"].astype(bool)).tobytes()
+            row[f"image_{stage}_range"] = obs["range"].astype(np.float16).tobytes()
+            row[f"image_{stage}_mask"] = np.packbits(obs["mask"].astype(bool)).tobytes()
     return row
 
 
@@ -134,14 +161,54 @@ def settings_differences(stored: dict, asked: dict) -> list[str]:
             for key, value in new.items() if old.get(key) != value]
 
 
-def write_manifest(out: Path, header: dict, episodes: int, done: dict[int, tuple[int, dict]]) -> None:
-    failures = {k: v for _, chunk_failures in done.values() for k, v in chunk_failures.items()}
+def file_sha256(path: Path) -> str:
+    """The SHA-256 of a file's bytes, as hex."""
+    digest = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+def collect_command(path: str | os.PathLike, manifest: dict) -> str:
+    """The ``affordance collect`` command that makes (or finishes, or redoes chunks of) the dataset ``path``
+    described by ``manifest``: its settings, with the env options that differ from the env's defaults."""
+    import dataclasses
+    import shlex
+
+    from affordance_env.options import EnvOptions
+
+    settings = manifest.get("settings") or {}
+    words = ["affordance", "collect", "--out", str(path)]
+    for flag, value in (("--episodes", manifest.get("episodes")), ("--seed", settings.get("seed")),
+                        ("--chunk-size", settings.get("chunk_size"))):
+        if value is not None:  # a manifest that lacks it: the collection's own default
+            words += [flag, str(value)]
+    if settings.get("action", "canonical") != "canonical":
+        words += ["--action", str(settings["action"])]
+    if settings.get("save_images"):
+        words.append("--save-images")
+    defaults = json.loads(json.dumps({f.name: f.default for f in dataclasses.fields(EnvOptions)}, default=list))
+    options = settings.get("env_options")
+    for name, value in (options if isinstance(options, dict) else {}).items():
+        if value is None or value == defaults.get(name):
+            continue
+        values = value if isinstance(value, list | tuple) else [value]
+        words += [f"--{name.replace('_', '-')}", *(str(v) for v in values)]
+    return shlex.join(words)
+
+
+def write_manifest(out: Path, header: dict, episodes: int, done: dict[int, tuple[int, dict, str]]) -> None:
+    """Write the manifest of the dataset ``out``; ``done`` maps the index of each finished chunk to its
+    interaction count, its failures (episode -> reason) and its SHA-256."""
+    failures = {k: v for _, chunk_failures, _ in done.values() for k, v in chunk_failures.items()}
     kinds = Counter(reason.split(":", 1)[0] for reason in failures.values())
     n_chunks = len(chunk_ranges(episodes, header["settings"]["chunk_size"]))
     manifest = {**header, "episodes": episodes, "chunks": n_chunks, "chunks_done": len(done),
-                "complete": len(done) == n_chunks, "rows": sum(n - len(f) for n, f in done.values()),
+                "complete": len(done) == n_chunks, "rows": sum(n - len(f) for n, f, _ in done.values()),
                 "failures": {"count": len(failures), "by_kind": dict(sorted(kinds.items())),
-                             "episodes": {k: failures[k] for k in sorted(failures, key=int)}}}
+                             "episodes": {k: failures[k] for k in sorted(failures, key=int)}},
+                CHECKSUMS: {chunk_name(i): done[i][2] for i in sorted(done)}}
     write_atomically(out / MANIFEST, lambda tmp: tmp.write_text(json.dumps(manifest, indent=1)))
 
 
@@ -187,6 +254,19 @@ def chunk_metadata(path: Path) -> tuple[dict, int]:
     if not isinstance(meta, dict):
         raise DatasetError(f"{path} is corrupt: its {METADATA_KEY.decode()!r} metadata is not an object.")
     return meta, parquet.num_rows
+
+
+def check_checksum(path: Path, manifest: dict) -> str:
+    """The SHA-256 of the chunk file ``path``, once checked to be the one ``manifest`` records for it; raises
+    DatasetError if the file changed after it was written (or the manifest does not know it)."""
+    recorded = (manifest.get(CHECKSUMS) or {}).get(path.name)
+    digest = file_sha256(path)
+    if recorded is None:
+        raise DatasetError(f"{path} is not recorded as finished in the dataset's {MANIFEST} (no SHA-256 for it).")
+    if digest != recorded:
+        raise DatasetError(f"{path} has changed since it was written: its SHA-256 is {digest[:16]}..., the "
+                           f"dataset's {MANIFEST} recorded {recorded[:16]}....")
+    return digest
 
 
 def check_chunk(path: Path, header: dict, start: int, stop: int) -> dict:

@@ -13,17 +13,36 @@ import pyarrow.parquet as pq
 
 from affordance_env.behaviors import ROLL_THRESHOLD, get_behavior, is_success
 from affordance_env.dataset.format import (
+    CHECKSUMS,
+    FEATURE_PREFIXES,
+    GROUND_TRUTH_COLUMNS,
     IMAGE_COLUMNS,
     MANIFEST,
+    POSE_COLUMNS,
     POSE_FIELDS,
+    STAGES,
     DatasetError,
     arrow_schema,
+    check_checksum,
     check_chunk,
     chunk_metadata,
     chunk_name,
     chunk_ranges,
+    collect_command,
     read_manifest,
 )
+
+#: The names the columns of datasets of schema versions 1 to 4 had, where version 5 renamed them.
+_OLD_IMAGE_NAMES = {f"{stage}_{kind}": f"image_{stage}_{kind}" for stage in STAGES for kind in ("range", "mask")}
+
+
+def _old_names(version: int) -> dict[str, str]:
+    """Old column name -> current one, for a dataset of schema ``version``."""
+    if version >= 5:
+        return {}
+    pose = "object_{}_{}" if version == 1 else "{}_{}"  # version 1 named the poses object_initial_x ...
+    renames = {pose.format(stage, f): f"true_{stage}_{f}" for stage in STAGES for f in POSE_FIELDS}
+    return {**renames, **_OLD_IMAGE_NAMES}
 
 
 def images(frame: pd.DataFrame, column: str) -> np.ndarray:
@@ -31,14 +50,16 @@ def images(frame: pd.DataFrame, column: str) -> np.ndarray:
 
     Args:
         frame: From :func:`load_dataset`.
-        column: ``initial_range``, ``final_range`` (distance along each pixel's ray [m]; float16 on disk,
-            about 0.5 mm resolution at 1 m; 0 where nothing was hit) or ``initial_mask``, ``final_mask``.
+        column: ``image_initial_range``, ``image_final_range`` (distance along each pixel's ray [m]; float16
+            on disk, about 0.5 mm resolution at 1 m; 0 where nothing was hit) or ``image_initial_mask``,
+            ``image_final_mask``.
 
     Returns:
         (n, H, W) array: float32 ranges or bool masks.
     """
     if column not in IMAGE_COLUMNS:
-        raise ValueError(f"column must be one of {IMAGE_COLUMNS}, got {column!r}.")
+        renamed = f" ({column!r} is named {_OLD_IMAGE_NAMES[column]!r} now)" if column in _OLD_IMAGE_NAMES else ""
+        raise ValueError(f"column must be one of {IMAGE_COLUMNS}, got {column!r}{renamed}.")
     if column not in frame.columns:
         raise ValueError(f"the frame has no {column!r} column: collect with save_images=True (--save-images) "
                          "and load with load_dataset(path, with_images=True).")
@@ -76,26 +97,40 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
                  ) -> pd.DataFrame:
     """Read a dataset directory into a DataFrame, one row per interaction, ordered by episode.
 
-    Columns (:func:`arrow_schema`): ``episode`` (index i), ``seed`` (env seed of interaction i), ``behavior``,
-    ``type``, ``size`` [m], ``action_0..2``, ``initial_x, _y, _z, _qw, _qx, _qy, _qz`` and ``final_...``
-    (object position [m] and quaternion), ``displacement`` [m], ``rolling_distance`` [m], ``rolled``,
-    ``success``, ``tilt`` [rad], ``toppled``, ``outcome``, ``outcome_time`` [s] (see the environment's ``info``;
-    datasets of schema version 2 and older lack ``rolling_distance``, ``tilt``, ``toppled`` and ``outcome_time``;
-    those of version 3 and older did not store ``success``: it is derived on loading by the environment's rule,
-    from ``behavior``, ``rolled``, ``displacement`` and the dataset's ``roll_threshold``), ``contact``,
-    ``hand_speed`` [m/s], ``visible_initial``, ``visible_final``, ``ik_success``, then ``initial_<f>``,
-    ``final_<f>``, ``effect_<f>`` for each name ``f`` of ``FEATURE_NAMES``; with ``with_images`` also the
-    encoded images (decode them with :func:`images`). ``frame.attrs["manifest"]`` holds the manifest and
-    ``frame.attrs["failures"]`` the interactions left out (episode -> reason).
+    The columns (:func:`arrow_schema`) fall in namespaces that cannot be confused:
+
+    - bookkeeping: ``episode`` (index i), ``seed`` (env seed of interaction i), ``behavior``;
+    - the action: ``action_0..2``;
+    - the ground truth, measured by the simulator (see the environment's ``info``), for evaluating and never an
+      input of a learner: ``type``, ``size`` [m], ``true_initial_x, _y, _z, _qw, _qx, _qy, _qz`` and
+      ``true_final_...`` (the object's position [m] and quaternion), ``displacement`` [m],
+      ``rolling_distance`` [m], ``rolled``, ``success``, ``tilt`` [rad], ``toppled``, ``outcome``,
+      ``outcome_time`` [s], ``contact``, ``hand_speed`` [m/s], ``visible_initial``, ``visible_final``,
+      ``ik_success`` (:data:`GROUND_TRUTH_COLUMNS` and :data:`POSE_COLUMNS`);
+    - the features: ``initial_<f>``, ``final_<f>``, ``effect_<f>``, exactly one column per prefix for each
+      name ``f`` of ``FEATURE_NAMES`` (:func:`learning_data` returns them as X and E);
+    - with ``with_images``, the encoded images ``image_initial_range`` ... (decode them with :func:`images`).
+
+    ``frame.attrs["manifest"]`` holds the manifest and ``frame.attrs["failures"]`` the interactions left out
+    (episode -> reason).
+
+    Every chunk is checked against the SHA-256 the manifest recorded when it was written: a chunk that changed
+    by a single byte raises DatasetError naming it and the command that redoes it.
+
+    Older datasets load with the current names: those of schema version 4 and older named the pose
+    ``initial_x`` ... and the images ``initial_range`` ... (version 1: ``object_initial_x`` ...), and have no
+    checksums; those of version 2 and older lack ``rolling_distance``, ``tilt``, ``toppled`` and
+    ``outcome_time``; those of version 3 and older did not store ``success``: it is derived on loading by the
+    environment's rule, from ``behavior``, ``rolled``, ``displacement`` and the dataset's ``roll_threshold``.
 
     Args:
         path: The dataset directory (or its ``manifest.json``).
         with_images: Also read the image columns of a dataset collected with ``save_images``.
-        allow_incomplete: Read the chunks present of a dataset whose collection has not finished.
+        allow_incomplete: Read the chunks finished so far of a dataset whose collection has not finished.
 
     Raises:
         FileNotFoundError: ``path`` does not exist.
-        DatasetError: not a dataset, a newer schema, a corrupt or foreign chunk, or (unless
+        DatasetError: not a dataset, a newer schema, a corrupt, changed or foreign chunk, or (unless
             ``allow_incomplete``) missing chunks.
     """
     path = Path(path)
@@ -114,40 +149,84 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
                            "with `affordance collect`.")
     manifest = read_manifest(path)
     version = manifest["schema_version"]
+    renames = _old_names(version)
+    images_on_disk = {old for old, new in renames.items() if new in IMAGE_COLUMNS} | set(IMAGE_COLUMNS)
+    redo = collect_command(path, manifest)
     tables, failures, missing = [], {}, []
     ranges = chunk_ranges(manifest["episodes"], manifest["settings"]["chunk_size"])
     for index, (start, stop) in enumerate(ranges):
         chunk = path / chunk_name(index)
-        if not chunk.exists():
+        # a chunk is finished once the manifest records its checksum (version 5 on); older ones: once it exists
+        if not chunk.exists() or (version >= 5 and chunk.name not in (manifest.get(CHECKSUMS) or {})):
             missing.append(chunk.name)
             continue
         try:
+            if version >= 5:
+                check_checksum(chunk, manifest)
             if version >= 2:
                 failures.update(check_chunk(chunk, manifest, start, stop)["chunk"]["failures"])
-            columns = None if with_images else [c for c in pq.read_schema(chunk).names if c not in IMAGE_COLUMNS]
+            names = pq.read_schema(chunk).names
+            columns = None if with_images else [c for c in names if c not in images_on_disk]
             table = pq.read_table(chunk, columns=columns)
         except DatasetError as exc:
-            raise DatasetError(f"{exc} Delete {chunk.name} and rerun the same collect command to redo "
-                               "it.") from exc
+            raise DatasetError(f"{exc} Redo it with `{redo}` (it collects that chunk again).") from exc
         except Exception as exc:  # pyarrow raises several types for damaged files
-            raise DatasetError(f"{chunk} is corrupt ({exc}); delete it and rerun the same collect command to "
-                               "redo it.") from exc
+            raise DatasetError(f"{chunk} is corrupt ({exc}); redo it with `{redo}` (it collects that chunk "
+                               "again).") from exc
         if version == 1:
             failures.update(json.loads((table.schema.metadata or {}).get(b"tap_affordance_failures", b"{}")))
-            table = table.drop_columns([c for c in IMAGE_COLUMNS if c in table.column_names])
+            table = table.drop_columns([c for c in images_on_disk if c in table.column_names])
         tables.append(table.replace_schema_metadata(None))
     if missing and not allow_incomplete:
-        raise DatasetError(f"{path} is incomplete: {len(missing)} chunk(s) missing ({', '.join(missing[:3])}"
-                           f"{', ...' if len(missing) > 3 else ''}); rerun the same collect command to "
-                           "finish it, or pass allow_incomplete=True.")
+        raise DatasetError(f"{path} is incomplete: {len(missing)} chunk(s) missing or unfinished "
+                           f"({', '.join(missing[:3])}{', ...' if len(missing) > 3 else ''}); finish it with "
+                           f"`{redo}`, or pass allow_incomplete=True.")
     if not tables:
         tables = [arrow_schema(with_images and manifest["settings"].get("save_images", False)).empty_table()]
     frame = pa.concat_tables(tables).to_pandas()
-    if version == 1:  # version 1 named the poses object_initial_x ...
-        frame = frame.rename(columns={f"object_{stage}_{f}": f"{stage}_{f}"
-                                      for stage in ("initial", "final") for f in POSE_FIELDS})
+    frame = frame.rename(columns=renames)
     if "success" not in frame.columns:  # versions 1 to 3: derived, in the column's place after rolled
         frame.insert(frame.columns.get_loc("rolled") + 1, "success", _derived_success(frame, manifest))
     frame.attrs["manifest"] = manifest
     frame.attrs["failures"] = {int(k): v for k, v in sorted(failures.items(), key=lambda kv: int(kv[0]))}
     return frame
+
+
+def learning_data(frame: pd.DataFrame, behavior: str | None = None) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """What a learner of one behaviour gets from a dataset frame: ``(X, E, labels)``.
+
+    Args:
+        frame: From :func:`load_dataset` (or a frame with its columns).
+        behavior: Keep the interactions of this behaviour (the paper learns one model per behaviour); None: the
+            frame must hold a single one.
+
+    Returns:
+        ``X``: (n, 49) initial features, ``E``: (n, 49) effects (final minus initial), both with the feature
+        names as columns, in the order of ``FEATURE_NAMES``; ``labels``: the ground truth of those rows
+        (``type``, ``size`` [m], ``success``, and the other :data:`GROUND_TRUTH_COLUMNS` the frame has), for
+        evaluating, never for learning. All three keep the frame's index.
+
+    Raises:
+        ValueError: the frame lacks feature columns, holds no interaction of ``behavior``, or mixes behaviours
+            and ``behavior`` is None.
+    """
+    from affordance_env.features import FEATURE_NAMES
+
+    missing = [f"{prefix}{n}" for prefix in (FEATURE_PREFIXES[0], FEATURE_PREFIXES[2]) for n in FEATURE_NAMES
+               if f"{prefix}{n}" not in frame.columns]
+    if missing:
+        raise ValueError(f"the frame lacks {len(missing)} feature column(s), e.g. {missing[:3]}; expected "
+                         "initial_<f> and effect_<f> for every name f of FEATURE_NAMES (a frame of load_dataset).")
+    found = sorted(pd.unique(frame["behavior"].astype(str))) if "behavior" in frame.columns else []
+    if behavior is not None:
+        if "behavior" in frame.columns:
+            if behavior not in found:
+                raise ValueError(f"the frame holds no {behavior!r} interactions (it holds {found}).")
+            frame = frame[frame["behavior"] == behavior]
+    elif len(found) > 1:
+        raise ValueError(f"the frame mixes the behaviours {found}; pass behavior= one of them (one model per "
+                         "behaviour).")
+    X = frame[[f"initial_{n}" for n in FEATURE_NAMES]].set_axis(list(FEATURE_NAMES), axis=1)
+    E = frame[[f"effect_{n}" for n in FEATURE_NAMES]].set_axis(list(FEATURE_NAMES), axis=1)
+    truth = [c for c in (*GROUND_TRUTH_COLUMNS, *POSE_COLUMNS) if c in frame.columns]
+    return X.astype(np.float64), E.astype(np.float64), frame[truth].copy()

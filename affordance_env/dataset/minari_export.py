@@ -4,32 +4,48 @@ The Parquet dataset stays the source of truth; :func:`export_minari` writes a co
 ``minari.load_dataset(dataset_id)``. One episode per interaction, of one step:
 
 - episodes: the valid interactions in order, numbered 0..n-1 (failed ones are left out), each with its seed.
-- observations: a ``Dict`` of ``features`` (49,) float32, and ``range`` (H, W) float32 and ``mask`` (H, W)
-  int8 when the dataset saved its images (``save_images``); two of each, before and after the interaction.
-  The environment's ``joints`` observation is not stored in datasets, so it is not in the export.
+- observations: the environment's ``Dict`` observation, before and after the interaction, with the keys a
+  dataset stores: ``features`` (49,) float32, and ``range`` (H, W) float32 and ``mask`` (H, W) int8 when the
+  dataset saved its images (``save_images``). Each key has the environment's own space, so the dataset's
+  observation space is that of ``recover_environment()`` without the keys of :func:`left_out`: ``joints`` (a
+  dataset does not store the robot's joint positions) and, without saved images, ``range`` and ``mask``.
+- infos: the interaction's ground truth, the labels a learner is evaluated against (never an input): the
+  dataset's ``episode``, ``type``, ``size`` [m], ``success``, ``rolled``, ``displacement`` [m], ``outcome``, ...
+  (every column of :data:`~affordance_env.dataset.format.GROUND_TRUTH_COLUMNS` the dataset has), and
+  ``true_initial_pose`` and ``true_final_pose`` (x, y, z [m], qw, qx, qy, qz). An episode is one interaction,
+  so both entries of each info (Minari keeps one per observation) hold the same labels.
 - action (3,) float32; reward: the object's displacement [m] (the environment's default reward); terminated
   True, truncated False.
 - the environment spec: ``TapAffordance-v0`` with the dataset's settings, so that
   ``dataset.recover_environment()`` makes the environment the data came from.
 
-Minari stores datasets where its own convention says (``MINARI_DATASETS_PATH``, by default
-``~/.minari/datasets``), in its Arrow format by default (``pip install "tap-affordance[minari]"``).
+The id is checked before anything is written, and the dataset is written to a hidden directory beside Minari's
+datasets and moved into place only when complete: an export that fails leaves nothing behind. Minari stores
+datasets where its own convention says (``MINARI_DATASETS_PATH``, by default ``~/.minari/datasets``), in its
+Arrow format by default (``pip install "tap-affordance[minari]"``).
 """
 
 from __future__ import annotations
 
-import dataclasses
+import contextlib
 import os
+import shutil
+import tempfile
+import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from affordance_env.dataset.format import GROUND_TRUTH_COLUMNS, POSE_FIELDS, STAGES
 from affordance_env.dataset.load import images, load_dataset
 from affordance_env.features import FEATURE_NAMES
 
 #: Data formats Minari writes.
 DATA_FORMATS = ("arrow", "hdf5")
+#: The form of a Minari dataset id that this export accepts (Minari's own, with the version required).
+ID_FORM = "(namespace/)name-v(version), e.g. tap-affordance/canonical-taps-v0"
 
 
 def _minari():
@@ -43,52 +59,101 @@ def _minari():
     return minari, EpisodeBuffer
 
 
-def observation_space(env_options: dict[str, Any], with_images: bool):
-    """The exported observation space: ``features``, and ``range`` and ``mask`` if the images were saved."""
+def check_dataset_id(dataset_id: str) -> tuple[str | None, str, int]:
+    """``(namespace, name, version)`` of a Minari dataset id; ValueError naming it and the expected form when it
+    is malformed or has no version (Minari itself would fail midway, after creating directories)."""
+    from minari.dataset.minari_dataset import DATASET_ID_RE, parse_dataset_id
+
+    match = DATASET_ID_RE.fullmatch(dataset_id) if isinstance(dataset_id, str) else None
+    if match is None or match.group("version") is None:
+        raise ValueError(f"Minari dataset id {dataset_id!r} is malformed: expected {ID_FORM}.")
+    return parse_dataset_id(dataset_id)
+
+
+def left_out(with_images: bool) -> dict[str, str]:
+    """The environment's observation keys that the export leaves out, and why."""
+    why = {"joints": "a dataset does not store the robot's joint positions"}
+    if not with_images:
+        why.update({key: "the dataset was collected without save_images" for key in ("range", "mask")})
+    return why
+
+
+def observation_space(env_space, with_images: bool):
+    """The exported observation space: the environment's ``Dict`` without the keys of :func:`left_out`."""
     from gymnasium import spaces
 
-    spaces_ = {"features": spaces.Box(-np.inf, np.inf, (len(FEATURE_NAMES),), np.float32)}
-    if with_images:
-        shape = (int(env_options["camera_height"]), int(env_options["camera_width"]))
-        spaces_["range"] = spaces.Box(0.0, np.inf, shape, np.float32)
-        spaces_["mask"] = spaces.Box(0, 1, shape, np.int8)
-    return spaces.Dict(spaces_)
+    dropped = left_out(with_images)
+    return spaces.Dict({key: space for key, space in env_space.spaces.items() if key not in dropped})
+
+
+@contextlib.contextmanager
+def _minari_root(path: Path) -> Iterator[None]:
+    """Make Minari read and write its datasets under ``path`` for the duration (it reads the variable on
+    every call)."""
+    saved = os.environ.get("MINARI_DATASETS_PATH")
+    os.environ["MINARI_DATASETS_PATH"] = str(path)
+    try:
+        yield
+    finally:
+        if saved is None:
+            del os.environ["MINARI_DATASETS_PATH"]
+        else:
+            os.environ["MINARI_DATASETS_PATH"] = saved
+
+
+def _infos(frame, i: int) -> dict[str, Any]:
+    row = frame.iloc[i]
+    infos: dict[str, Any] = {"episode": [int(row["episode"])] * 2}
+    for column in GROUND_TRUTH_COLUMNS:
+        if column in frame.columns:
+            value = row[column].item() if hasattr(row[column], "item") else row[column]
+            infos[column] = [value, value]
+    for stage in STAGES:
+        pose = row[[f"true_{stage}_{f}" for f in POSE_FIELDS]].to_numpy(np.float64)
+        infos[f"true_{stage}_pose"] = np.stack([pose, pose])
+    return infos
 
 
 def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: str = "arrow",
-                  description: str | None = None, author: str = "tap-affordance", author_email: str | None = None):
+                  description: str | None = None, author: str = "tap-affordance", author_email: str | None = None,
+                  code_permalink: str | None = None):
     """Write the collected dataset at ``dataset`` as the Minari dataset ``dataset_id``.
 
     Args:
         dataset: Directory of a dataset made by :func:`affordance_env.dataset.collect` (complete).
-        dataset_id: Minari's id, ``(namespace/)(env_name/)dataset_name-v(version)``, e.g.
-            ``"tap-affordance/canonical-taps-v0"``.
+        dataset_id: Minari's id, ``(namespace/)name-v(version)``, e.g. ``"tap-affordance/canonical-taps-v0"``.
         data_format: ``"arrow"`` (default) or ``"hdf5"`` (needs h5py).
-        description, author, author_email: Recorded in the Minari metadata (Minari warns without an email).
+        description, author, author_email, code_permalink: Recorded in the Minari metadata; an e-mail or a
+            permalink not given is left out (Minari's reminders about them are not shown).
 
     Returns:
         The ``minari.MinariDataset``.
 
     Raises:
         ImportError: minari is not installed (the message says how to install it).
-        ValueError: an unknown data format, or a Minari dataset with that id exists already.
+        ValueError: a malformed id, an unknown data format, or a Minari dataset (or a directory) with that id
+            exists already; nothing is written.
         DatasetError: ``dataset`` is not a complete dataset.
     """
     if data_format not in DATA_FORMATS:
         raise ValueError(f"data_format must be one of {DATA_FORMATS}, got {data_format!r}.")
     minari, EpisodeBuffer = _minari()
-    if dataset_id in minari.list_local_datasets():
-        raise ValueError(f"a Minari dataset {dataset_id!r} exists already; delete it with "
-                         f"`minari delete {dataset_id}` or choose another id.")
+    namespace, _, _ = check_dataset_id(dataset_id)
+    from minari.storage.datasets_root_dir import get_dataset_path
+
+    root = get_dataset_path()
+    target = root / dataset_id
+    if dataset_id in minari.list_local_datasets() or target.exists():
+        raise ValueError(f"a Minari dataset {dataset_id!r} exists already ({target}); delete it with "
+                         f"`minari delete {dataset_id}` (or remove that directory) or choose another id.")
     frame = load_dataset(dataset, with_images=True)
     manifest = frame.attrs["manifest"]
     options = manifest["settings"]["env_options"]
     with_images = bool(manifest["settings"].get("save_images"))
-    stages = {stage: frame[[f"{stage}_{n}" for n in FEATURE_NAMES]].to_numpy(np.float32)
-              for stage in ("initial", "final")}
+    stages = {stage: frame[[f"{stage}_{n}" for n in FEATURE_NAMES]].to_numpy(np.float32) for stage in STAGES}
     if with_images:
-        decoded = {f"{stage}_{kind}": images(frame, f"{stage}_{kind}")
-                   for stage in ("initial", "final") for kind in ("range", "mask")}
+        decoded = {f"{stage}_{kind}": images(frame, f"image_{stage}_{kind}")
+                   for stage in STAGES for kind in ("range", "mask")}
     actions = frame[[f"action_{j}" for j in range(3)]].to_numpy(np.float32)
     rewards = frame["displacement"].to_numpy(np.float64)
     buffers = []
@@ -98,30 +163,48 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
             observations["range"] = np.stack([decoded["initial_range"][i], decoded["final_range"][i]])
             observations["mask"] = np.stack([decoded["initial_mask"][i], decoded["final_mask"][i]]).astype(np.int8)
         # Minari numbers episodes 0..n-1 (it counts them from the largest id); the valid interactions are
-        # renumbered in order, each keeps its seed.
+        # renumbered in order, each keeps its seed (and its dataset episode in its infos).
         buffers.append(EpisodeBuffer(id=i, seed=int(seed), observations=observations,
                                      actions=actions[i : i + 1], rewards=[float(rewards[i])], terminations=[True],
-                                     truncations=[False]))
+                                     truncations=[False], infos=_infos(frame, i)))
     import gymnasium as gym
 
     from affordance_env.registration import ENV_ID, register_envs
 
     register_envs()
-    spec = dataclasses.replace(gym.spec(ENV_ID), kwargs=dict(options))
-    from gymnasium import spaces
+    dropped = left_out(with_images)
+    text = description or f"TapAffordance interactions exported from {Path(dataset).resolve()}."
+    text += (" Observations: the environment's, without " + "; ".join(f"{k} ({why})" for k, why in dropped.items())
+             + ". Infos: the ground truth of each interaction.")
+    env = gym.make(ENV_ID, **options)  # the env recover_environment() makes: its spec and its spaces
+    staging = Path(tempfile.mkdtemp(prefix=".tap-affordance-export-", dir=root))  # hidden: Minari skips it
+    try:
+        with _minari_root(staging), warnings.catch_warnings():
+            for field in ("code_permalink", "author_email"):  # left out on purpose when not given
+                warnings.filterwarnings("ignore", message=f"`{field}` is set to None", category=UserWarning)
+            minari.create_dataset_from_buffers(
+                dataset_id=dataset_id,
+                buffer=buffers,
+                env=env,
+                eval_env=env.spec,
+                observation_space=observation_space(env.observation_space, with_images),
+                action_space=env.action_space,
+                algorithm_name=f"TapAffordance collect ({manifest['settings']['action']} actions)",
+                author=author,
+                author_email=author_email,
+                code_permalink=code_permalink,
+                description=text,
+                data_format=data_format,
+                jpeg_encoding=False,
+                requirements=[f"tap-affordance=={manifest['package_version']}"],
+            )
+        from minari.namespace import create_namespace, list_local_namespaces
 
-    return minari.create_dataset_from_buffers(
-        dataset_id=dataset_id,
-        buffer=buffers,
-        env=spec,
-        eval_env=spec,
-        observation_space=observation_space(options, with_images),
-        action_space=spaces.Box(-1.0, 1.0, (3,), np.float32),
-        algorithm_name=f"TapAffordance collect ({manifest['settings']['action']} actions)",
-        author=author,
-        author_email=author_email,
-        description=description or f"TapAffordance interactions exported from {Path(dataset).resolve()}.",
-        data_format=data_format,
-        jpeg_encoding=False,
-        requirements=[f"tap-affordance=={manifest['package_version']}"],
-    )
+        if namespace is not None and namespace not in list_local_namespaces():
+            create_namespace(namespace)
+        target.parent.mkdir(parents=True, exist_ok=True)
+        os.replace(staging / dataset_id, target)
+    finally:
+        env.close()
+        shutil.rmtree(staging, ignore_errors=True)
+    return minari.load_dataset(dataset_id)
