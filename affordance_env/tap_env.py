@@ -524,7 +524,7 @@ class TapAffordanceEnv(gym.Env):
             "outcome_time": 0.0 if fault else float(outcome_time),
             "contact": stroke.contact,
             "hand_speed": stroke.hand_speed,
-            "stroke_speed": float("nan") if grasping else stroke.speed,
+            "stroke_speed": 0.0 if grasping else stroke.speed,
             "ik": {"success": stroke.ik_success, "position_error": stroke.ik_position_error,
                    "orientation_error": stroke.ik_orientation_error},
             "visible": visible,
