@@ -1,14 +1,16 @@
 """TapAffordance environment: an iCub in MuJoCo taps objects and sees the effect through a range camera.
 
-``import affordance_env`` registers ``TapAffordance-v0`` with Gymnasium::
+``import affordance_env`` registers ``TapAffordance-v1`` with Gymnasium::
 
     import gymnasium as gym
     import affordance_env  # noqa: F401
 
-    env = gym.make("TapAffordance-v0")
+    env = gym.make("TapAffordance-v1")
 
-or, without the import, ``gym.make("affordance_env:TapAffordance-v0")``.
+or, without the import, ``gym.make("affordance_env:TapAffordance-v1")``.
 """
+
+import importlib.metadata as _metadata
 
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
 from affordance_env.objects import OBJECT_TYPES
@@ -17,7 +19,10 @@ from affordance_env.robot_model import ACTIVE_JOINTS
 
 register_envs()
 
-__version__ = "0.3.0"
+try:  # the version has one source, the package's metadata (pyproject.toml)
+    __version__ = _metadata.version("tap-affordance")
+except _metadata.PackageNotFoundError:  # a source tree that was never installed
+    __version__ = "0+unknown"
 
 
 def __getattr__(name: str):

@@ -1,4 +1,4 @@
-"""The options of TapAffordance-v0 that decide its data: their defaults, and their checks.
+"""The options of TapAffordance-v1 that decide its data: their defaults, and their checks.
 
 Checking them builds nothing and imports neither MuJoCo nor Pinocchio, so a collection checks its options in its
 coordinating process, in milliseconds, before it starts the workers that build the environments.
@@ -75,6 +75,6 @@ class EnvOptions:
         known = [f.name for f in dataclasses.fields(cls)]
         unknown = sorted(set(options) - set(known))
         if unknown:
-            raise ValueError(f"unknown or unsupported env options {unknown}; the data options of TapAffordance-v0 "
+            raise ValueError(f"unknown or unsupported env options {unknown}; the data options of TapAffordance-v1 "
                              f"(what a dataset records) are {known}.")
         return cls(**options)

@@ -1,4 +1,4 @@
-"""TapAffordance-v0: one interaction of Akgun et al. (2009) per step."""
+"""TapAffordance-v1: one interaction of Akgun et al. (2009) per step."""
 
 from __future__ import annotations
 
@@ -233,6 +233,13 @@ class TapAffordanceEnv(gym.Env):
       (``"human"`` too) is refused with a ValueError naming these |
 
     ## Version History
+    * v1: the iCub's motor limits (joint speeds planned within 100 deg/s for the arm, torso and neck and 180 deg/s
+      for the fingers, motor torques limited, gravity compensation included), stiff contacts (10 ms, impedance
+      0.995), the palm's restitution 0.3, every move one minimum-jerk or line trajectory with feedforward, the
+      hardest strokes capped at the speed the joints allow (``info["stroke_speed"]``), a home pose that holds the
+      forearm 15 cm above the table, a way home that watches the object (a touch is a failure, ``"home: ..."``), and
+      a careful grasp: a slow guarded descent, fingers that close with a light touch and grip with their motors'
+      torque, a held object put down at rest, an unheld one left where it is. Data of v0 are not comparable.
     * v0: initial release.
     """
 
@@ -315,7 +322,7 @@ class TapAffordanceEnv(gym.Env):
         try:
             bound = inspect.signature(cls.__init__).bind(None, **options)
         except TypeError as exc:
-            raise ValueError(f"Options of TapAffordance-v0: {exc}.") from None
+            raise ValueError(f"Options of TapAffordance-v1: {exc}.") from None
         bound.apply_defaults()
         data_options = {f.name for f in dataclasses.fields(EnvOptions)}
         EnvOptions(**{name: value for name, value in bound.arguments.items() if name in data_options})

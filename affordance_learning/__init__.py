@@ -11,7 +11,12 @@
   and its outputs (``affordance reproduce`` runs them end to end for the tap and the grasp).
 """
 
-__version__ = "0.3.0"
+import importlib.metadata as _metadata
+
+try:  # the version has one source, the package's metadata (pyproject.toml)
+    __version__ = _metadata.version("tap-affordance")
+except _metadata.PackageNotFoundError:  # a source tree that was never installed
+    __version__ = "0+unknown"
 
 from affordance_learning.default_model import (  # noqa: E402 (after __version__, which it reads)
     DefaultModelError,

@@ -19,8 +19,8 @@ def _demo(args: argparse.Namespace) -> int:
     kwargs = {"behavior": args.behavior}
     if args.object:
         kwargs["object_types"] = (args.object,)
-    env = gym.make("TapAffordance-v0", **kwargs)
-    print(f"TapAffordance-v0, behavior={args.behavior!r}: {args.episodes} interaction(s) from seed {args.seed}")
+    env = gym.make("TapAffordance-v1", **kwargs)
+    print(f"TapAffordance-v1, behavior={args.behavior!r}: {args.episodes} interaction(s) from seed {args.seed}")
     start = time.perf_counter()
     for i in range(args.episodes):
         _, info0 = env.reset(seed=args.seed + i)

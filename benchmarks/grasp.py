@@ -2,7 +2,7 @@
 
     python benchmarks/grasp.py [--episodes 90] [--size-range LOW HIGH] [--timestep DT]
 
-Runs ``TapAffordance-v0`` with ``behavior="grasp"`` for seeds 0 .. episodes-1 (the env draws type, size, position
+Runs ``TapAffordance-v1`` with ``behavior="grasp"`` for seeds 0 .. episodes-1 (the env draws type, size, position
 and yaw; the action is the canonical 0) and prints: the share of valid interactions (``info["failure"] is
 None``), the success rate (``info["success"]``) over all valid grasps and per third of the sizes drawn, the
 largest size held and the smallest dropped per object type, the object's rise at the end of the hold for

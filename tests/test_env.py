@@ -1,4 +1,4 @@
-"""TapAffordance-v0 as a user meets it: Gymnasium's checker, determinism, the paper's phenomenon, errors."""
+"""TapAffordance-v1 as a user meets it: Gymnasium's checker, determinism, the paper's phenomenon, errors."""
 
 
 import gymnasium as gym
@@ -24,7 +24,7 @@ def env():
 # Accepted checker warnings: the features are unbounded real numbers (Box(-inf, inf)).
 @pytest.mark.filterwarnings("ignore:.*Box observation space m..imum value is .?infinity")
 def test_gym_make_and_check_env():
-    env = gym.make("TapAffordance-v0", camera_width=48, camera_height=40)
+    env = gym.make("TapAffordance-v1", camera_width=48, camera_height=40)
     with_checker_warnings = check_env(env.unwrapped, skip_render_check=True)
     assert with_checker_warnings is None
     obs, info = env.reset(seed=3)
@@ -34,7 +34,7 @@ def test_gym_make_and_check_env():
 
 
 def test_module_colon_id_works():
-    env = gym.make("affordance_env:TapAffordance-v0")
+    env = gym.make("affordance_env:TapAffordance-v1")
     assert isinstance(env.unwrapped, TapAffordanceEnv)
     env.close()
 
@@ -169,7 +169,7 @@ def test_effects_of_real_taps_carry_the_motion(canonical_taps):
 
 def test_async_vector_env():
     envs = gym.vector.AsyncVectorEnv(
-        [lambda: gym.make("TapAffordance-v0", camera_width=32, camera_height=32) for _ in range(2)]
+        [lambda: gym.make("TapAffordance-v1", camera_width=32, camera_height=32) for _ in range(2)]
     )
     obs, infos = envs.reset(seed=[1, 2])
     assert obs["features"].shape == (2, 49)
@@ -460,7 +460,7 @@ def test_gym_make_refuses_a_render_mode_the_env_lacks_naming_those_it_has():
     # not Gymnasium's HumanRendering wrapper (and its "pygame is not installed"): the env's own refusal
     with pytest.raises(ValueError, match=r"render_mode must be None or one of \['rgb_array', 'rgb_array_list'\], "
                                          "got 'human'"):
-        gym.make("TapAffordance-v0", render_mode="human")
+        gym.make("TapAffordance-v1", render_mode="human")
 
 
 def test_range_noise_is_seeded_and_realistic():

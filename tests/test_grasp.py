@@ -8,16 +8,16 @@ from gymnasium.utils.env_checker import check_env
 from affordance_env.behaviors import (
     CLOSE_SPEED_CANONICAL,
     CLOSE_SPEED_RANGE,
-    GRASP_GUARD_CLEARANCE,
-    GRASP_RETREAT_HEIGHT,
-    HAND_RELEASE,
-    HOLD_TIME,
-    OPEN_HAND_DEPTH,
     GRASP_CENTRE_HAND,
     GRASP_FINGERS_YAW,
     GRASP_GAP,
+    GRASP_GUARD_CLEARANCE,
+    GRASP_RETREAT_HEIGHT,
     HAND_CLOSED,
+    HAND_RELEASE,
+    HOLD_TIME,
     LIFT_HEIGHT,
+    OPEN_HAND_DEPTH,
     PLACE_SHIFT,
     GraspBehavior,
     get_behavior,
@@ -274,7 +274,7 @@ def test_same_seed_gives_the_same_grasp():
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:.*Box observation space m..imum value is .?infinity")
 def test_gymnasium_checker_passes_for_the_grasp():
-    env = gym.make("TapAffordance-v0", behavior="grasp", camera_width=32, camera_height=24)
+    env = gym.make("TapAffordance-v1", behavior="grasp", camera_width=32, camera_height=24)
     assert check_env(env.unwrapped, skip_render_check=True) is None
     _, info = env.reset(seed=1)
     info = env.step(env.action_space.sample())[4]

@@ -178,7 +178,7 @@ def collect(
         workers: Processes on this machine (joblib), or in the local Dask cluster of ``scheduler="dask"``.
             The data do not depend on it.
         action: ``"canonical"`` (the paper's tap, all zeros) or ``"random"`` (uniform in the action box).
-        env_options: Keyword arguments of ``TapAffordance-v0`` (behavior, object_types, size_range,
+        env_options: Keyword arguments of ``TapAffordance-v1`` (behavior, object_types, size_range,
             camera_width, camera_height, camera_fovy, roll_threshold, settle_timeout); the others keep the
             env's defaults, which are recorded too.
         chunk_size: Interactions per file: the most a crash can lose, per worker.

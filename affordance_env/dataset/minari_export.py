@@ -16,7 +16,7 @@ The Parquet dataset stays the source of truth; :func:`export_minari` writes a co
   so both entries of each info (Minari keeps one per observation) hold the same labels.
 - action (3,) float32; reward: the object's displacement [m] (the environment's default reward); terminated
   True, truncated False.
-- the environment spec: ``TapAffordance-v0`` with the dataset's settings, so that
+- the environment spec: ``TapAffordance-v1`` with the dataset's settings, so that
   ``dataset.recover_environment()`` makes the environment the data came from.
 
 The id is checked before anything is written, and the dataset is written to a hidden directory beside Minari's
