@@ -13,14 +13,21 @@ index       meaning                                                          ran
 ==========  ===============================================================  ======================
 0           height of the palm centre above the canonical contact height     -1.5 .. +1.5 cm
 1           lateral offset of the stroke, across the stroke direction        -2 .. +2 cm
-2           hand speed along the stroke, 0.18 m/s x 3 ** action[2]           0.06 .. 0.54 m/s
+2           hand speed along the stroke, 0.18 m/s x 3 ** action[2], at most  0.06 .. 0.54 m/s
+            what the arm's joint speed limits allow
 ==========  ===============================================================  ======================
+
+The arm's joints (100 deg/s, :mod:`affordance_env.motor_limits`) cap the hard strokes: where the stroke line
+would turn a joint faster than that, the palm moves as fast as the slowest-allowed joint lets it
+(``info["stroke_speed"]``). Over 40 placements at action[2] = +1, the tap then reaches 0.29-0.54 m/s (median
+0.34), tap_back 0.43-0.50 and the push 0.18-0.35 (its forearm, across the body, turns the shoulder fastest); the
+canonical stroke (0.18 m/s) and the gentle ones are never capped.
 
 The canonical tap is moderate (the paper: "moderately hitting an object from its side"): at 0.18 m/s a ball or a
 lying cylinder rolls some 5 to 25 cm on the table and stays in view of the head camera; the speed scale is
 geometric, because the distance a struck object rolls grows with the square of its speed: at the gentlest tap (-1)
-rolling objects move 2-3 cm, at the hardest (+1) two in three roll off the 1 m wide table (see
-``assets/README.md``).
+rolling objects move 2-3 cm, at the hardest (+1, as fast as the joints allow) many roll off the 1 m wide table
+(see ``assets/README.md``).
 
 For the grasp, 0 is the canonical grasp:
 

@@ -61,8 +61,9 @@ CONTACT_SOLIMP = (0.995, 0.995, 0.001, 0.5, 2.0)
 #: approach speed a ball takes away from a still palm. The iCub's palm is its plastic shell under the tactile
 #: skin, a few millimetres of soft silicone over the sensors; a hard ball on such an elastomer-covered pad
 #: rebounds with 0.2-0.4 of its speed (a bare plastic shell: 0.6-0.8). PALM_SOLREF gives it: its damping ratio
-#: 0.4 returns 0.27-0.31 of the speed at 0.06-0.54 m/s at the stroke's 2 ms timestep (``tests/test_scene.py``
-#: measures it). At 1 (critical damping) a ball would keep a tenth of its speed, as on a lump of clay.
+#: 0.4 returns 0.27-0.31 of the speed at 0.06-0.54 m/s at the stroke's 2 ms timestep
+#: (``tests/test_physics_limits.py`` measures it). At 1 (critical damping) a ball would keep a tenth of its
+#: speed, as on a lump of clay.
 PALM_RESTITUTION = 0.3
 PALM_SOLREF = (0.01, 0.4)
 #: Friction of the fingered hand's geoms (grasp variant): sliding, torsional [m], rolling [m]. The mk3 hand's
@@ -94,10 +95,9 @@ ARMATURE = 0.02
 #: Joint damping [N m s / rad]: a small viscous friction. The servos are critically damped by their actuators;
 #: 1 N m s/rad on top overdamped the wrist (0.6 s to settle after each move).
 DAMPING = 0.1
-#: Finger joints of the mk3 hand (grasp variant). Position-servo stiffness [N m / rad]: at a 1 rad tracking error
-#: a finger presses with 1 N m, some 20 N at a fingertip 5 cm from its joint, of the order of a human's firm
-#: grip, and far below the URDF's placeholder effort limit (50 000). Damping [N m s / rad] and armature
-#: [kg m^2]: the URDF's damping of 1 N m s/rad is a placeholder that, against kp = 1, makes the fingers lag
+#: Finger joints of the mk3 hand (grasp variant). Position-servo stiffness [N m / rad]: a finger presses with at
+#: most its motor's torque (0.3 N m, ``motor_limits``), reached at a tracking error of 0.3 rad. Damping
+#: [N m s / rad] and armature [kg m^2]: the URDF's damping of 1 N m s/rad is a placeholder that, against kp = 1, makes the fingers lag
 #: 30 degrees behind a 1 s closing ramp (time constant damping / kp = 1 s); 0.03 is a small gear friction
 #: (0.03 s) and the fingers track to a fraction of a degree. The armature, the reflected inertia of the finger's
 #: motor and gearbox, keeps the light links (10-17 g, inertias of 1e-6 kg m^2) well conditioned at the 2 ms
@@ -105,13 +105,8 @@ DAMPING = 0.1
 HAND_KP, HAND_DAMPING, HAND_ARMATURE = 1.0, 0.03, 1e-3
 #: Timestep of the grasp variant [s]. The tap scene's 2 ms resolves the impact of a tap; a grasp has no impact,
 #: and its fastest dynamics are resolved at 5 ms with at least 2 steps per time constant (MuJoCo's stability
-#: bound) and mostly 4 or more: the contacts' (MuJoCo's default 20 ms), the finger coupling's (10 ms, below), the
-#: finger servos' (sqrt(armature / kp) = 32 ms) and the arm servos' (25 ms and more). Over the 90 canonical
-#: grasps of ``benchmarks/grasp.py`` (seeds 0-89) the share held per third of sizes is 100, 53 and 7 % at 5 ms as
-#: at 2 ms, and every one of the 90 ends the same, held or not, at 2, 2.5 and 5 ms (``--timestep``). While the hand
-#: carries the object it has grasped, the two move as one and the grasp steps at 10 ms (``motion.GRASP_CARRY_TIMESTEP``
-#: says why): a grasp takes 667 steps, 2065 at 2 ms, and costs about 1.7 taps on one core
-#: (``benchmarks/env.py --behavior tap grasp``). It divides the 10 ms control tick.
+#: bound): the contacts' (10 ms, CONTACT_SOLREF), the finger coupling's (10 ms, below), the finger servos'
+#: (sqrt(armature / kp) = 32 ms) and the arm servos' (25 ms and more). It divides the 10 ms control tick.
 GRASP_TIMESTEP = 0.005
 #: Ratio of the frictional to the normal constraints' impedance (MuJoCo's ``impratio``, elliptic cones) of the
 #: grasp variant: friction as hard as the grip's normal forces, so that a held object does not creep in the

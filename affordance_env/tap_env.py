@@ -104,25 +104,33 @@ class TapAffordanceEnv(gym.Env):
     One episode is one interaction: ``reset`` places the object, lets it settle, turns the head so that the object
     is at the image centre, and takes the initial snapshot; ``step`` executes the behaviour (default: the paper's
     tap) and takes the final snapshot. The hand is driven by Pinocchio inverse kinematics and MuJoCo position
-    servos: the arm and head move along minimum-jerk profiles at up to 100 degrees per second (the iCub's joint
-    speed limit) with velocity and inertial feedforward, so the robot is still again as soon as a move ends; the
-    stroke moves the palm in a straight line at the action's speed and stops a short follow-through after the hand
-    first touches the object.
+    servos with the iCub's motor limits (``affordance_env.motor_limits``: every motor's torque is limited, gravity
+    compensation included; every move is planned within the joints' speed limits, 100 degrees per second for the
+    arm, torso and neck): the arm and head move along minimum-jerk profiles with velocity and inertial feedforward,
+    so the robot is still again as soon as a move ends; the stroke moves the palm in a straight line at the
+    action's speed (or as fast as the joints allow) and stops a short follow-through after the hand first touches
+    the object. The way home watches the object: an arm that comes within 1.5 cm of it waits for it to rest and
+    goes over it, and a touch after the arm was clear of it makes the interaction a failure. Contacts are stiff
+    (nothing sinks into anything by more than 1-2 mm) and the palm returns 0.3 of a struck object's speed
+    (``affordance_env.scene.PALM_RESTITUTION``).
 
     ``behavior="grasp"`` is the paper's grasp, by the left arm with the fingered iCub hand of ``icub-models``
-    (``left_hand_mk3``: 11 finger joints driven by 7 servos, each distal joint coupled to its proximal one as on
-    the real hand; the right arm then hangs still): palm down over the object, the open hand descends to just
-    above the object's top, the fingers and the opposed thumb close on a ramp, the hand lifts 8 cm, holds still
-    for 1 s, carries the object 6 cm to the robot's left, puts it down and opens; the arm returns home and the
-    final snapshot sees the object where it was put down (a held object moved 6 cm) or where the attempt left it.
-    Only the fingers' servos move the object (no welds, no applied forces). Whether the object fits the open hand,
-    between the thumb and the fingertips, decides the outcome: with the default sizes about half the canonical
-    grasps hold (``info["success"]``), nearly all under 6.4 cm and few over 8.2 cm (``benchmarks/grasp.py``).
+    (``left_hand_mk3``: 11 finger joints driven by 7 motors of 0.3 N m each, each distal joint coupled to its
+    proximal one as on the real hand; the right arm then hangs still), done as a careful robot does it: palm down
+    over the object, the open hand descends slowly (4 cm/s) towards just above the object's top and stops there or
+    at the first touch; the fingers and the opposed thumb close with a light touch until each has stalled on the
+    object, then grip with their motors' full torque; the hand lifts 8 cm and holds still for 1 s. A held object
+    is carried 6 cm to the robot's left and lowered slowly until it meets the table; once it rests there the hand
+    opens, rises straight up and goes home. An object the hand does not hold is left where it is: the hand opens
+    above it. The final snapshot sees the object where it was put down (a held object moved about 6 cm) or where
+    the attempt left it (a failed grasp moves it a median 1-2 cm). Only the fingers' motors move the object (no
+    welds, no applied forces). Whether the object fits the open hand, between the thumb and the fingertips,
+    decides the outcome (``info["success"]``): nearly all small objects are held, few large ones
+    (``python benchmarks/physics_audit.py --behavior grasp``).
     A tap's stroke, from its start to the end of its follow-through, is simulated at 2 ms, which resolves the
     impact; the rest of a tap interaction (the head turning, the reach, the way home, the object rolling to rest)
     at 5 ms (``affordance_env.motion.FREE_TIMESTEP``). The grasp variant of the scene integrates at 5 ms
-    (``affordance_env.scene.GRASP_TIMESTEP``), and at 10 ms while the closed hand lifts, holds and carries the object
-    (``affordance_env.motion.GRASP_CARRY_TIMESTEP``).
+    (``affordance_env.scene.GRASP_TIMESTEP``).
 
     The world: a 60 x 100 cm wooden lab table whose top is what objects rest on and roll on (rolling resistance of
     wood on wood, see ``assets/README.md``); past its edges an object falls to the floor. The range camera in the
@@ -139,7 +147,8 @@ class TapAffordanceEnv(gym.Env):
     |-------|---------|-------|
     | 0 | height of the palm above the canonical contact height | -1.5 .. +1.5 cm |
     | 1 | lateral offset of the stroke, across its direction | -2 .. +2 cm |
-    | 2 | hand speed along the stroke, 0.18 x 3 ** a m/s | 0.06 .. 0.54 m/s |
+    | 2 | hand speed along the stroke, 0.18 x 3 ** a m/s, at most what the joints' speed limits allow
+      (``info["stroke_speed"]``; the hardest tap reaches 0.29-0.54 m/s, the hardest push 0.18-0.35) | 0.06 .. 0.54 m/s |
 
     For ``behavior="grasp"``, 0 is the canonical grasp:
 
@@ -147,7 +156,7 @@ class TapAffordanceEnv(gym.Env):
     |-------|---------|-------|
     | 0 | height of the palm above the object's top when the hand closes | -0.5 .. +1.5 cm |
     | 1 | offset of the object across the hand, towards the little finger | -1.5 .. +1.5 cm |
-    | 2 | time to close the hand, 0.4 / 2 ** a s | 0.8 .. 0.2 s |
+    | 2 | speed of the closing fingers, 0.75 + 0.25 a of their motors' speed limit (180 deg/s) | 0.5 .. 1 |
 
     Values outside [-1, 1], NaN or a wrong shape raise ``ValueError``.
 

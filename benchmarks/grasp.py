@@ -8,7 +8,7 @@ None``), the success rate (``info["success"]``) over all valid grasps and per th
 largest size held and the smallest dropped per object type, the object's rise at the end of the hold for
 successes and failures (how clearly the lift threshold separates them), the outcome of every seed in one line
 (X held, . not held, F failed), and the wall time and physics steps per interaction. ``--timestep`` simulates the
-grasp at another timestep than the grasp variant's, its carry included (to compare outcomes seed by seed).
+grasp at another timestep than the grasp variant's (to compare outcomes seed by seed).
 """
 
 from __future__ import annotations
@@ -19,7 +19,6 @@ from collections import Counter
 
 import numpy as np
 
-import affordance_env.motion
 import affordance_env.scene
 from affordance_env.objects import OBJECT_TYPES
 from affordance_env.tap_env import TapAffordanceEnv
@@ -36,13 +35,12 @@ def main() -> None:
 
     if args.timestep is not None:
         affordance_env.scene.GRASP_TIMESTEP = args.timestep  # read when the env builds its model
-        affordance_env.motion.GRASP_CARRY_TIMESTEP = args.timestep  # read at every grasp
     kwargs = {} if args.size_range is None else {"size_range": tuple(args.size_range)}
     env = TapAffordanceEnv(behavior="grasp", **kwargs)
     rows, failures, steps, line = [], Counter(), 0, []
     step = env.physics.step
 
-    def counted_step(n: int = 1) -> None:  # steps as taken: the carry runs at a longer timestep than the rest
+    def counted_step(n: int = 1) -> None:
         nonlocal steps
         steps += n
         step(n)
