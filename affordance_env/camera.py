@@ -18,8 +18,6 @@ import numpy as np
 
 from affordance_env.pinhole import Intrinsics
 
-#: Range reported for pixels whose ray hits nothing within ``max_range`` [m].
-NO_HIT = np.inf
 #: The 8 corners of a box of half-sizes 1.
 _CORNERS = np.array([[x, y, z] for x in (-1.0, 1.0) for y in (-1.0, 1.0) for z in (-1.0, 1.0)])
 #: Its 12 edges: pairs of corners that differ in one coordinate.

@@ -97,11 +97,11 @@ ARMATURE = 0.02
 DAMPING = 0.1
 #: Finger joints of the mk3 hand (grasp variant). Position-servo stiffness [N m / rad]: a finger presses with at
 #: most its motor's torque (0.3 N m, ``motor_limits``), reached at a tracking error of 0.3 rad. Damping
-#: [N m s / rad] and armature [kg m^2]: the URDF's damping of 1 N m s/rad is a placeholder that, against kp = 1, makes the fingers lag
-#: 30 degrees behind a 1 s closing ramp (time constant damping / kp = 1 s); 0.03 is a small gear friction
-#: (0.03 s) and the fingers track to a fraction of a degree. The armature, the reflected inertia of the finger's
-#: motor and gearbox, keeps the light links (10-17 g, inertias of 1e-6 kg m^2) well conditioned at the 2 ms
-#: timestep: 1e-3 kg m^2 gives a servo period of 2 pi sqrt(1e-3 / 1) = 0.2 s, a hundred timesteps.
+#: [N m s / rad] and armature [kg m^2]: the URDF's damping of 1 N m s/rad is a placeholder that, against kp = 1,
+#: makes the fingers lag 30 degrees behind a 1 s closing ramp (time constant damping / kp = 1 s); 0.03 is a small
+#: gear friction (0.03 s) and the fingers track to a fraction of a degree. The armature, the reflected inertia of
+#: the finger's motor and gearbox, keeps the light links (10-17 g, inertias of 1e-6 kg m^2) well conditioned: 1e-3
+#: kg m^2 gives a servo period of 2 pi sqrt(1e-3 / 1) = 0.2 s, forty timesteps of the grasp scene.
 HAND_KP, HAND_DAMPING, HAND_ARMATURE = 1.0, 0.03, 1e-3
 #: Timestep of the grasp variant [s]. The tap scene's 2 ms resolves the impact of a tap; a grasp has no impact,
 #: and its fastest dynamics are resolved at 5 ms with at least 2 steps per time constant (MuJoCo's stability

@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import contextlib
-import dataclasses
-import inspect
 import numbers
 from collections.abc import Callable, Mapping, Sequence
 from typing import Any
@@ -14,29 +11,15 @@ import numpy as np
 from gymnasium import spaces
 
 from affordance_env.attention import attend
-from affordance_env.behaviors import (
-    ACTION_DIM,
-    BEHAVIORS,
-    GraspBehavior,
-    StrokePlan,
-    check_action,
-    get_behavior,
-    is_success,
-    plan_grasp,
-    plan_stroke,
-)
+from affordance_env.behaviors import ACTION_DIM, BEHAVIORS, check_action
 from affordance_env.camera import RangeCamera
 from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
+from affordance_env.interactions import Interaction, get_interaction
 from affordance_env.kinematics import Kinematics
-from affordance_env.motion import (
-    HOLD_MAX_TIME,
-    HOLD_SPEED_TOLERANCE,
-    GraspOutcome,
-    MotionExecutor,
-)
+from affordance_env.motion import HOLD_MAX_TIME, HOLD_SPEED_TOLERANCE, MotionExecutor, ReachOutcome
 from affordance_env.objects import check_object_type, check_size, object_geometry
 from affordance_env.options import EnvOptions
-from affordance_env.outcome import REST_DURATION, ObjectMonitor, grasp_success, outcome_labels
+from affordance_env.outcome import REST_DURATION, ObjectMonitor, outcome_labels
 from affordance_env.physics import TapPhysics
 from affordance_env.range_noise import add_kinect_noise
 from affordance_env.scene import build_model
@@ -50,15 +33,11 @@ RESET_OPTIONS = ("object_type", "size", "position", "yaw")
 YAW_JITTER = 0.25
 #: The placed object is at rest for the initial snapshot when slower than these [m/s], [rad/s].
 REST_SPEED, REST_ANGULAR_SPEED = 1e-3, 1e-2
-#: The hand may start the stroke at most this far from the planned pre-stroke pose [m], and may have moved
-#: the object at most this much before the stroke [m]; otherwise the interaction is marked failed.
-MAX_START_ERROR, MAX_OBJECT_MOVED_BEFORE = 0.01, 0.003
 
-
-def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: tuple[bool, bool],
-                    touched_on_way_home: bool = False) -> str | None:
-    """Why an interaction cannot be used, or None; see the class docstring. ``stroke``: a StrokeOutcome or a
-    GraspOutcome; ``still``: whether the robot was still for the initial and for the final snapshot;
+def _failure_reason(fault: str | None, visible_initially: bool, outcome: ReachOutcome, still: tuple[bool, bool],
+                    touched_on_way_home: bool, interaction: Interaction) -> str | None:
+    """Why an interaction cannot be used, or None; see the class docstring. ``outcome``: what the interaction
+    reported; ``still``: whether the robot was still for the initial and for the final snapshot;
     ``touched_on_way_home``: the arm touched the object again after it had been clear of it."""
     if fault is not None:
         return f"physics: {fault}"
@@ -68,21 +47,12 @@ def _failure_reason(fault: str | None, visible_initially: bool, stroke, still: t
                     f"{HOLD_SPEED_TOLERANCE:g} rad/s after {HOLD_MAX_TIME:g} s of holding still)")
     if not visible_initially:
         return "perception: the object was not visible in the initial snapshot"
-    what = "grasp" if isinstance(stroke, GraspOutcome) else "stroke"
-    if not stroke.ik_success:
-        return (f"ik: the {what} was not reachable (position error {stroke.ik_position_error * 1e3:.1f} mm, "
-                f"orientation error {stroke.ik_orientation_error:.2f} rad)")
+    if not outcome.ik_success:
+        return (f"ik: the {interaction.kind} was not reachable (position error "
+                f"{outcome.ik_position_error * 1e3:.1f} mm, orientation error {outcome.ik_orientation_error:.2f} rad)")
     if touched_on_way_home:
         return "home: the arm touched the object on its way home"
-    if what == "grasp":  # the hand meets the object on its way down, and may miss it: that is the grasp's outcome
-        return None
-    if stroke.object_moved > MAX_OBJECT_MOVED_BEFORE:
-        return f"reach: the arm moved the object by {stroke.object_moved * 1e3:.1f} mm before the stroke"
-    if stroke.start_error > MAX_START_ERROR:
-        return f"reach: the stroke started {stroke.start_error * 1e3:.1f} mm from the planned pose"
-    if not stroke.contact:
-        return "tap: the hand never touched the object"
-    return None
+    return interaction.failure(outcome)
 
 
 def _object_at_rest(physics: TapPhysics) -> bool:
@@ -275,7 +245,9 @@ class TapAffordanceEnv(gym.Env):
                              roll_threshold=roll_threshold, settle_timeout=settle_timeout,
                              range_noise=range_noise)  # checked and normalised
         self._check_render_mode(render_mode)
-        self.behavior = get_behavior(options.behavior)
+        #: The interaction of the behaviour (:mod:`affordance_env.interactions`).
+        self.interaction = get_interaction(options.behavior)
+        self.behavior = self.interaction.behavior
         self.object_types = options.object_types
         self.size_range = options.size_range
         self.roll_threshold = options.roll_threshold
@@ -292,9 +264,7 @@ class TapAffordanceEnv(gym.Env):
                                   support="table_top")
         self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy,
                                             support="table_top")
-        if not isinstance(self.behavior, GraspBehavior):  # every approach's IK starts from one posture
-            self.physics.reset_home()
-            self.motion.set_approach_posture(self._nominal_plan())
+        self.interaction.prepare(self.motion, PLACEMENT_CENTRE, float(np.mean(self.size_range)))
         self._renderer = None
         self._render_size = (render_width, render_height)
         #: With a render mode: pictures taken every 1/render_fps s of simulated time since the last ``reset``
@@ -324,30 +294,10 @@ class TapAffordanceEnv(gym.Env):
         self._q_home = np.zeros(nq)
 
     @classmethod
-    def check_options(cls, **options: Any) -> None:
-        """Raise ValueError, naming the value and what was expected, for any of the constructor's options that it
-        would refuse; without building anything (:class:`~affordance_env.options.EnvOptions` checks the options
-        that decide the data without importing the simulator, which is what a collection uses)."""
-        try:
-            bound = inspect.signature(cls.__init__).bind(None, **options)
-        except TypeError as exc:
-            raise ValueError(f"Options of TapAffordance-v1: {exc}.") from None
-        bound.apply_defaults()
-        data_options = {f.name for f in dataclasses.fields(EnvOptions)}
-        EnvOptions(**{name: value for name, value in bound.arguments.items() if name in data_options})
-        cls._check_render_mode(bound.arguments["render_mode"])
-
-    @classmethod
     def _check_render_mode(cls, render_mode: str | None) -> None:
         if render_mode not in (None, *cls.metadata["render_modes"]):
             raise ValueError(f"render_mode must be None or one of {cls.metadata['render_modes']}, got "
                              f"{render_mode!r}.")
-
-    def _nominal_plan(self) -> StrokePlan:
-        """The canonical stroke of a sphere of the middle size at the centre of the placement region."""
-        geometry = object_geometry("sphere", float(np.mean(self.size_range)))
-        centre = np.array([*PLACEMENT_CENTRE, self.physics.table_top + geometry.half_height])
-        return plan_stroke(self.behavior, geometry, centre, 0.0, self.physics.table_top, np.zeros(ACTION_DIM))
 
     def _blank_observation(self) -> dict[str, np.ndarray]:
         space = self.observation_space
@@ -431,7 +381,7 @@ class TapAffordanceEnv(gym.Env):
         self._q_home = physics.joint_targets()
         geometry = object_geometry(object_type, size)
         physics.set_object(geometry, xy, yaw)  # 0.1 mm above the table: it settles while the head turns
-        with self._free_stepping():
+        with self.interaction.free_stepping(self.motion):
             attention = attend(physics, self.attention_camera, self.motion.move_joints)
             still = self.motion.hold_still(also=_object_at_rest)
         self._q_home = physics.joint_targets()  # the arm's home, with the gaze on the object
@@ -447,12 +397,6 @@ class TapAffordanceEnv(gym.Env):
             "still": still,
         }
         return obs, info
-
-    def _free_stepping(self) -> contextlib.AbstractContextManager:
-        """A tap interaction steps at ``motion.FREE_TIMESTEP`` outside its stroke; a grasp at its own timesteps."""
-        if isinstance(self.behavior, GraspBehavior):
-            return contextlib.nullcontext()
-        return self.motion.stepping(self.motion.free_timestep)
 
     def _wait_outcome(self, monitor: ObjectMonitor, since: float) -> tuple[str, float]:
         """Simulate until the object has left the table, has been at rest since ``since`` [s] or later, or
@@ -480,17 +424,14 @@ class TapAffordanceEnv(gym.Env):
         action = check_action(action)
         initial, self._initial = self._initial, None
         physics = self.physics
-        grasping = isinstance(self.behavior, GraspBehavior)
-        plan = (plan_grasp if grasping else plan_stroke)(
-            self.behavior, initial["geometry"], initial["pose"][:3], initial["yaw"], physics.table_top, action)
+        interaction = self.interaction
+        plan = interaction.plan(initial["geometry"], initial["pose"][:3], initial["yaw"], physics.table_top, action)
         monitor = physics.start_monitor()  # from now on, whatever the arm does
         try:
-            stroke = self.motion.grasp(plan) if grasping else self.motion.stroke(plan)
-            with self._free_stepping():
-                home = self.motion.go_home(self._q_home, via=stroke.q_retreat if grasping else stroke.q_withdraw)
-                # The outcome is awaited from the first touch of a stroke, or from the release of a grasp.
-                since = stroke.release_time if grasping else (
-                    stroke.contact_time if stroke.contact else physics.data.time)
+            done = interaction.execute(self.motion, plan)
+            with interaction.free_stepping(self.motion):
+                home = self.motion.go_home(self._q_home, via=interaction.via_home(done))
+                since = interaction.awaited_since(done, float(physics.data.time))
                 outcome, outcome_time = self._wait_outcome(monitor, since)
         finally:
             physics.monitor = None
@@ -507,7 +448,8 @@ class TapAffordanceEnv(gym.Env):
             final_features = NOT_VISIBLE_VALUES
             final_pose = np.full(7, np.nan)
             visible = False
-        failure = _failure_reason(fault, initial["visible"], stroke, (initial["still"], home.still), home.touched)
+        failure = _failure_reason(fault, initial["visible"], done, (initial["still"], home.still), home.touched,
+                                  interaction)
         # Travel on the table: to where the object rests, or to where it left the table (not where it fell).
         p_end = monitor.exit_position if monitor.left_table else final_pose
         displacement = 0.0 if fault else float(np.linalg.norm(p_end[:2] - initial["pose"][:2]))
@@ -519,11 +461,8 @@ class TapAffordanceEnv(gym.Env):
             else effect_features(initial["features"].values, final_features)
         )
         # The success label: a failed interaction is no sample, so no success either.
-        if grasping:  # lifted and held, from the simulation
-            success = failure is None and grasp_success(stroke.rise, stroke.links_holding, stroke.on_table)
-        else:
-            success = failure is None and labels is not None and is_success(
-                self.behavior.success_rule, labels.rolled, displacement, self.roll_threshold)
+        success = failure is None and labels is not None and interaction.success(done, labels, displacement,
+                                                                                 self.roll_threshold)
         info = {
             "object": {"type": initial["geometry"].object_type, "size": initial["geometry"].size,
                        "initial_pose": initial["pose"], "final_pose": final_pose},
@@ -538,18 +477,15 @@ class TapAffordanceEnv(gym.Env):
             "tilt": 0.0 if fault else labels.tilt,
             "outcome": "fault" if fault else outcome,
             "outcome_time": 0.0 if fault else float(outcome_time),
-            "contact": stroke.contact,
-            "hand_speed": stroke.hand_speed,
-            "stroke_speed": 0.0 if grasping else stroke.speed,
-            "ik": {"success": stroke.ik_success, "position_error": stroke.ik_position_error,
-                   "orientation_error": stroke.ik_orientation_error},
+            "contact": done.contact,
+            "hand_speed": done.hand_speed,
+            "ik": {"success": done.ik_success, "position_error": done.ik_position_error,
+                   "orientation_error": done.ik_orientation_error},
             "visible": visible,
             "behavior": self.behavior.name,
             "failure": failure,
+            **interaction.info(done),
         }
-        if grasping:
-            info["grasp"] = {"rise": stroke.rise, "links_holding": stroke.links_holding,
-                             "on_table": stroke.on_table}
         reward = float(self.reward_fn(info))
         return obs, reward, True, False, info
 

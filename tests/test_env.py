@@ -1,5 +1,6 @@
 """TapAffordance-v1 as a user meets it: Gymnasium's checker, determinism, the paper's phenomenon, errors."""
 
+import dataclasses
 
 import gymnasium as gym
 import numpy as np
@@ -108,16 +109,14 @@ def test_bad_actions_get_clear_errors(env, action, match):
 def test_bad_options_get_clear_errors(kwargs, match, monkeypatch):
     with pytest.raises(ValueError, match=match):
         TapAffordanceEnv(**kwargs)
-    # check_options refuses them as the constructor does, without building a model (a collection's check)
-    monkeypatch.setattr(tap_env_module, "build_model", lambda *a: pytest.fail("check_options built a model"))
-    with pytest.raises(ValueError, match=match):
-        TapAffordanceEnv.check_options(**kwargs)
-    TapAffordanceEnv.check_options(**{"behavior": "push", "camera_width": 32, "camera_height": 24})
-    with pytest.raises(ValueError, match="colour"):
-        TapAffordanceEnv.check_options(colour="red")
-    if "render_mode" not in kwargs:  # and so do the data options alone, as a collection checks them
+    # the data options alone are refused the same way, without building a model (as a collection checks them)
+    if "render_mode" not in kwargs:
+        monkeypatch.setattr(tap_env_module, "build_model", lambda *a: pytest.fail("the check built a model"))
         with pytest.raises(ValueError, match=match):
             EnvOptions.checked(**kwargs)
+        EnvOptions.checked(**{"behavior": "push", "camera_width": 32, "camera_height": 24})
+        with pytest.raises(ValueError, match="colour"):
+            EnvOptions.checked(colour="red")
 
 
 def test_reward_fn_is_used():
@@ -295,12 +294,10 @@ def test_other_behaviors_reach_their_stroke_and_move_the_object_their_way(behavi
 def test_a_stroke_started_off_its_pose_is_reported(monkeypatch):
     # The servos bring the hand within a few millimetres of the pre-stroke pose; asked for 10 micrometres, the
     # interaction is reported as a reach failure, not kept as a sample.
-    import affordance_env.tap_env as tap_env
-
     env = TapAffordanceEnv(camera_width=32, camera_height=32)
     env.reset(seed=0)
     assert env.step(np.zeros(3))[4]["failure"] is None
-    monkeypatch.setattr(tap_env, "MAX_START_ERROR", 1e-5)
+    env.interaction = dataclasses.replace(env.interaction, max_start_error=1e-5)
     env.reset(seed=0)
     info = env.step(np.zeros(3))[4]
     assert info["failure"].startswith("reach: the stroke started"), info["failure"]
