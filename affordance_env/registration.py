@@ -21,7 +21,21 @@ def make_tap_env(**kwargs: Any) -> gym.Env:
     return TapAffordanceEnv(**kwargs)
 
 
+def make_tap_vector_env(num_envs: int = 1, **kwargs: Any) -> gym.vector.VectorEnv:
+    """``gym.make_vec("TapAffordance-v1", num_envs)``: environments side by side in this process, each reset in the
+    same vector step that ends its episode (Gymnasium's ``AutoresetMode.SAME_STEP``, which the env declares in its
+    metadata), so that every vector step is an interaction. With Gymnasium's default, the next step, every
+    second step of a one-interaction episode would be a reset with reward 0. ``vectorization_mode="async"``
+    with ``vector_kwargs={"autoreset_mode": gym.vector.AutoresetMode.SAME_STEP}`` gives worker processes."""
+    if isinstance(num_envs, bool) or not isinstance(num_envs, int) or num_envs < 1:
+        raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}.")
+    kwargs.pop("max_episode_steps", None)  # one interaction per episode: the env terminates it
+    return gym.vector.SyncVectorEnv([lambda: make_tap_env(**kwargs) for _ in range(num_envs)],
+                                    autoreset_mode=gym.vector.AutoresetMode.SAME_STEP)
+
+
 def register_envs() -> None:
     """Register ``TapAffordance-v1`` (idempotent)."""
     if ENV_ID not in gym.registry:
-        gym.register(id=ENV_ID, entry_point="affordance_env.registration:make_tap_env")
+        gym.register(id=ENV_ID, entry_point="affordance_env.registration:make_tap_env",
+                     vector_entry_point="affordance_env.registration:make_tap_vector_env")

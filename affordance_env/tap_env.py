@@ -222,7 +222,9 @@ class TapAffordanceEnv(gym.Env):
     * v0: initial release.
     """
 
-    metadata = {"render_modes": ["rgb_array", "rgb_array_list"], "render_fps": 30}
+    metadata = {"render_modes": ["rgb_array", "rgb_array_list"], "render_fps": 30,
+                # one interaction per episode: a vector env resets it within the step that ends it
+                "autoreset_mode": gym.vector.AutoresetMode.SAME_STEP}
 
     def __init__(
         self,

@@ -177,6 +177,24 @@ def test_async_vector_env():
     envs.close()
 
 
+def test_every_vector_step_is_an_interaction():
+    # gym.make_vec resets each env within the step that ends its one-interaction episode (AutoresetMode.SAME_STEP,
+    # declared in the env's metadata): with Gymnasium's default, every second step would be a reset, reward 0.
+    envs = gym.make_vec("TapAffordance-v1", 2, camera_width=32, camera_height=24)
+    assert envs.metadata["autoreset_mode"] == gym.vector.AutoresetMode.SAME_STEP
+    envs.reset(seed=0)
+    objects = []
+    for _ in range(3):
+        obs, rewards, terminated, truncated, infos = envs.step(np.zeros((2, 3), dtype=np.float32))
+        assert terminated.all() and not truncated.any()
+        assert list(infos["final_info"]["behavior"]) == ["tap", "tap"]  # both envs ran an interaction ...
+        assert np.all(rewards == infos["final_info"]["displacement"]) and np.all(rewards > 0)
+        objects.append(tuple(infos["final_info"]["object"]["size"]))
+        assert obs["features"].shape == (2, 49)  # ... and the observation is already the next object's
+    assert len(set(objects)) == 3  # a new object every step
+    envs.close()
+
+
 def _rss_mib() -> float:
     with open("/proc/self/status") as status:
         for line in status:
