@@ -7,6 +7,7 @@ indexing ``MjData`` itself.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 
 import mujoco
@@ -269,6 +270,20 @@ class TapPhysics:
             xy: Position of the object's centre on the table, world x and y [m].
             yaw: Rotation about the vertical axis [rad].
         """
+        self._make_object(geometry)
+        m = self.model
+        quat_yaw = np.array([np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)])
+        quat = np.empty(4)
+        mujoco.mju_mulQuat(quat, quat_yaw, geometry.quat_rest)
+        a = self.object_qpos
+        self.data.qpos[a : a + 3] = [xy[0], xy[1], self.table_top + geometry.half_height + 1e-4]
+        self.data.qpos[a + 3 : a + 7] = quat
+        self.data.qvel[self.object_qvel : self.object_qvel + 6] = 0.0
+        mujoco.mj_forward(m, self.data)
+
+    def _make_object(self, geometry: ObjectGeometry) -> None:
+        """Make ``geometry`` the object of interest in the model (its primitive, size, mass and inertia), without
+        touching the state."""
         m = self.model
         for primitive, g in self.object_geoms.items():
             active = primitive == geometry.primitive
@@ -295,14 +310,23 @@ class TapPhysics:
         self.active_geom = g
         self.geometry = geometry
         mujoco.mj_setConst(m, self.scratch)  # on scratch data: it resets the state it is given to qpos0
-        quat_yaw = np.array([np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)])
-        quat = np.empty(4)
-        mujoco.mju_mulQuat(quat, quat_yaw, geometry.quat_rest)
-        a = self.object_qpos
-        self.data.qpos[a : a + 3] = [xy[0], xy[1], self.table_top + geometry.half_height + 1e-4]
-        self.data.qpos[a + 3 : a + 7] = quat
-        self.data.qvel[self.object_qvel : self.object_qvel + 6] = 0.0
-        mujoco.mj_forward(m, self.data)
+
+    # --- snapshots of the world --------------------------------------------------------------------------------
+    def get_state(self) -> tuple[ObjectGeometry | None, mujoco.MjData]:
+        """The world as it is: the object's geometry and a copy of MuJoCo's data, state and derived quantities
+        alike (what the last step computed, which the next one reads before it computes them anew)."""
+        return self.geometry, copy.copy(self.data)
+
+    def set_state(self, snapshot: tuple[ObjectGeometry | None, mujoco.MjData]) -> None:
+        """Put the world back as :meth:`get_state` saw it: the same steps then follow, bit for bit."""
+        geometry, data = snapshot
+        if not isinstance(data, mujoco.MjData):
+            raise TypeError(f"snapshot must be what get_state() returned, got {type(snapshot).__name__}.")
+        current = self.geometry
+        if geometry is not None and (current is None or (geometry.object_type, geometry.size)
+                                     != (current.object_type, current.size)):
+            self._make_object(geometry)
+        mujoco.mj_copyData(self.data, self.model, data)  # into the same arrays: the views into them stay valid
 
     def object_pose(self) -> np.ndarray:
         """Object pose: position [m] and orientation quaternion (w, x, y, z), (7,)."""

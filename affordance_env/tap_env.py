@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import copy
 import numbers
 from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import gymnasium as gym
@@ -53,6 +55,23 @@ def _failure_reason(fault: str | None, visible_initially: bool, outcome: ReachOu
     if touched_on_way_home:
         return "home: the arm touched the object on its way home"
     return interaction.failure(outcome)
+
+
+@dataclass(frozen=True)
+class EnvState:
+    """A snapshot of :class:`TapAffordanceEnv` (:meth:`~TapAffordanceEnv.get_state`): treat it as opaque.
+
+    Attributes:
+        physics: The object's geometry and MuJoCo's integration state.
+        initial: What the episode's initial snapshot saw (None between episodes).
+        q_home: The arm's home targets, with the gaze on the object.
+        rng: The state of the env's random generator.
+    """
+
+    physics: tuple[Any, np.ndarray]
+    initial: dict[str, Any] | None
+    q_home: np.ndarray
+    rng: dict[str, Any]
 
 
 def _object_at_rest(physics: TapPhysics) -> bool:
@@ -109,6 +128,11 @@ class TapAffordanceEnv(gym.Env):
     moderate tap rolls a ball 8-26 cm, and it is seen where it stops. 3-D features (``mean_x``, ``hand_dx``, ...)
     are in the robot's root frame, which is fixed (the robot does not walk), so final minus initial is the
     object's motion; image features are in the head camera's image, also unmoved between the two snapshots.
+
+    ``get_state()`` and ``set_state(state)`` snapshot and restore the world and the episode (0.4 and 0.02 ms,
+    ``benchmarks/state.py``): the same action after a restore gives the same interaction, bit for bit. A vector
+    env (``gym.make_vec``) resets each env in the step that ends its episode, so every vector step is an
+    interaction.
 
     ## Action Space
     ``Box(-1, 1, (3,), float32)``; 0 is the paper's canonical tap.
@@ -399,6 +423,23 @@ class TapAffordanceEnv(gym.Env):
             "still": still,
         }
         return obs, info
+
+    def get_state(self) -> EnvState:
+        """A snapshot of the world and of the episode: the object and MuJoCo's state, what the initial snapshot
+        saw, and the env's random generator. :meth:`set_state` puts it back; the same action then gives the same
+        interaction, bit for bit (an oracle that tries several actions from one state does not replay the reset)."""
+        initial = None if self._initial is None else dict(self._initial)
+        return EnvState(self.physics.get_state(), initial, self._q_home.copy(),
+                        copy.deepcopy(self.np_random.bit_generator.state))
+
+    def set_state(self, state: EnvState) -> None:
+        """Put back the world and the episode as :meth:`get_state` saw them."""
+        if not isinstance(state, EnvState):
+            raise TypeError(f"state must be what get_state() returned (an EnvState), got {type(state).__name__}.")
+        self.physics.set_state(state.physics)
+        self._initial = None if state.initial is None else dict(state.initial)
+        self._q_home = state.q_home.copy()
+        self.np_random.bit_generator.state = copy.deepcopy(state.rng)
 
     def _wait_outcome(self, monitor: ObjectMonitor, since: float) -> tuple[str, float]:
         """Simulate until the object has left the table, has been at rest since ``since`` [s] or later, or
