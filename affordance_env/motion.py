@@ -648,8 +648,11 @@ class MotionExecutor:
             self.phase = "wait"
             self.hold(HOME_WAIT, until=lambda: _object_at_rest(physics) or not physics.object_on_table())
             self.phase = "home"
+            q_now = physics.joint_targets()
+            R_world_hand = self.kinematics.hand_pose(q_now).rotation  # straight up, the hand turned as it is
             p_up = physics.hand_position() + np.array([0.0, 0.0, HOME_RAISE])
-            q_up = self.kinematics.solve_ik(p_up, physics.joint_targets()).q
+            q_up = self.kinematics.solve_ik(p_up, q_now, R_world_hand,
+                                            orientation_tolerance=IK_ORIENTATION_TOLERANCE).q
             self.move_through([q_up, q_home], until=watch(False))
         still = self.hold_still()
         touched = state["touched"] or (state["clear"] and physics.hand_touches_object())
