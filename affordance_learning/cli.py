@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 import time
 import warnings
@@ -194,6 +195,11 @@ def main(argv: list[str] | None = None) -> int:
     is a bug and keeps its traceback.
     """
     args = build_parser().parse_args(argv)
+    # joblib's resource tracker, a process of its own that inherits this environment, lists on Ctrl-C the
+    # semaphores of the workers it stopped as it cleans them up: two warnings after the line below, not for people
+    tracker = "ignore::UserWarning:joblib.externals.loky.backend.resource_tracker"
+    if tracker not in os.environ.get("PYTHONWARNINGS", ""):
+        os.environ["PYTHONWARNINGS"] = ",".join(w for w in (os.environ.get("PYTHONWARNINGS"), tracker) if w)
     with warnings.catch_warnings():
         # joblib's note, on Ctrl-C, that the chunks its workers held were cancelled: the line below says it
         warnings.filterwarnings("ignore", message=".*tasks which were still being processed by the workers",
