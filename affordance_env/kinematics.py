@@ -52,7 +52,11 @@ def _build_model(variant: str) -> pin.Model:
     robot = get_variant(variant)
     full = pin.buildModelFromXML(icub_urdf())
     locked = [full.getJointId(name) for name in full.names[1:] if name not in robot.active_joints]
-    model = pin.buildReducedModel(full, locked, pin.neutral(full))
+    q_locked = pin.neutral(full)  # locked at zero, or where the variant holds them (the other arm at home)
+    for name, angle in robot.held.items():
+        if full.existJointName(name):
+            q_locked[full.joints[full.getJointId(name)].idx_q] = angle
+    model = pin.buildReducedModel(full, locked, q_locked)
     if robot.fingered:
         # The palm link (the hand model's root) at HAND_MOUNT_POS in HAND_MOUNT_FRAME, unrotated, as in MuJoCo.
         T_mount_palm = pin.SE3(np.eye(3), np.array(HAND_MOUNT_POS))

@@ -275,6 +275,9 @@ class MotionExecutor:
     def __init__(self, physics: TapPhysics, kinematics: Kinematics, free_timestep: float = FREE_TIMESTEP) -> None:
         self.physics = physics
         self.kinematics = kinematics
+        #: The palm of the arm that ``kinematics`` moves (in the scene with both arms, either arm's).
+        self.palm_site = int(physics.model.site(kinematics.variant.palm_site).id)
+        self._palm = physics.data.site_xpos[self.palm_site]  # a view: the palm's position after each step
         self._opt = physics.model.opt  # MuJoCo's options, read at every tick: the wrapper is made once
         self._tick_timestep, self._steps_per_tick = 0.0, 1  # the last timestep seen, and its steps per tick
         #: Velocity limit of every active joint [rad/s] (:mod:`affordance_env.motor_limits`) ...
@@ -395,7 +398,7 @@ class MotionExecutor:
         Returns the remaining distance [m] (larger than ``tolerance`` if ``max_time`` [s] ran out).
         """
         def arrived() -> bool:
-            return float(np.linalg.norm(self.physics.hand_position() - p_world_target)) <= tolerance
+            return float(np.linalg.norm(self._palm - p_world_target)) <= tolerance
 
         if not arrived():
             q = self.physics.joint_targets()
@@ -404,7 +407,7 @@ class MotionExecutor:
                 self.physics.step(self.steps_per_tick)
                 if arrived():
                     break
-        return float(np.linalg.norm(self.physics.hand_position() - p_world_target))
+        return float(np.linalg.norm(self._palm - p_world_target))
 
     def _ik(self, p: np.ndarray, q_init: np.ndarray, plan: StrokePlan | GraspPlan) -> IKResult:
         """IK of a palm position with the plan's hand orientation (and joint ranges, if it has any)."""
@@ -423,7 +426,7 @@ class MotionExecutor:
         hand is within CONTACT_WATCH_DISTANCE of the object (the stroke: its first touch to the step).
         """
         physics = self.physics
-        palm = physics.data.site_xpos[physics.palm_site]  # a view: the palm position after each step
+        palm = self._palm  # a view: the palm position after each step
         lead = physics.servo_lead
         n_steps = self.steps_per_tick
         dt = physics.model.opt.timestep
@@ -497,11 +500,11 @@ class MotionExecutor:
             self.move_through([start.q] if above is None else [above.q, start.q])  # through the pose above, if any
             start_error = self.settle(plan.p_start)
         object_moved = float(np.linalg.norm(physics.object_pose()[:3] - p_object_before))
-        p_hand_start = physics.hand_position()
+        p_hand_start = self._palm.copy()
         self.phase = "stroke"
         result = self.follow_line(path, physics.hand_touches_object, per_step=True,
                                   follow_through=plan.follow_through)
-        travel = float(np.dot(physics.hand_position() - p_hand_start, plan.direction))
+        travel = float(np.dot(self._palm.copy() - p_hand_start, plan.direction))
         # The pose above the object is a via point that only has to clear it; the stroke itself must be exact.
         return StrokeOutcome(*_ik_verdict([start, *path.results]), result.touched, result.time, result.speed,
                              travel, start_error, object_moved, None if above is None else above.q, path.speed)
@@ -572,7 +575,7 @@ class MotionExecutor:
         self.phase = "close"
         self._fingers(plan.hand_closed, plan.close_speed, until_held=True)
         self.phase = "lift"
-        p_from = physics.hand_position()
+        p_from = self._palm.copy()
         lift = self.line(p_from, p_from + (plan.p_lift - plan.p_grasp), plan, LIFT_SPEED)
         results += lift.results
         self.follow_line(lift)
@@ -586,7 +589,7 @@ class MotionExecutor:
         if held:  # carry it to above where it is put down: as high above the table as it was lifted
             self.phase = "carry"
             # where the object would touch the table, from how far it has risen with the hand
-            z_touch = physics.hand_position()[2] - (float(physics.object_pose()[2]) - z_start)
+            z_touch = float(self._palm[2]) - (float(physics.object_pose()[2]) - z_start)
             p_carry = np.array([plan.p_place[0], plan.p_place[1], z_touch + PLACE_APPROACH])
             carry = self._ik(p_carry, physics.joint_targets(), plan)
             results.append(carry)
@@ -595,7 +598,7 @@ class MotionExecutor:
             # it rests. Fingertips curled under a small object meet the table first: the grip loosens to the
             # closing's light touch, and the fingers yield and spread on the table as the hand goes on down.
             self.phase = "place"
-            p_hand = physics.hand_position()
+            p_hand = self._palm.copy()
             p_low = p_hand - np.array([0.0, 0.0, PLACE_APPROACH + PLACE_OVERTRAVEL])
             down = self.line(p_hand, p_low, plan, GUARDED_SPEED)
             placed = self.follow_line(down, lambda: physics.object_touches_table()
@@ -603,7 +606,7 @@ class MotionExecutor:
             if not placed:  # the fingers under the object met the table: they loosen and yield as the hand goes on
                 fingers = np.array([self.kinematics.joint_names.index(name) for name in plan.hand_closed])
                 physics.limit_torques(fingers, CLOSING_TORQUE)
-                p_hand = physics.hand_position()
+                p_hand = self._palm.copy()
                 on_down = self.line(p_hand, p_hand - np.array([0.0, 0.0, PLACE_OVERTRAVEL]), plan, GUARDED_SPEED)
                 placed = self.follow_line(on_down, physics.object_touches_table).touched
                 physics.limit_torques(fingers, None)
@@ -615,7 +618,7 @@ class MotionExecutor:
         self.hold_still(also=_object_at_rest)
         release_time = float(physics.data.time)
         # The way home rises first: straight up from where the hand let go.
-        p_up = physics.hand_position() + np.array([0.0, 0.0, plan.p_retreat[2] - plan.p_place[2]])
+        p_up = self._palm.copy() + np.array([0.0, 0.0, plan.p_retreat[2] - plan.p_place[2]])
         retreat = self._ik(p_up, physics.joint_targets(), plan)
         return GraspOutcome(*_ik_verdict(results), touch.touched, touch.time, touch.speed, rise, holding,
                             on_table, release_time, placed, retreat.q)
@@ -650,7 +653,7 @@ class MotionExecutor:
             self.phase = "home"
             q_now = physics.joint_targets()
             R_world_hand = self.kinematics.hand_pose(q_now).rotation  # straight up, the hand turned as it is
-            p_up = physics.hand_position() + np.array([0.0, 0.0, HOME_RAISE])
+            p_up = self._palm.copy() + np.array([0.0, 0.0, HOME_RAISE])
             q_up = self.kinematics.solve_ik(p_up, q_now, R_world_hand,
                                             orientation_tolerance=IK_ORIENTATION_TOLERANCE).q
             self.move_through([q_up, q_home], until=watch(False))

@@ -16,6 +16,7 @@ import numpy as np
 from affordance_env.objects import PRIMITIVES, ObjectGeometry
 from affordance_env.outcome import ObjectMonitor
 from affordance_env.robot_model import HAND_COUPLINGS, coupled_position, get_variant
+from affordance_env.scene import ROBOT_CONAFFINITY, ROBOT_CONTYPE
 
 #: Geom group that hides the scene's inactive object primitives from the range camera and the renderer.
 HIDDEN_GEOM_GROUP = 3
@@ -83,8 +84,11 @@ class TapPhysics:
         self.head_site = _id(model, obj.mjOBJ_SITE, "head")
         self.table_geom = _id(model, obj.mjOBJ_GEOM, "table_top")
         self.home_key = _id(model, obj.mjOBJ_KEY, "home")
-        contact_bodies = {_id(model, obj.mjOBJ_BODY, n) for n in self.variant.contact_links}
-        self.hand_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] in contact_bodies])
+        # The robot's geoms that touch the world: those of its contact links, of an arm held still too (fused into
+        # the body it hangs from).
+        self.hand_geoms = np.array([g for g in range(model.ngeom) if model.geom_bodyid[g] != self.object_body
+                                    and (model.geom_contype[g], model.geom_conaffinity[g])
+                                    == (ROBOT_CONTYPE, ROBOT_CONAFFINITY)])
         self._is_hand_geom = np.zeros(model.ngeom, dtype=bool)
         self._is_hand_geom[self.hand_geoms] = True
         self._hand_geom_list = self.hand_geoms.tolist()

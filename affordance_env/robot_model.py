@@ -4,7 +4,7 @@ MuJoCo (:mod:`affordance_env.scene`) and Pinocchio (:mod:`affordance_env.kinemat
 returned by :func:`icub_urdf`, and both lock every joint outside a variant's active joints at zero. That is the
 single source of truth for the robot's geometry.
 
-Two variants (:data:`VARIANTS`):
+Variants (:data:`VARIANTS`):
 
 - ``"tap"`` (the default): torso, neck and right arm move; the right hand is the V2.5 model's rigid hand.
   :data:`ACTIVE_JOINTS`, :data:`REACH_JOINTS`, :data:`HAND_FRAME` and :data:`CONTACT_LINKS` are this variant's.
@@ -12,11 +12,17 @@ Two variants (:data:`VARIANTS`):
   ``icub-models`` (:func:`hand_urdf`), mounted in ``l_hand_dh_frame`` at :data:`HAND_MOUNT_POS` in place of the
   V2.5 left hand. Its 11 finger joints are driven by 7 motors, as on the real hand: each distal joint follows
   its proximal one (:data:`HAND_COUPLINGS`).
+- ``"two_arms"`` and ``"two_arms_left"``: the robot with both, the right arm with the V2.5 hand and the left arm
+  with the fingered hand, the arm that does not act held rigid at its home pose (:data:`HELD_AT_HOME`). The
+  first moves the right arm, the second the left arm and its fingers; both see and measure the relation features
+  to the right palm (the ``palm`` site), whichever arm acts.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import functools
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -162,7 +168,13 @@ class RobotVariant:
         hand_frame: URDF frame of the palm centre (z along the palm normal, x along the fingers).
         contact_links: Links that may touch the world (table, objects); all others collide with nothing.
         camera_visible_links: Links that can come into the head camera's view (ray cast over the object).
-        fingered: Whether the hand is the fingered mk3 hand.
+        fingered: Whether the acting hand is the fingered mk3 hand (its finger joints move).
+        mk3_hand: Whether the left hand is the fingered mk3 hand (moving or held).
+        held: Joints that do not move and are held at these angles [rad] instead of at zero (the other arm at its
+            home pose).
+        palm_sites: MuJoCo sites at the palms' centres, (site, frame) pairs; ``palm`` is the one the relation
+            features are measured to.
+        palm_site: The site at the acting palm's centre.
     """
 
     name: str
@@ -174,7 +186,16 @@ class RobotVariant:
     contact_links: tuple[str, ...]
     camera_visible_links: tuple[str, ...]
     fingered: bool
+    mk3_hand: bool = False
+    held: Mapping[str, float] = dataclasses.field(default_factory=dict)
+    palm_sites: tuple[tuple[str, str], ...] = (("palm", HAND_FRAME),)
+    palm_site: str = "palm"
 
+
+# The mk3 palm has no joint of its own: in the simulation it is fused into "l_hand", the link that the wrist turns
+# (the V2.5 hand mesh is removed from it); the fingers are the other mk3 links.
+_LEFT_CONTACT_LINKS: tuple[str, ...] = ("l_forearm", "l_wrist_1", "l_hand", *HAND_LINKS[1:])
+_LEFT_VISIBLE_LINKS: tuple[str, ...] = ("l_upper_arm", "l_elbow_1", "l_forearm", "l_wrist_1", "l_hand", *HAND_LINKS[1:])
 
 VARIANTS: dict[str, RobotVariant] = {
     "tap": RobotVariant(
@@ -195,13 +216,33 @@ VARIANTS: dict[str, RobotVariant] = {
         actuated_joints=TORSO_JOINTS + NECK_JOINTS + LEFT_ARM_JOINTS + HAND_DRIVEN_JOINTS,
         reach_joints=TORSO_JOINTS + LEFT_ARM_JOINTS,
         hand_frame="l_hand_dh_frame",
-        # The mk3 palm has no joint of its own: in the simulation it is fused into "l_hand", the link that the
-        # wrist turns (the V2.5 hand mesh is removed from it); the fingers are the other mk3 links.
-        contact_links=("l_forearm", "l_wrist_1", "l_hand", *HAND_LINKS[1:]),
-        camera_visible_links=("l_upper_arm", "l_elbow_1", "l_forearm", "l_wrist_1", "l_hand", *HAND_LINKS[1:]),
+        contact_links=_LEFT_CONTACT_LINKS,
+        camera_visible_links=_LEFT_VISIBLE_LINKS,
         fingered=True,
+        mk3_hand=True,
+        palm_sites=(("palm", "l_hand_dh_frame"),),
     ),
 }
+
+#: The home pose of each arm, in which it is held while the other one acts (the ``home`` keyframes of
+#: :mod:`affordance_env.scene`, whose values these are): the right arm, and the left arm with its open hand.
+HELD_AT_HOME: dict[str, dict[str, float]] = {
+    "right": {"r_shoulder_pitch": -1.4, "r_shoulder_roll": 0.6, "r_shoulder_yaw": 0.0, "r_elbow": 1.5,
+              "r_wrist_prosup": 0.0, "r_wrist_pitch": 0.0, "r_wrist_yaw": -0.33},
+    "left": {"l_shoulder_pitch": -1.4, "l_shoulder_roll": 0.6, "l_shoulder_yaw": 0.0, "l_elbow": 1.5,
+             "l_wrist_prosup": 0.0, "l_wrist_pitch": 0.0, "l_wrist_yaw": 0.0, **HAND_OPEN,
+             **{distal: float(coupled_position(distal, HAND_OPEN[proximal]))
+                for distal, (proximal, _) in HAND_COUPLINGS.items()}},
+}
+_TWO_PALMS = (("palm", HAND_FRAME), ("left_palm", "l_hand_dh_frame"))
+VARIANTS["two_arms"] = dataclasses.replace(
+    VARIANTS["tap"], name="two_arms", mk3_hand=True, held=HELD_AT_HOME["left"],
+    contact_links=CONTACT_LINKS + _LEFT_CONTACT_LINKS,
+    camera_visible_links=CAMERA_VISIBLE_LINKS + _LEFT_VISIBLE_LINKS, palm_sites=_TWO_PALMS)
+VARIANTS["two_arms_left"] = dataclasses.replace(
+    VARIANTS["grasp"], name="two_arms_left", held=HELD_AT_HOME["right"],
+    contact_links=_LEFT_CONTACT_LINKS + CONTACT_LINKS,
+    camera_visible_links=_LEFT_VISIBLE_LINKS + CAMERA_VISIBLE_LINKS, palm_sites=_TWO_PALMS, palm_site="left_palm")
 
 
 def get_variant(name: str) -> RobotVariant:

@@ -8,6 +8,7 @@ and ``"grasp"``, the left arm with the fingered ``left_hand_mk3`` hand (:func:`h
 from __future__ import annotations
 
 import functools
+from collections.abc import Mapping
 
 import mujoco
 import numpy as np
@@ -166,8 +167,10 @@ GRASP_HOME_QPOS: dict[str, float] = {
 
 
 def home_qpos(variant: str = "tap") -> dict[str, float]:
-    """Joint angles [rad] of the ``home`` keyframe of the robot ``variant``, by joint name."""
-    return dict(HOME_QPOS) if get_variant(variant).name == "tap" else dict(GRASP_HOME_QPOS)
+    """Joint angles [rad] of the ``home`` keyframe of the robot ``variant``, by joint name: the moving arm at its
+    home (HOME_QPOS for the right arm, GRASP_HOME_QPOS for the left arm and its fingered hand)."""
+    home = {**HOME_QPOS, **GRASP_HOME_QPOS}
+    return {name: home[name] for name in get_variant(variant).active_joints}
 
 
 def _servo_kp(joint: str) -> float:
@@ -293,11 +296,10 @@ def robot_spec(variant: str = "tap") -> mujoco.MjSpec:
     contact_links = robot.contact_links
     visible_links = robot.camera_visible_links
     spec = mujoco.MjSpec.from_string(icub_urdf())
-    # 1. Lock every joint the project does not move (legs, the other arm): the bodies become static and are fused.
-    for joint in list(spec.joints):
-        if joint.name not in robot.active_joints:
-            spec.delete(joint)
-    if robot.fingered:
+    # 1. Lock every joint the project does not move (legs, the other arm): the bodies become static and are fused;
+    #    a held joint (the other arm at home) is locked at its angle.
+    _lock_joints(spec, robot.active_joints, robot.held)
+    if robot.mk3_hand:
         _replace_hand(spec)
     # 2. Collisions: only the acting hand, wrist and forearm touch the world; nothing touches the robot itself.
     for body in spec.bodies:
@@ -319,16 +321,36 @@ def robot_spec(variant: str = "tap") -> mujoco.MjSpec:
     for joint in spec.joints:
         joint.damping = [DAMPING, 0.0, 0.0]
         joint.armature = ARMATURE
-    # 5. Palm site (for hand queries) and the range camera in the head.
-    palm = spec.body(robot.hand_frame)
-    palm.add_site(name="palm", size=[0.005, 0.005, 0.005], rgba=[0.2, 0.8, 0.2, 0.0])
+    # 5. Palm sites (for hand queries) and the range camera in the head.
+    for site, frame in robot.palm_sites:
+        spec.body(frame).add_site(name=site, size=[0.005, 0.005, 0.005], rgba=[0.2, 0.8, 0.2, 0.0])
     head = spec.body(HEAD_FRAME)
     head.add_site(name="head", size=[0.01, 0.01, 0.01], rgba=[0, 0, 0, 0])
     head.add_camera(name="range_camera", pos=list(RANGE_CAMERA_POS_HEAD), quat=list(RANGE_CAMERA_QUAT_HEAD),
                     fovy=RANGE_CAMERA_FOVY_DEG)
-    if robot.fingered:
+    if robot.mk3_hand:
         _attach_hand(spec)
+        _lock_joints(spec, robot.active_joints, robot.held)  # the hand's own joints, when it is held
     return spec
+
+
+def _lock_joints(spec: mujoco.MjSpec, active: tuple[str, ...], held: Mapping[str, float]) -> None:
+    """Delete every joint of ``spec`` not in ``active``; the body of a joint in ``held`` is first turned by its
+    angle about the joint's axis (every joint of the URDFs is at its body's origin), so it stays there."""
+    for joint in list(spec.joints):
+        if joint.name in active:
+            continue
+        angle = held.get(joint.name, 0.0)
+        if angle:
+            if np.any(joint.pos):
+                raise ValueError(f"joint {joint.name!r} is not at its body's origin; it cannot be held at an angle.")
+            body = joint.parent
+            turn = np.empty(4)
+            mujoco.mju_axisAngle2Quat(turn, np.asarray(joint.axis, dtype=float), angle)
+            quat = np.empty(4)
+            mujoco.mju_mulQuat(quat, np.asarray(body.quat, dtype=float), turn)
+            body.quat = quat
+        spec.delete(joint)
 
 
 def _replace_hand(spec: mujoco.MjSpec) -> None:
@@ -388,7 +410,7 @@ def build_spec(variant: str = "tap") -> mujoco.MjSpec:
         act.ctrllimited = True
         joint.actfrcrange = [-torque_limit[name], torque_limit[name]]
         joint.actfrclimited = True
-    # 6b. The fingered hand's coupling: each distal joint follows its proximal joint; its timestep.
+    # 6b. The fingered hand's coupling: each distal joint follows its proximal joint; the grasp's timestep.
     if variant_.fingered:
         spec.option.timestep = GRASP_TIMESTEP
         spec.option.impratio = GRASP_IMPRATIO
@@ -412,6 +434,6 @@ def build_spec(variant: str = "tap") -> mujoco.MjSpec:
 def build_model(variant: str = "tap") -> mujoco.MjModel:
     """Compile :func:`build_spec` (about half a second: the robot meshes are processed), or load the same model
     from the cache of compiled models (:mod:`affordance_env.model_cache`) in a tenth of that."""
-    urdfs = (icub_urdf(), hand_urdf()) if get_variant(variant).fingered else (icub_urdf(),)
+    urdfs = (icub_urdf(), hand_urdf()) if get_variant(variant).mk3_hand else (icub_urdf(),)
     return cached_model(variant, urdfs, lambda: build_spec(variant).compile())
 
