@@ -1,11 +1,13 @@
 """TapAffordance environment: an iCub in MuJoCo taps objects and sees the effect through a range camera.
 
-``import affordance_env`` registers ``TapAffordance-v1`` with Gymnasium::
+``import affordance_env`` registers ``TapAffordance-v1`` (one interaction of one behaviour per episode) and
+``TapAffordanceGoal-v0`` (bring the object to a goal, choosing among the four behaviours) with Gymnasium::
 
     import gymnasium as gym
     import affordance_env  # noqa: F401
 
     env = gym.make("TapAffordance-v1")
+    goal_env = gym.make("TapAffordanceGoal-v0")
 
 or, without the import, ``gym.make("affordance_env:TapAffordance-v1")``.
 """

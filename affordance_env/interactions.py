@@ -62,6 +62,9 @@ class Interaction(Protocol):
     def execute(self, motion: MotionExecutor, plan: StrokePlan | GraspPlan) -> ReachOutcome:
         """Run the plan on the robot up to the way home."""
 
+    def reachable(self, motion: MotionExecutor, plan: StrokePlan | GraspPlan) -> bool:
+        """Whether the arm can reach every pose of the plan (kinematics only: no physics step)."""
+
     def via_home(self, outcome: ReachOutcome) -> np.ndarray | None:
         """Joint targets the way home passes through first, or None."""
 
@@ -108,6 +111,9 @@ class StrokeInteraction:
     def execute(self, motion: MotionExecutor, plan: StrokePlan) -> StrokeOutcome:
         return motion.stroke(plan)
 
+    def reachable(self, motion: MotionExecutor, plan: StrokePlan) -> bool:
+        return motion.stroke_reachable(plan)
+
     def via_home(self, outcome: StrokeOutcome) -> np.ndarray | None:
         return outcome.q_withdraw
 
@@ -149,6 +155,9 @@ class GraspInteraction:
 
     def execute(self, motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
         return motion.grasp(plan)
+
+    def reachable(self, motion: MotionExecutor, plan: GraspPlan) -> bool:
+        return motion.grasp_reachable(plan)
 
     def via_home(self, outcome: GraspOutcome) -> np.ndarray | None:
         return outcome.q_retreat

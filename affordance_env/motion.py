@@ -486,14 +486,24 @@ class MotionExecutor:
         above = None if plan.p_above is None else self._ik(plan.p_above, start.q, plan)
         return above, start
 
-    def stroke(self, plan: StrokePlan) -> StrokeOutcome:
-        """Reach, and stroke until contact plus follow-through (or full travel); not the way home."""
-        physics = self.physics
+    def plan_stroke_path(self, plan: StrokePlan) -> tuple[IKResult | None, IKResult, LinePath]:
+        """The stroke's IK, solved before any move: the poses of :meth:`plan_approach` and the stroke's line."""
         above, start = self.plan_approach(plan)
         length = float(np.dot(plan.p_end - plan.p_start, plan.direction))
         # The joint speeds along the whole line cap the stroke's speed.
         path = LinePath(self, plan.p_start, plan.direction, length, plan, plan.speed, start.q, ramp=STROKE_RAMP,
                         to_rest=False)
+        return above, start, path
+
+    def stroke_reachable(self, plan: StrokePlan) -> bool:
+        """Whether :meth:`stroke` will find every pose of ``plan`` within the IK's tolerances; kinematics only."""
+        _, start, path = self.plan_stroke_path(plan)
+        return _ik_verdict([start, *path.results])[0]
+
+    def stroke(self, plan: StrokePlan) -> StrokeOutcome:
+        """Reach, and stroke until contact plus follow-through (or full travel); not the way home."""
+        physics = self.physics
+        above, start, path = self.plan_stroke_path(plan)
         p_object_before = physics.object_pose()[:3]
         self.phase = "reach"
         with self.stepping(self.free_timestep):  # the object rests and the hand moves in free space
@@ -552,15 +562,30 @@ class MotionExecutor:
         finally:
             physics.limit_torques(fingers, None)
 
+    def _grasp_poses(self, plan: GraspPlan) -> list[IKResult]:
+        """IK of the grasp's poses above the object, at the grasp and lifted, the hand open."""
+        q_open = self._with_hand(self.physics.joint_targets(), plan.hand_open)
+        results = [self._ik(plan.p_above, q_open, plan)]
+        for p in (plan.p_grasp, plan.p_lift):
+            results.append(self._ik(p, results[-1].q, plan))
+        return results
+
+    def grasp_reachable(self, plan: GraspPlan) -> bool:
+        """Whether :meth:`grasp` will find its poses within the IK's tolerances (above, at and down to the grasp,
+        the lift and the put-down beside); kinematics only."""
+        above, at, lifted = self._grasp_poses(plan)
+        descent = self.line(plan.p_above, plan.p_grasp, plan, GUARDED_SPEED, q_start=above.q)
+        lift = self.line(plan.p_grasp, plan.p_lift, plan, LIFT_SPEED, q_start=at.q)
+        place = self._ik(np.array([plan.p_place[0], plan.p_place[1], plan.p_grasp[2] + PLACE_APPROACH]), lifted.q,
+                         plan)
+        return _ik_verdict([above, at, lifted, *descent.results, *lift.results, place])[0]
+
     def grasp(self, plan: GraspPlan) -> GraspOutcome:
         """Reach above the object with the open hand, descend slowly until the hand touches it or is at the grasp
         pose, close the hand, lift, hold; if the object is held, carry it beside and put it down until it rests on
         the table; open the hand once the object rests. Not the way home, which rises first (``q_retreat``)."""
         physics = self.physics
-        q_open = self._with_hand(physics.joint_targets(), plan.hand_open)
-        results = [self._ik(plan.p_above, q_open, plan)]
-        for p in (plan.p_grasp, plan.p_lift):
-            results.append(self._ik(p, results[-1].q, plan))
+        results = self._grasp_poses(plan)
         z_start = float(physics.object_pose()[2])
         # Reach: to above the object, fast, the hand open.
         self.phase = "reach"

@@ -107,3 +107,34 @@ def object_geometry(object_type: str, size: float) -> ObjectGeometry:
         quat = identity
     return ObjectGeometry(object_type, size, "cylinder", np.array([r, r, 0.0]), quat, r, r, mass, inertia,
                           float(np.sqrt(2) * r))
+
+
+#: An object whose primitive axis is within this angle of the vertical stands [rad]; beyond it, it lies.
+STANDING_TILT = np.pi / 4
+
+
+def as_resting(geometry: ObjectGeometry, quat: np.ndarray) -> tuple[ObjectGeometry, float]:
+    """The geometry and yaw [rad] that a plan should use for ``geometry`` resting in orientation ``quat`` (w, x, y,
+    z): a standing cylinder that toppled is planned for as a lying one, along the axis it lies on, and a box by the
+    yaw of its faces. The shapes are such that the height above the table does not change (cylinders as long as
+    they are wide, boxes cubes); what changes is the extent across a stroke and the hand's turn over a grasp."""
+    q = np.asarray(quat, dtype=float)
+    if q.shape != (4,) or not np.all(np.isfinite(q)) or np.linalg.norm(q) == 0.0:
+        raise ValueError(f"quat must be a finite, non-zero quaternion (w, x, y, z), got {quat!r}.")
+    w, x, y, z = q / np.linalg.norm(q)
+    R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                  [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                  [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    if geometry.primitive == "sphere":
+        return geometry, 0.0
+    if geometry.primitive == "box":  # the body axis nearest the horizontal plane gives the faces' yaw
+        axis = R[:, int(np.argmin(np.abs(R[2])))]
+        return geometry, float(np.arctan2(axis[1], axis[0]))
+    axis = R[:, 2]  # a cylinder's axis is its primitive's z
+    if abs(axis[2]) >= np.cos(STANDING_TILT):
+        return (geometry if geometry.object_type == "vertical_cylinder"
+                else object_geometry("vertical_cylinder", geometry.size)), 0.0
+    lying = geometry if geometry.object_type == "horizontal_cylinder" else object_geometry("horizontal_cylinder",
+                                                                                            geometry.size)
+    # At zero yaw a lying cylinder's axis is along world x.
+    return lying, float(np.arctan2(axis[1], axis[0]))

@@ -285,6 +285,33 @@ class TapPhysics:
         self.data.qvel[self.object_qvel : self.object_qvel + 6] = 0.0
         mujoco.mj_forward(m, self.data)
 
+    def set_object_pose(self, pose: np.ndarray) -> None:
+        """Put the object at ``pose`` (x, y, z [m], unit quaternion w, x, y, z), at rest."""
+        a = self.object_qpos
+        self.data.qpos[a : a + 7] = pose
+        self.data.qvel[self.object_qvel : self.object_qvel + 6] = 0.0
+        mujoco.mj_forward(self.model, self.data)
+
+    def adopt(self, other: TapPhysics) -> None:
+        """Take over the world of ``other``, a model of the same scene with another arm acting: its object
+        (geometry, pose and velocity, bit for bit), its time, and the joints both move (torso and neck: positions,
+        velocities and servo targets); every other joint at home. The same world then goes on in this model."""
+        mujoco.mj_resetDataKeyframe(self.model, self.data, self.home_key)
+        theirs, mine = other.geometry, self.geometry
+        if theirs is not None and (mine is None or (theirs.object_type, theirs.size) != (mine.object_type, mine.size)):
+            self._make_object(theirs)
+        a, b = self.object_qpos, other.object_qpos
+        self.data.qpos[a : a + 7] = other.data.qpos[b : b + 7]
+        av, bv = self.object_qvel, other.object_qvel
+        self.data.qvel[av : av + 6] = other.data.qvel[bv : bv + 6]
+        for name in set(self.variant.actuated_joints) & set(other.variant.actuated_joints):
+            mine, theirs = self.model.joint(name), other.model.joint(name)
+            self.data.qpos[mine.qposadr[0]] = other.data.qpos[theirs.qposadr[0]]
+            self.data.qvel[mine.dofadr[0]] = other.data.qvel[theirs.dofadr[0]]
+            self.data.ctrl[self.model.actuator(name).id] = other.data.ctrl[other.model.actuator(name).id]
+        self.data.time = other.data.time
+        mujoco.mj_forward(self.model, self.data)
+
     def _make_object(self, geometry: ObjectGeometry) -> None:
         """Make ``geometry`` the object of interest in the model (its primitive, size, mass and inertia), without
         touching the state."""

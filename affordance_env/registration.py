@@ -7,6 +7,9 @@ from typing import Any
 import gymnasium as gym
 
 ENV_ID = "TapAffordance-v1"
+GOAL_ENV_ID = "TapAffordanceGoal-v0"
+#: Interactions per episode of the goal env, after which it is truncated.
+GOAL_MAX_EPISODE_STEPS = 5
 
 
 def make_tap_env(**kwargs: Any) -> gym.Env:
@@ -34,8 +37,19 @@ def make_tap_vector_env(num_envs: int = 1, **kwargs: Any) -> gym.vector.VectorEn
                                     autoreset_mode=gym.vector.AutoresetMode.SAME_STEP)
 
 
+def make_goal_env(**kwargs: Any) -> gym.Env:
+    """``TapAffordanceGoalEnv(**kwargs)``: the entry point of ``TapAffordanceGoal-v0`` (a function for the reason
+    given at :func:`make_tap_env`)."""
+    from affordance_env.goal_env import TapAffordanceGoalEnv
+
+    return TapAffordanceGoalEnv(**kwargs)
+
+
 def register_envs() -> None:
-    """Register ``TapAffordance-v1`` (idempotent)."""
+    """Register ``TapAffordance-v1`` and ``TapAffordanceGoal-v0`` (idempotent)."""
+    if GOAL_ENV_ID not in gym.registry:
+        gym.register(id=GOAL_ENV_ID, entry_point="affordance_env.registration:make_goal_env",
+                     max_episode_steps=GOAL_MAX_EPISODE_STEPS)
     if ENV_ID not in gym.registry:
         gym.register(id=ENV_ID, entry_point="affordance_env.registration:make_tap_env",
                      vector_entry_point="affordance_env.registration:make_tap_vector_env")

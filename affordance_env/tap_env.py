@@ -19,7 +19,7 @@ from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_f
 from affordance_env.interactions import Interaction, get_interaction
 from affordance_env.kinematics import Kinematics
 from affordance_env.motion import HOLD_MAX_TIME, HOLD_SPEED_TOLERANCE, MotionExecutor, ReachOutcome
-from affordance_env.objects import check_object_type, check_size, object_geometry
+from affordance_env.objects import as_resting, check_object_type, check_size, object_geometry
 from affordance_env.options import EnvOptions
 from affordance_env.outcome import REST_DURATION, ObjectMonitor, outcome_labels
 from affordance_env.physics import TapPhysics
@@ -30,7 +30,9 @@ from affordance_env.scene import build_model
 PLACEMENT_CENTRE = np.array([-0.30, 0.03])
 PLACEMENT_HALF_WIDTH = np.array([0.03, 0.03])
 #: Keys of ``reset(options=...)`` that choose the object instead of drawing it.
-RESET_OPTIONS = ("object_type", "size", "position", "yaw")
+RESET_OPTIONS = ("object_type", "size", "position", "yaw", "object_pose")
+#: Depth of the object's top, whose centre is where the object is seen on the table [m].
+TOP_DEPTH = 0.003
 #: Yaw jitter of boxes and lying cylinders [rad].
 YAW_JITTER = 0.25
 #: The placed object is at rest for the initial snapshot when slower than these [m/s], [rad/s].
@@ -175,7 +177,10 @@ class TapAffordanceEnv(gym.Env):
     position uniform within +-3 cm of (-0.30, 0.03) m on the table, yaw jittered by up to 0.25 rad (boxes and
     lying cylinders; a lying cylinder's axis stays across the tap direction). All drawn from ``self.np_random``.
     ``reset(options={...})`` may set any of them instead: ``object_type``, ``size`` [m], ``position`` (x, y) on
-    the table [m], ``yaw`` [rad]; another key raises ``ValueError`` listing these.
+    the table [m], ``yaw`` [rad], or ``object_pose`` (x, y, z [m], qw, qx, qy, qz): any pose, a toppled
+    standing cylinder too, from which the object settles; the behaviour then plans for the object as it rests
+    (:func:`affordance_env.objects.as_resting`: a toppled cylinder is struck or gripped as a lying one). Another key
+    raises ``ValueError`` listing these.
 
     ## Episode End
     The episode terminates after one interaction (``terminated=True``). The object is followed at every control
@@ -234,6 +239,9 @@ class TapAffordanceEnv(gym.Env):
       ``"rgb_array_list"``: every frame of the interaction, for a video (Gymnasium's ``RecordVideo`` keeps one
       frame per step, so for one-step episodes use this mode and write the frames yourself); any other mode
       (``"human"`` too) is refused with a ValueError naming these |
+    | ``two_arms`` | False | the scene with both arms (:data:`affordance_env.robot_model.VARIANTS` ``"two_arms"``):
+      the other arm waits rigid at its home pose, and the relation features are measured to the right palm for every
+      behaviour (the scene of ``TapAffordanceGoal-v0``) |
 
     ## Version History
     * v1: the iCub's motor limits (joint speeds planned within 100 deg/s for the arm, torso and neck and 180 deg/s
@@ -265,6 +273,7 @@ class TapAffordanceEnv(gym.Env):
         render_mode: str | None = None,
         render_width: int = 480,
         render_height: int = 360,
+        two_arms: bool = False,
     ) -> None:
         options = EnvOptions(behavior=behavior, object_types=object_types, size_range=size_range,
                              camera_width=camera_width, camera_height=camera_height, camera_fovy=camera_fovy,
@@ -282,7 +291,8 @@ class TapAffordanceEnv(gym.Env):
         self.reward_fn = default_reward if reward_fn is None else reward_fn
         self.render_mode = render_mode
 
-        robot = self.behavior.robot
+        # The behaviour's arm; with two_arms, in the scene with both arms (the other one held at home).
+        robot = {"tap": "two_arms", "grasp": "two_arms_left"}[self.behavior.robot] if two_arms else self.behavior.robot
         self.physics = TapPhysics(build_model(robot), robot)
         self.kinematics = Kinematics(variant=robot)
         self.motion = MotionExecutor(self.physics, self.kinematics)
@@ -291,11 +301,16 @@ class TapAffordanceEnv(gym.Env):
         self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy,
                                             support="table_top")
         self.interaction.prepare(self.motion, PLACEMENT_CENTRE, float(np.mean(self.size_range)))
+        #: The approach posture of each behaviour prepared (see :meth:`prepare_behaviors`).
+        self._postures = {self.behavior.name: self.motion.approach_posture}
         self._renderer = None
         self._render_size = (render_width, render_height)
         #: With a render mode: pictures taken every 1/render_fps s of simulated time since the last ``reset``
         #: (the whole interaction: placing, attention, the behaviour, the wait for the outcome).
         self.frames: list[np.ndarray] = []
+        #: Where the last snapshot saw the object on the table: the centre (x, y) [m] of its top, the visible points
+        #: within TOP_DEPTH of its highest one (NaN when not seen). Every object's top lies over its centre.
+        self.seen_position = np.full(2, np.nan)
         self._next_frame_time = 0.0
         if render_mode is not None:
             self.physics.on_step = self._record_frame
@@ -347,6 +362,9 @@ class TapAffordanceEnv(gym.Env):
         features = compute_features(
             image.p_world_points, image.ranges, mask, image.p_world_camera, p_world_hand, uv_hand
         )
+        points = image.p_world_points[mask]
+        top = points[points[:, 2] >= points[:, 2].max() - TOP_DEPTH] if len(points) else points
+        self.seen_position = top[:, :2].mean(axis=0) if len(top) else np.full(2, np.nan)
         ranges = np.where(np.isfinite(image.ranges), image.ranges, 0.0).astype(np.float32)
         obs = {
             "range": ranges,
@@ -356,7 +374,8 @@ class TapAffordanceEnv(gym.Env):
         }
         return obs, features
 
-    def _sample_object(self, options: dict[str, Any] | None) -> tuple[str, float, np.ndarray, float]:
+    def _sample_object(self, options: dict[str, Any] | None
+                       ) -> tuple[str, float, np.ndarray, float, np.ndarray | None]:
         """Type, size, position and yaw of the next object: drawn from ``self.np_random``, then replaced by any
         given in ``options`` (the draws are made either way, so the rest of the episode's randomness is the same)."""
         rng = self.np_random
@@ -390,7 +409,33 @@ class TapAffordanceEnv(gym.Env):
             yaw = float(options["yaw"]) if real else float("nan")
             if not np.isfinite(yaw):
                 raise ValueError(f"yaw must be a finite angle [rad], got {options['yaw']!r}.")
-        return object_type, size, xy, yaw
+        pose = None
+        if "object_pose" in options:
+            if "position" in options or "yaw" in options:
+                raise ValueError("reset options 'object_pose' and 'position' or 'yaw' exclude each other: the pose "
+                                 "gives both.")
+            pose = self._check_pose(options["object_pose"], object_geometry(object_type, size))
+        return object_type, size, xy, yaw, pose
+
+    def _check_pose(self, value: Any, geometry: Any) -> np.ndarray:
+        try:
+            pose = np.asarray(value, dtype=np.float64)
+        except (TypeError, ValueError):
+            pose = np.full(1, np.nan)
+        low, high = self.physics.table_extent()
+        top = self.physics.table_top
+        ok = pose.shape == (7,) and bool(np.all(np.isfinite(pose)))
+        if ok:
+            ok = (bool(np.all(pose[:2] >= low) and np.all(pose[:2] <= high))
+                  and top + 0.5 * geometry.half_height <= pose[2] <= top + 3.0 * geometry.rbound
+                  and float(np.linalg.norm(pose[3:])) > 1e-6)
+        if not ok:
+            raise ValueError(f"object_pose must be (x, y, z, qw, qx, qy, qz): x in [{low[0]:.2f}, {high[0]:.2f}] and "
+                             f"y in [{low[1]:.2f}, {high[1]:.2f}] m on the table, z [m] the object's centre above the "
+                             f"table top ({top:.3f} m) by {0.5 * geometry.half_height:.3f} to "
+                             f"{3.0 * geometry.rbound:.3f} m, and a non-zero quaternion; got {value!r}.")
+        pose[3:] /= np.linalg.norm(pose[3:])
+        return pose
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         """Place a new object, let it settle, attend to it and take the initial snapshot.
@@ -399,7 +444,7 @@ class TapAffordanceEnv(gym.Env):
         ``affordance_env.OBJECT_TYPES``), ``size`` [m], ``position`` (x, y) on the table [m] and ``yaw`` [rad].
         """
         super().reset(seed=seed)
-        object_type, size, xy, yaw = self._sample_object(options)
+        object_type, size, xy, yaw, pose = self._sample_object(options)
         self.frames = []
         self._next_frame_time = 0.0
         physics = self.physics
@@ -407,22 +452,54 @@ class TapAffordanceEnv(gym.Env):
         self._q_home = physics.joint_targets()
         geometry = object_geometry(object_type, size)
         physics.set_object(geometry, xy, yaw)  # 0.1 mm above the table: it settles while the head turns
+        if pose is not None:  # any pose: it settles too, and the plan reads its geometry from where it rests
+            physics.set_object_pose(pose)
+        return self._observe(None if pose is not None else (geometry, yaw))
+
+    def _observe(self, plan_geometry: tuple[Any, float] | None = None) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        """Attend to the object where it is, wait until the robot (and the object) are still, and take the initial
+        snapshot. ``plan_geometry``: the geometry and yaw the interaction plans for; None: read from how the
+        object rests (a toppled cylinder lies)."""
+        physics = self.physics
         with self.interaction.free_stepping(self.motion):
             attention = attend(physics, self.attention_camera, self.motion.move_joints)
             still = self.motion.hold_still(also=_object_at_rest)
         self._q_home = physics.joint_targets()  # the arm's home, with the gaze on the object
         obs, features = self._snapshot()
         pose = physics.object_pose()
+        geometry, yaw = as_resting(physics.geometry, pose[3:]) if plan_geometry is None else plan_geometry
         self._initial = {"features": features, "pose": pose, "yaw": yaw, "geometry": geometry,
                          "visible": features.visible, "still": still}
         info = {
-            "object": {"type": object_type, "size": size, "pose": pose},
+            "object": {"type": physics.geometry.object_type, "size": physics.geometry.size, "pose": pose},
             "attention": {"success": attention.success, "visible": attention.visible,
                           "pixel_error": attention.pixel_error},
             "visible": features.visible,
             "still": still,
         }
         return obs, info
+
+    def prepare_behaviors(self, names: Sequence[str]) -> None:
+        """Make the env able to run the behaviours ``names`` too (:meth:`use_behavior`): those of the same arm.
+        Call it before ``reset``: it puts the robot at home."""
+        for name in names:
+            interaction = get_interaction(name)
+            if interaction.behavior.robot != self.behavior.robot:
+                raise ValueError(f"behavior {name!r} needs the {interaction.behavior.robot!r} arm; this env has the "
+                                 f"{self.behavior.robot!r} arm.")
+            if name not in self._postures:
+                self.motion.approach_posture = None
+                interaction.prepare(self.motion, PLACEMENT_CENTRE, float(np.mean(self.size_range)))
+                self._postures[name] = self.motion.approach_posture
+        self.motion.approach_posture = self._postures[self.behavior.name]
+
+    def use_behavior(self, name: str) -> None:
+        """Run the behaviour ``name`` (prepared by :meth:`prepare_behaviors`) from the next ``step`` on."""
+        if name not in self._postures:
+            raise ValueError(f"behavior {name!r} is not prepared in this env; prepared: {', '.join(self._postures)}.")
+        self.interaction = get_interaction(name)
+        self.behavior = self.interaction.behavior
+        self.motion.approach_posture = self._postures[name]
 
     def get_state(self) -> EnvState:
         """A snapshot of the world and of the episode: the object and MuJoCo's state, what the initial snapshot

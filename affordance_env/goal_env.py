@@ -1,0 +1,341 @@
+"""TapAffordanceGoal-v0: bring the object to a place on the table, choosing among the four behaviours."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+from gymnasium import spaces
+
+from affordance_env.behaviors import ACTION_DIM, check_action
+from affordance_env.options import EnvOptions
+from affordance_env.tap_env import RESET_OPTIONS, TapAffordanceEnv
+from affordance_env.workspace import WORKSPACES, in_any_workspace
+
+#: The behaviours, in the order of the action's ``behavior`` index.
+BEHAVIORS: tuple[str, ...] = ("tap", "tap_back", "push", "grasp")
+#: The arm that does each behaviour.
+ARM_OF: Mapping[str, str] = {"tap": "right", "tap_back": "right", "push": "right", "grasp": "left"}
+#: Keys of ``reset(options=...)``.
+GOAL_RESET_OPTIONS = ("goal", *RESET_OPTIONS)
+#: Goals are drawn this far from the object [m] ...
+GOAL_DISTANCE = (0.10, 0.25)
+#: ... and at least this far inside the table's edges [m].
+GOAL_TABLE_MARGIN = 0.05
+
+
+def goal_distance(achieved_goal: np.ndarray, desired_goal: np.ndarray) -> np.ndarray:
+    """Distance on the table [m] between achieved and desired goals, (..., 2) -> (...)."""
+    return np.linalg.norm(np.asarray(achieved_goal, dtype=float) - np.asarray(desired_goal, dtype=float), axis=-1)
+
+
+class TapAffordanceGoalEnv(gym.Env):
+    """The iCub moves one object to a goal on the table, one interaction per step, choosing the behaviour.
+
+    ## Description
+    The world of ``TapAffordance-v1`` with both arms in one scene: the right arm with the V2.5 hand taps, taps
+    back and pushes, the left arm with the fingered ``left_hand_mk3`` hand grasps (lifts, holds and puts down 6 cm
+    to the robot's left); the arm that does not act waits rigid at its home pose, where it is in every scene of
+    this env, so every behaviour sees the same robot and measures the relation features to the same (right) palm.
+    ``reset`` places an object and draws a goal; each ``step`` runs one interaction with the behaviour and its
+    parameters that the action chooses. The object stays exactly where the interaction left it, at rest (the
+    interaction ends once it rests, has left the table, or ``settle_timeout`` passed); then the head turns to it
+    again and the next observation is taken. A goal-conditioned env in the style of Gymnasium-Robotics' Fetch
+    envs (a ``Dict`` observation with ``achieved_goal`` and ``desired_goal``, ``compute_reward``).
+
+    ## Action Space
+    ``Dict(behavior=Discrete(4), params=Box(-1, 1, (3,), float32))``: the behaviour, named by
+    ``env.unwrapped.behaviors`` (``tap``, ``tap_back``, ``push``, ``grasp``), and its parameters, those of
+    ``TapAffordance-v1``'s action for that behaviour (0 is the canonical action). :class:`FlatActionWrapper` gives a
+    ``Box(-1, 1, (7,))`` action (four behaviour scores, the highest chosen, then the parameters) for libraries that
+    need one. Out-of-range parameters, NaN, a wrong shape or an unknown behaviour raise ``ValueError``.
+
+    ## Observation Space
+    ``Dict`` of
+
+    | key | shape | meaning |
+    |-----|-------|---------|
+    | ``observation`` | ``Dict(features (49,), range (H, W), mask (H, W))`` | the range camera's view of the object,
+      as in TapAffordance-v1, taken with the robot at home and the gaze on the object |
+    | ``achieved_goal`` | (2,) | the object's perceived position on the table, root frame [m]: the centre of its
+      top as the range camera sees it (the visible points within 3 mm of its highest one; every object's top lies
+      over its centre); where the object is not seen, its true position (an object that left the table: the
+      nearest point of the table's edge) |
+    | ``desired_goal`` | (2,) | the goal, root frame [m] |
+
+    ## Rewards
+    ``compute_reward(achieved_goal, desired_goal, info)``, vectorised over leading dimensions: with
+    ``reward_type="sparse"`` (default) 0 within ``goal_tolerance`` of the goal and -1 elsewhere; ``"dense"``: minus
+    the distance [m]. ``step`` returns the same value.
+
+    ## Starting State
+    As TapAffordance-v1 (object type, size, position, yaw drawn from ``self.np_random``, or given by ``reset``'s
+    ``options``: ``object_type``, ``size``, ``position``, ``yaw``, ``object_pose``). The goal is drawn
+    ``GOAL_DISTANCE`` (10-25 cm) from the object's perceived position, in a uniform direction, at least
+    ``GOAL_TABLE_MARGIN`` inside the table's edges and inside the union of the behaviours' workspaces
+    (:mod:`affordance_env.workspace`); ``options={"goal": (x, y)}`` sets it.
+
+    ## Episode End
+    Terminated when the object is within ``goal_tolerance`` of the goal (``info["is_success"]``), when it left the
+    table, or when the simulation became unstable (``info["failure"]`` starts with ``"physics:"``). Truncated
+    after ``max_episode_steps`` interactions (5 by default, set at registration through Gymnasium's
+    ``TimeLimit``).
+
+    ## Info
+    After ``reset``: ``object``, ``visible``, ``attention``, ``still`` as TapAffordance-v1, and ``distance``.
+    After ``step``: every key of TapAffordance-v1's step info for the interaction (``effect``, ``object`` with
+    ``initial_pose`` and ``final_pose``, ``displacement``, ``success``, ``failure``, ...), and ``behavior``,
+    ``distance`` [m] to the goal and ``is_success``.
+
+    ## Arguments
+    ``object_types``, ``size_range``, ``camera_width``, ``camera_height``, ``camera_fovy``, ``roll_threshold``,
+    ``settle_timeout``, ``range_noise``: as TapAffordance-v1. ``goal_tolerance`` (0.03 m): the goal is reached
+    within it. ``reward_type``: ``"sparse"`` or ``"dense"``. ``render_mode``: ``"rgb_array"`` or None.
+
+    ## Snapshots
+    ``get_state()`` and ``set_state(state)``: the world (both arms' scenes and which one acts), the episode's goal
+    and observation and the random generator; the same action after a restore gives the same interaction, bit for
+    bit. ``feasible(behavior, params)``: whether the arm can reach every pose of that interaction with the object
+    where it is, from the kinematics alone (no physics step).
+
+    ## Version History
+    * v0: initial release.
+    """
+
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+
+    def __init__(
+        self,
+        object_types: Sequence[str] = EnvOptions.object_types,
+        size_range: tuple[float, float] = EnvOptions.size_range,
+        camera_width: int = EnvOptions.camera_width,
+        camera_height: int = EnvOptions.camera_height,
+        camera_fovy: float = EnvOptions.camera_fovy,
+        roll_threshold: float = EnvOptions.roll_threshold,
+        settle_timeout: float = EnvOptions.settle_timeout,
+        range_noise: str | None = EnvOptions.range_noise,
+        goal_tolerance: float = 0.03,
+        reward_type: str = "sparse",
+        render_mode: str | None = None,
+        render_width: int = 480,
+        render_height: int = 360,
+    ) -> None:
+        if not (isinstance(goal_tolerance, (int, float)) and np.isfinite(goal_tolerance) and goal_tolerance > 0):
+            raise ValueError(f"goal_tolerance must be a positive distance [m], got {goal_tolerance!r}.")
+        if reward_type not in ("sparse", "dense"):
+            raise ValueError(f"reward_type must be 'sparse' or 'dense', got {reward_type!r}.")
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got "
+                             f"{render_mode!r}.")
+        common = dict(object_types=object_types, size_range=size_range, camera_width=camera_width,
+                      camera_height=camera_height, camera_fovy=camera_fovy, roll_threshold=roll_threshold,
+                      settle_timeout=settle_timeout, range_noise=range_noise, render_mode=render_mode,
+                      render_width=render_width, render_height=render_height, two_arms=True)
+        right = TapAffordanceEnv(behavior="tap", **common)
+        right.prepare_behaviors(("tap_back", "push"))
+        #: One TapAffordance env per arm, both of the scene with both arms; the env wires them into one world.
+        self.arms: dict[str, TapAffordanceEnv] = {"right": right, "left": TapAffordanceEnv(behavior="grasp", **common)}
+        self._arm = right
+        #: The behaviours, named by the action's ``behavior`` index.
+        self.behaviors = BEHAVIORS
+        self.goal_tolerance = float(goal_tolerance)
+        self.reward_type = reward_type
+        self.render_mode = render_mode
+        inner = right.observation_space
+        low, high = right.physics.table_extent()
+        self.observation_space = spaces.Dict({
+            "observation": spaces.Dict({key: inner[key] for key in ("features", "range", "mask")}),
+            "achieved_goal": spaces.Box(low, high, (2,), np.float64),
+            "desired_goal": spaces.Box(low, high, (2,), np.float64),
+        })
+        self.action_space = spaces.Dict({"behavior": spaces.Discrete(len(BEHAVIORS)),
+                                         "params": spaces.Box(-1.0, 1.0, (ACTION_DIM,), np.float32)})
+        self._goal = np.zeros(2)
+        self._obs: dict[str, Any] | None = None
+
+    # --- the goal ----------------------------------------------------------------------------------------------
+    def compute_reward(self, achieved_goal: np.ndarray, desired_goal: np.ndarray, info: Any) -> np.ndarray | float:
+        """The reward of reaching ``achieved_goal`` when ``desired_goal`` is wanted, (..., 2) each; ``info`` is
+        not used. Vectorised: a batch of goals gives a batch of rewards."""
+        d = goal_distance(achieved_goal, desired_goal)
+        reward = -(d > self.goal_tolerance).astype(np.float64) if self.reward_type == "sparse" else -d
+        return float(reward) if np.ndim(reward) == 0 else reward
+
+    def _check_goal(self, goal: Any) -> np.ndarray:
+        try:
+            xy = np.asarray(goal, dtype=np.float64)
+        except (TypeError, ValueError):
+            xy = np.full(1, np.nan)
+        low, high = self._arm.physics.table_extent()
+        if xy.shape != (2,) or not np.all(np.isfinite(xy)) or np.any(xy < low) or np.any(xy > high):
+            raise ValueError(f"goal must be (x, y) on the table top, x in [{low[0]:.2f}, {high[0]:.2f}] and y in "
+                             f"[{low[1]:.2f}, {high[1]:.2f}] m, got {goal!r}.")
+        return xy
+
+    def _draw_goal(self, xy: np.ndarray) -> np.ndarray:
+        """A goal GOAL_DISTANCE from ``xy``, on the table and in some behaviour's workspace."""
+        low, high = self._arm.physics.table_extent()
+        rng = self.np_random
+        for _ in range(1000):
+            angle = rng.uniform(-np.pi, np.pi)
+            goal = xy + rng.uniform(*GOAL_DISTANCE) * np.array([np.cos(angle), np.sin(angle)])
+            if np.all(goal >= low + GOAL_TABLE_MARGIN) and np.all(goal <= high - GOAL_TABLE_MARGIN) \
+                    and in_any_workspace(goal):
+                return goal
+        raise RuntimeError(f"No goal {GOAL_DISTANCE} m from the object at {xy} lies on the table and in a workspace; "
+                           "place the object inside the workspaces (affordance_env.workspace).")
+
+    # --- observing ---------------------------------------------------------------------------------------------
+    def _observation(self, inner_obs: Mapping[str, np.ndarray], visible: bool) -> dict[str, Any]:
+        seen = self._arm.seen_position
+        physics = self._arm.physics
+        achieved = (seen.copy() if visible and np.all(np.isfinite(seen))
+                    else np.clip(physics.object_pose()[:2], *physics.table_extent()))  # off the table: at its edge
+        return {"observation": {key: inner_obs[key] for key in ("features", "range", "mask")},
+                "achieved_goal": achieved, "desired_goal": self._goal.copy()}
+
+    def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
+        """Place an object, attend to it, draw the goal (or take ``options["goal"]``) and observe."""
+        super().reset(seed=seed)
+        if options is not None and not isinstance(options, Mapping):
+            raise ValueError(f"options must be a dict with keys among {GOAL_RESET_OPTIONS}, got {options!r}.")
+        options = dict(options or {})
+        unknown = sorted(set(options) - set(GOAL_RESET_OPTIONS))
+        if unknown:
+            raise ValueError(f"Unknown reset option(s) {unknown}. Valid options: {', '.join(GOAL_RESET_OPTIONS)}.")
+        goal = options.pop("goal", None)
+        goal = None if goal is None else self._check_goal(goal)
+        for arm in self.arms.values():
+            arm.np_random = self.np_random  # one random generator for the whole world
+        self._arm = self.arms["right"]
+        self.arms["left"]._initial = None
+        inner_obs, info = self._arm.reset(options=options)
+        obs = self._observation(inner_obs, info["visible"])
+        self._goal = self._draw_goal(obs["achieved_goal"]) if goal is None else goal
+        obs["desired_goal"] = self._goal.copy()
+        info["distance"] = float(goal_distance(obs["achieved_goal"], self._goal))
+        self._obs = obs
+        return obs, info
+
+    def _check_action(self, action: Any) -> tuple[str, np.ndarray]:
+        if not isinstance(action, Mapping) or set(action) != {"behavior", "params"}:
+            raise ValueError(f"action must be a dict with keys 'behavior' (an index into {list(BEHAVIORS)} or a "
+                             f"name) and 'params' (3 values in [-1, 1]), got {action!r}.")
+        behavior = action["behavior"]
+        if isinstance(behavior, str):
+            name = behavior
+            if name not in BEHAVIORS:
+                raise ValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
+        else:
+            index = int(behavior) if np.ndim(behavior) == 0 and float(behavior) == int(behavior) else -1
+            if not 0 <= index < len(BEHAVIORS):
+                raise ValueError(f"action 'behavior' must be an index in 0..{len(BEHAVIORS) - 1} "
+                                 f"({', '.join(BEHAVIORS)}), got {behavior!r}.")
+            name = BEHAVIORS[index]
+        return name, check_action(action["params"])
+
+    def _switch_to(self, name: str) -> TapAffordanceEnv:
+        """The arm env of behaviour ``name``, in the world as it is now."""
+        arm = self.arms[ARM_OF[name]]
+        if arm is not self._arm:
+            arm.physics.adopt(self._arm.physics)
+            arm._q_home = arm.physics.joint_targets()
+            arm._initial, self._arm._initial = self._arm._initial, None
+            self._arm = arm
+        if arm.behavior.name != name:
+            arm.use_behavior(name)
+        return arm
+
+    def feasible(self, behavior: int | str, params: Any) -> bool:
+        """Whether the arm can reach every pose of ``behavior`` with ``params`` on the object where it is now, from
+        the kinematics alone (no physics step); False: the interaction would fail with ``"ik: ..."``."""
+        name, a = self._check_action({"behavior": behavior, "params": params})
+        if self._obs is None or self._arm._initial is None:
+            raise RuntimeError("feasible() needs an object: call reset() first.")
+        initial = self._arm._initial
+        arm = self.arms[ARM_OF[name]]
+        interaction = arm.interaction if arm.behavior.name == name else None
+        if interaction is None:
+            from affordance_env.interactions import get_interaction
+
+            interaction = get_interaction(name)
+        plan = interaction.plan(initial["geometry"], initial["pose"][:3], initial["yaw"], arm.physics.table_top, a)
+        motion = arm.motion
+        saved = motion.approach_posture
+        motion.approach_posture = arm._postures[name]
+        try:
+            return bool(interaction.reachable(motion, plan))
+        finally:
+            motion.approach_posture = saved
+
+    def step(self, action):
+        """Run one interaction with the chosen behaviour and parameters; the object stays where it ends."""
+        if self._obs is None:
+            raise RuntimeError("step() called before reset() or after the episode ended; call reset() first.")
+        name, params = self._check_action(action)
+        arm = self._switch_to(name)
+        _, _, _, _, info = arm.step(params)
+        fault = info["outcome"] == "fault"
+        off_table = info["outcome"] == "off_table"
+        if fault or off_table:  # nothing more to see: the episode ends
+            inner_obs = arm._blank_observation() if fault else arm._snapshot()[0]
+            obs = self._observation(inner_obs, False)
+        else:  # the head turns to the object where it rests, for the next interaction
+            inner_obs, seen = arm._observe()
+            obs = self._observation(inner_obs, seen["visible"])
+        distance = float(goal_distance(obs["achieved_goal"], self._goal))
+        info.update(behavior=name, distance=distance, is_success=bool(distance <= self.goal_tolerance))
+        reward = self.compute_reward(obs["achieved_goal"], self._goal, info)
+        terminated = bool(info["is_success"] or off_table or fault)
+        self._obs = None if terminated else obs
+        return obs, float(reward), terminated, False, info
+
+    # --- snapshots -----------------------------------------------------------------------------------------------
+    def get_state(self) -> dict[str, Any]:
+        """A snapshot of the world and the episode; :meth:`set_state` puts it back (treat it as opaque)."""
+        arm = next(key for key, value in self.arms.items() if value is self._arm)
+        return {"arm": arm, "behavior": self._arm.behavior.name, "world": self._arm.get_state(),
+                "goal": self._goal.copy(), "obs": self._obs}
+
+    def set_state(self, state: Mapping[str, Any]) -> None:
+        """Put back the world and the episode as :meth:`get_state` saw them."""
+        if not isinstance(state, Mapping) or set(state) != {"arm", "behavior", "world", "goal", "obs"}:
+            raise TypeError(f"state must be what get_state() returned, got {type(state).__name__}.")
+        self._arm = self.arms[state["arm"]]
+        self._arm.set_state(state["world"])
+        if self._arm.behavior.name != state["behavior"]:
+            self._arm.use_behavior(state["behavior"])
+        for arm in self.arms.values():
+            if arm is not self._arm:
+                arm._initial = None
+        self._goal = state["goal"].copy()
+        self._obs = state["obs"]
+
+    def render(self):
+        """A picture of the scene from the ``overview`` camera (``render_mode="rgb_array"``), else None."""
+        return self._arm._picture() if self.render_mode == "rgb_array" else None
+
+    def close(self) -> None:
+        for arm in self.arms.values():
+            arm.close()
+
+
+class FlatActionWrapper(gym.ActionWrapper):
+    """``Box(-1, 1, (7,), float32)`` actions for TapAffordanceGoal-v0: four behaviour scores (the highest one's
+    behaviour is run, ties to the first) and the three parameters."""
+
+    def __init__(self, env: gym.Env) -> None:
+        super().__init__(env)
+        self.action_space = spaces.Box(-1.0, 1.0, (len(BEHAVIORS) + ACTION_DIM,), np.float32)
+
+    def action(self, action: Any) -> dict[str, Any]:
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != self.action_space.shape or not np.all(np.isfinite(a)):
+            raise ValueError(f"action must be {self.action_space.shape[0]} finite values (4 behaviour scores, 3 "
+                             f"parameters in [-1, 1]), got {action!r}.")
+        return {"behavior": int(np.argmax(a[: len(BEHAVIORS)])), "params": a[len(BEHAVIORS):].astype(np.float32)}
+
+
+__all__ = ["TapAffordanceGoalEnv", "FlatActionWrapper", "BEHAVIORS", "goal_distance", "WORKSPACES"]

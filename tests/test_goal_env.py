@@ -1,0 +1,183 @@
+"""TapAffordanceGoal-v0: four behaviours in one world, an object that stays, goals, snapshots and reach."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env
+
+import affordance_env  # noqa: F401 (registers the envs)
+from affordance_env.features import FEATURE_NAMES
+from affordance_env.goal_env import BEHAVIORS, FlatActionWrapper, TapAffordanceGoalEnv, goal_distance
+from affordance_env.objects import as_resting, object_geometry
+from affordance_env.tap_env import TapAffordanceEnv
+from affordance_env.workspace import in_any_workspace, in_workspace, sample_in_workspace
+
+SMALL = {"camera_width": 40, "camera_height": 30}
+
+
+@pytest.fixture(scope="module")
+def env():
+    env = TapAffordanceGoalEnv(**SMALL)
+    yield env
+    env.close()
+
+
+def test_check_env_and_registration():
+    env = gym.make("TapAffordanceGoal-v0", **SMALL)
+    check_env(env.unwrapped, skip_render_check=True)
+    assert env.spec.max_episode_steps == 5
+    assert env.unwrapped.behaviors == ("tap", "tap_back", "push", "grasp")
+    env.close()
+
+
+def test_the_object_stays_where_the_interaction_left_it_for_every_behaviour(env):
+    obs, info = env.reset(seed=4, options={"object_type": "sphere", "size": 0.05, "position": (-0.32, 0.05),
+                                           "goal": (-0.45, -0.2)})
+    np.testing.assert_allclose(obs["desired_goal"], (-0.45, -0.2))
+    pose = info["object"]["pose"]
+    for k, behavior in enumerate(BEHAVIORS):
+        obs, reward, terminated, truncated, info = env.step({"behavior": k, "params": np.zeros(3, np.float32)})
+        assert info["behavior"] == behavior and info["failure"] is None, info["failure"]
+        # each interaction starts where the last one left the object (at rest while the head turned to it)
+        np.testing.assert_allclose(info["object"]["initial_pose"], pose, atol=1e-9)
+        pose = info["object"]["final_pose"]
+        assert obs["achieved_goal"] == pytest.approx(pose[:2], abs=0.01)  # seen where it is
+        assert reward == env.compute_reward(obs["achieved_goal"], obs["desired_goal"], info)
+        if terminated:
+            break
+
+
+def test_interactions_of_the_two_arms_move_the_object_their_way(env):
+    env.reset(seed=1, options={"object_type": "sphere", "size": 0.05, "position": (-0.30, 0.05)})
+    _, _, _, _, tap = env.step({"behavior": "tap", "params": np.zeros(3)})
+    assert tap["displacement"] > 0.05 and tap["success"]  # the ball rolls
+    env.reset(seed=1, options={"object_type": "box", "size": 0.05, "position": (-0.30, 0.05)})
+    _, _, _, _, grasp = env.step({"behavior": "grasp", "params": np.zeros(3)})
+    assert grasp["success"] and grasp["grasp"]["rise"] > 0.05  # the left hand lifts it ...
+    moved = grasp["object"]["final_pose"][:2] - grasp["object"]["initial_pose"][:2]
+    assert moved[1] < -0.04  # ... and puts it down to the robot's left (-y in the root frame)
+
+
+def test_relation_features_are_measured_to_the_same_palm_whichever_arm_acts():
+    right = TapAffordanceEnv(behavior="tap", two_arms=True, **SMALL)
+    left = TapAffordanceEnv(behavior="grasp", two_arms=True, **SMALL)
+    one_armed = TapAffordanceEnv(behavior="grasp", **SMALL)
+    options = {"object_type": "box", "size": 0.06, "position": (-0.3, 0.0)}
+    features = [e.reset(seed=0, options=options)[0]["features"] for e in (right, left, one_armed)]
+    image = [FEATURE_NAMES.index(name) for name in ("hand_image_dx", "hand_image_dy", "hand_image_distance")]
+    other = np.setdiff1d(np.arange(len(FEATURE_NAMES)), image)
+    # the same world: the right arm servoed at home, or held there, is seen within a pixel and measured within 0.1 mm
+    np.testing.assert_allclose(features[0][other], features[1][other], atol=1e-4)
+    np.testing.assert_allclose(features[0][image], features[1][image], atol=0.5)
+    hand = [FEATURE_NAMES.index(name) for name in ("hand_dx", "hand_dy", "hand_dz", "hand_distance")]
+    assert not np.allclose(features[0][hand], features[2][hand], atol=0.05)  # the one-armed grasp: the left palm
+
+
+def test_goals_are_drawn_on_the_table_inside_the_workspaces_at_the_asked_distance(env):
+    for seed in range(12):
+        obs, info = env.reset(seed=seed)
+        d = goal_distance(obs["achieved_goal"], obs["desired_goal"])
+        assert 0.10 - 1e-9 <= d <= 0.25 + 1e-9 and info["distance"] == pytest.approx(d)
+        assert in_any_workspace(obs["desired_goal"])
+
+
+def test_compute_reward_is_vectorised_and_matches_the_tolerance(env):
+    achieved = np.array([[0.0, 0.0], [0.0, 0.0], [0.1, 0.0]])
+    desired = np.array([[0.0, 0.029], [0.0, 0.031], [0.1, 0.0]])
+    np.testing.assert_array_equal(env.compute_reward(achieved, desired, {}), [0.0, -1.0, 0.0])
+    dense = TapAffordanceGoalEnv.__new__(TapAffordanceGoalEnv)
+    dense.reward_type, dense.goal_tolerance = "dense", 0.03
+    np.testing.assert_allclose(dense.compute_reward(achieved, desired, {}), [-0.029, -0.031, 0.0])
+
+
+def test_reaching_the_goal_terminates_and_an_episode_is_truncated_after_five_steps():
+    env = gym.make("TapAffordanceGoal-v0", **SMALL)
+    obs, _ = env.reset(seed=2, options={"object_type": "box", "size": 0.05, "position": (-0.30, 0.05)})
+    env.unwrapped._goal = obs["achieved_goal"].copy()  # already there: any interaction that leaves it ends it
+    _, reward, terminated, _, info = env.step({"behavior": "grasp", "params": np.array([0.0, 0.0, 1.0])})
+    assert info["is_success"] == terminated == (reward == 0.0)
+    env.reset(seed=2, options={"object_type": "box", "size": 0.09, "position": (-0.30, 0.05), "goal": (-0.5, 0.3)})
+    for step in range(5):
+        _, _, terminated, truncated, _ = env.step({"behavior": "grasp", "params": np.zeros(3)})  # too big: stays
+        assert not terminated and truncated == (step == 4)
+    env.close()
+
+
+def test_a_restore_gives_the_same_interaction_bit_for_bit(env):
+    env.reset(seed=5, options={"object_type": "sphere", "size": 0.06})
+    env.step({"behavior": "grasp", "params": np.zeros(3)})  # the world is now the left arm's
+    state = env.get_state()
+    action = {"behavior": "tap", "params": np.array([0.2, -0.3, 0.4], np.float32)}
+    first = env.step(action)
+    env.step({"behavior": "push", "params": np.zeros(3)})
+    env.set_state(state)
+    again = env.step(action)
+    np.testing.assert_array_equal(first[0]["observation"]["range"], again[0]["observation"]["range"])
+    np.testing.assert_array_equal(first[4]["effect"], again[4]["effect"])
+    np.testing.assert_array_equal(first[4]["object"]["final_pose"], again[4]["object"]["final_pose"])
+
+
+def test_feasible_agrees_with_the_interactions_ik(env):
+    agree = 0
+    draws = [("tap", (-0.30, 0.05)), ("push", (-0.30, 0.30)), ("grasp", (-0.30, -0.25)), ("grasp", (-0.30, 0.10)),
+             ("tap_back", (-0.25, -0.30))]
+    for behavior, xy in draws:
+        env.reset(seed=0, options={"object_type": "box", "size": 0.06, "position": xy})
+        feasible = env.feasible(behavior, np.zeros(3))
+        _, _, _, _, info = env.step({"behavior": behavior, "params": np.zeros(3)})
+        reached = info["ik"]["success"]  # measured whether or not another failure came first
+        agree += feasible == reached
+        assert feasible == in_workspace(behavior, np.array(xy))
+    assert agree == len(draws)
+
+
+def test_bad_actions_options_and_goals_get_clear_errors(env):
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="Unknown behavior 'kick'"):
+        env.step({"behavior": "kick", "params": np.zeros(3)})
+    with pytest.raises(ValueError, match="index in 0..3"):
+        env.step({"behavior": 7, "params": np.zeros(3)})
+    with pytest.raises(ValueError, match=r"\[-1, 1\]"):
+        env.step({"behavior": 0, "params": np.full(3, 2.0)})
+    with pytest.raises(ValueError, match="keys 'behavior'"):
+        env.step(np.zeros(3))
+    with pytest.raises(ValueError, match="goal must be"):
+        env.reset(options={"goal": (5.0, 0.0)})
+    with pytest.raises(ValueError, match="Unknown reset option"):
+        env.reset(options={"target": (0.0, 0.0)})
+
+
+def test_flat_action_wrapper_runs_the_highest_scoring_behaviour():
+    wrapper = FlatActionWrapper(TapAffordanceGoalEnv.__new__(TapAffordanceGoalEnv))
+    assert wrapper.action_space.shape == (7,)
+    action = wrapper.action(np.array([0.1, -0.2, 0.9, 0.3, 0.5, -0.5, 0.0]))
+    assert action["behavior"] == 2 and action["params"].tolist() == [0.5, -0.5, 0.0]
+    with pytest.raises(ValueError, match="7 finite values"):
+        wrapper.action(np.zeros(3))
+
+
+@pytest.mark.parametrize("object_type", ["vertical_cylinder", "box"])
+def test_any_resting_pose_can_be_placed_and_plans_read_it(object_type):
+    env = TapAffordanceEnv(**SMALL)
+    lying = np.array([np.sqrt(0.5), 0.0, np.sqrt(0.5), 0.0])  # a standing cylinder toppled along x
+    g = object_geometry(object_type, 0.06)
+    _, info = env.reset(seed=0, options={"object_type": object_type, "size": 0.06,
+                                         "object_pose": (-0.3, 0.02, env.physics.table_top + 0.03, *lying)})
+    assert info["object"]["pose"][:2] == pytest.approx((-0.3, 0.02), abs=2e-3)
+    planned = env._initial["geometry"]
+    expected = "horizontal_cylinder" if object_type == "vertical_cylinder" else "box"
+    assert planned.object_type == expected and as_resting(g, lying)[0].object_type == expected
+    with pytest.raises(ValueError, match="object_pose must be"):
+        env.reset(options={"object_pose": (-0.3, 0.0, 5.0, 1, 0, 0, 0)})
+    with pytest.raises(ValueError, match="exclude each other"):
+        env.reset(options={"object_pose": (-0.3, 0.0, 0.0, 1, 0, 0, 0), "yaw": 0.1})
+
+
+def test_workspaces_sample_inside_themselves():
+    rng = np.random.default_rng(0)
+    for name in BEHAVIORS:
+        points = np.array([sample_in_workspace(name, rng) for _ in range(50)])
+        assert np.all(in_workspace(name, points))
+    assert not in_any_workspace(np.array([-0.7, 0.0]))  # far side of the table: out of every arm's reach
+    with pytest.raises(ValueError, match="Unknown behavior"):
+        in_workspace("kick", np.zeros(2))
