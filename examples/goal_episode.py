@@ -27,7 +27,8 @@ def main() -> None:
     rng = np.random.default_rng(args.seed)
     obs, info = env.reset(seed=args.seed)
     print(f"{info['object']['type']} of {info['object']['size'] * 100:.1f} cm at "
-          f"{np.round(obs['achieved_goal'], 3)}, goal {np.round(obs['desired_goal'], 3)}: {info['distance'] * 100:.1f} cm")
+          f"{np.round(obs['achieved_goal'], 3)}, goal {np.round(obs['desired_goal'], 3)}: "
+          f"{info['distance'] * 100:.1f} cm")
     for step in range(1, 6):
         state = world.get_state()
         candidates = [(b, np.zeros(3, np.float32)) for b in range(4)]
