@@ -513,8 +513,14 @@ def test_kill_minus_nine_then_resume_equals_uninterrupted(reference, tmp_path):
         f"collect({str(out)!r}, 24, workers=2, chunk_size=2, seed=5, env_options={SMALL!r}, progress=False)\n"
     )
     process = subprocess.Popen([sys.executable, "-c", code])
+    def recorded() -> int:  # chunks the manifest records as finished (a chunk file lands just before that)
+        try:
+            return len(json.loads((out / "manifest.json").read_text()).get("chunk_sha256", {}))
+        except (OSError, ValueError):
+            return 0
+
     deadline = time.time() + 60
-    while time.time() < deadline and len(list(out.glob("chunk-*.parquet"))) < 2:
+    while time.time() < deadline and recorded() < 1:
         time.sleep(0.02)
     workers = descendants(process.pid)
     os.kill(process.pid, signal.SIGKILL)  # the coordinator: its workers go on with the chunks they hold ...
@@ -524,7 +530,7 @@ def test_kill_minus_nine_then_resume_equals_uninterrupted(reference, tmp_path):
         with contextlib.suppress(ProcessLookupError):
             os.kill(pid, signal.SIGKILL)
     written = len(list(out.glob("chunk-*.parquet")))
-    assert 2 <= written < 12, "kill -9 should land in the middle of the collection"
+    assert 1 <= written < 12, "kill -9 should land in the middle of the collection"
     with pytest.raises(DatasetError, match="incomplete"):
         load_dataset(out)
     assert 0 < len(load_dataset(out, allow_incomplete=True)) < 24
