@@ -10,6 +10,7 @@ import numpy as np
 from gymnasium import spaces
 
 from affordance_env.behaviors import ACTION_DIM, check_action
+from affordance_env.interactions import get_interaction
 from affordance_env.options import EnvOptions
 from affordance_env.tap_env import RESET_OPTIONS, TapAffordanceEnv
 from affordance_env.workspace import WORKSPACES, in_any_workspace
@@ -256,11 +257,7 @@ class TapAffordanceGoalEnv(gym.Env):
             raise RuntimeError("feasible() needs an object: call reset() first.")
         initial = self._arm._initial
         arm = self.arms[ARM_OF[name]]
-        interaction = arm.interaction if arm.behavior.name == name else None
-        if interaction is None:
-            from affordance_env.interactions import get_interaction
-
-            interaction = get_interaction(name)
+        interaction = get_interaction(name)
         plan = interaction.plan(initial["geometry"], initial["pose"][:3], initial["yaw"], arm.physics.table_top, a)
         motion = arm.motion
         saved = motion.approach_posture
