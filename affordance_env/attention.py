@@ -2,6 +2,8 @@
 
 Closed loop on the image, as in the paper: look, find the object's pixels, move the neck by a Newton step on
 the centroid's pixel error (image Jacobian from the model's kinematics), let the servos settle, look again.
+An object out of view is first searched for: the head looks in the directions of :data:`SEARCH_GAZES` in turn
+until it sees it.
 """
 
 from __future__ import annotations
@@ -16,6 +18,11 @@ from affordance_env.physics import TapPhysics
 
 #: Neck joints used for gaze: pitch (image rows) and yaw (image columns).
 GAZE_JOINTS = ("neck_pitch", "neck_yaw")
+#: Where the head looks for an object it does not see: (pitch, yaw) offsets [rad] from its current gaze, nearest
+#: first, each clipped to the neck's range. The eye camera sees +-37 degrees across and +-29 up and down (57.4
+#: degrees vertical field of view at 4:3), so yaw steps of 0.5 rad (29 degrees) and a pitch step of 0.15 rad
+#: overlap the view they leave and cover the table beside and in front of the robot.
+SEARCH_GAZES = ((0.0, 0.5), (0.0, -0.5), (-0.15, 0.5), (-0.15, -0.5), (-0.15, 0.0), (0.0, 0.9), (0.0, -0.9))
 
 
 def _gaze_indices(physics: TapPhysics) -> np.ndarray:
@@ -70,6 +77,26 @@ def _image_jacobian(
     return jac
 
 
+def _search(physics: TapPhysics, camera: RangeCamera, move_joints, move_time: float | None, hold_time: float
+            ) -> tuple[np.ndarray, np.ndarray] | None:
+    """Look in the directions of SEARCH_GAZES until the object is seen: its centroid; or None, the head back at
+    its first gaze."""
+    gaze = _gaze_indices(physics)
+    q_start = physics.joint_targets()
+    low, high = np.array([physics.model.joint(name).range for name in GAZE_JOINTS]).T
+    for offset in SEARCH_GAZES:
+        q = q_start.copy()
+        q[gaze] = np.clip(q_start[gaze] + offset, low, high)
+        move_joints(q, move_time)
+        move_joints(q, hold_time)
+        seen = _centroid(camera, physics)
+        if seen is not None:
+            return seen
+    move_joints(q_start, move_time)  # not found: back to where the head looked
+    move_joints(q_start, hold_time)
+    return None
+
+
 def attend(
     physics: TapPhysics,
     camera: RangeCamera,
@@ -95,6 +122,8 @@ def attend(
     centre = np.array([K.cx, K.cy])
     scratch = physics.scratch
     seen = _centroid(camera, physics)
+    if seen is None:
+        seen = _search(physics, camera, move_joints, move_time, hold_time)
     if seen is None:
         return AttentionResult(False, False, float("inf"), 0)
     for iteration in range(1, max_iterations + 1):

@@ -1,35 +1,46 @@
-"""Where on the table each behaviour can act: its workspace, a convex polygon of object positions.
+"""Where on the table each behaviour can act: its workspace, a set of grid cells of object positions.
 
-Measured by ``python benchmarks/workspace.py``: the canonical action of the behaviour is reachable by the arm's
-inverse kinematics for every object type at the smallest and the largest size (4 and 10 cm) at every grid cell
-(2.5 cm) inside the polygon. Pure geometry: nothing here needs the simulator.
+Measured by ``python benchmarks/workspace.py`` in the scene with both arms: a cell (``SPACING`` square) is in a
+behaviour's workspace when the canonical action of the behaviour is reachable by the arm's inverse kinematics for
+every object type at the smallest and the largest size (4 and 10 cm) and at the yaws the env draws (0, +-0.25 rad),
+and the head, attending, sees each of them there. Each workspace is stored as runs of cells along y. Pure geometry:
+nothing here needs the simulator.
 """
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping
 
 import numpy as np
 
-#: Vertices (x, y) [m], root frame, of each behaviour's workspace, counter-clockwise.
-WORKSPACES: Mapping[str, tuple[tuple[float, float], ...]] = {
-    "tap": (  # 233 cells
-        (-0.172, -0.062), (-0.172, 0.263), (-0.297, 0.263), (-0.397, 0.213), (-0.472, 0.138), (-0.497, 0.088),
-        (-0.497, -0.062), (-0.472, -0.112), (-0.422, -0.187), (-0.397, -0.212), (-0.297, -0.262), (-0.247, -0.212),
+#: The side of a cell [m].
+SPACING = 0.025
+#: Each behaviour's workspace: runs of cells (x, y_first, y_last), the centres [m] (root frame) of the run's cells
+#: along y at that x.
+WORKSPACES: Mapping[str, tuple[tuple[float, float, float], ...]] = {
+    "tap": (  # 209 cells
+        (-0.4975, -0.0625, 0.0625), (-0.4725, -0.1125, 0.1125), (-0.4475, -0.1375, 0.1625), (-0.4225, -0.1625, 0.1875),
+        (-0.3975, -0.1875, 0.1875), (-0.3725, -0.2125, 0.2125), (-0.3475, -0.2125, 0.2375), (-0.3225, -0.2375, 0.2375),
+        (-0.2975, -0.2375, 0.2375), (-0.2725, -0.2125, 0.2125), (-0.2475, -0.1875, 0.2125), (-0.2225, -0.1375, 0.1875),
+        (-0.1975, -0.0875, 0.1875), (-0.1725, -0.0625, 0.1875),
     ),
-    "tap_back": (  # 235 cells
-        (-0.172, 0.013), (-0.172, 0.313), (-0.197, 0.338), (-0.272, 0.338), (-0.347, 0.313), (-0.397, 0.288),
-        (-0.472, 0.213), (-0.497, 0.163), (-0.497, 0.013), (-0.447, -0.087), (-0.372, -0.162), (-0.322, -0.187),
-        (-0.272, -0.187),
+    "tap_back": (  # 191 cells
+        (-0.4975, 0.0125, 0.1375), (-0.4725, -0.0375, 0.1875), (-0.4475, -0.0625, 0.2375), (-0.4225, -0.0875, 0.2375),
+        (-0.3975, -0.1125, 0.2625), (-0.3725, -0.1375, 0.2875), (-0.3475, -0.1625, 0.2875), (-0.3225, -0.1625, 0.2625),
+        (-0.2975, -0.1875, 0.2375), (-0.2725, -0.1625, 0.2125), (-0.2475, -0.1375, 0.2125), (-0.2225, -0.0625, 0.1875),
+        (-0.1975, -0.0125, 0.1875), (-0.1725, 0.0125, 0.1875),
     ),
-    "push": (  # 144 cells
-        (-0.172, -0.237), (-0.172, 0.088), (-0.222, 0.138), (-0.247, 0.138), (-0.297, 0.113), (-0.322, 0.088),
-        (-0.372, 0.013), (-0.397, -0.062), (-0.397, -0.112), (-0.372, -0.212), (-0.272, -0.312), (-0.222, -0.312),
-        (-0.197, -0.287),
+    "push": (  # 114 cells
+        (-0.3725, -0.1875, -0.0125), (-0.3475, -0.2375, 0.0375), (-0.3225, -0.2625, 0.0625), (-0.2975, -0.2375, 0.0875),
+        (-0.2725, -0.2125, 0.1125), (-0.2475, -0.2125, 0.1125), (-0.2225, -0.1875, 0.1125), (-0.1975, -0.1875, 0.1125),
+        (-0.1725, -0.1875, 0.0875),
     ),
-    "grasp": (  # 182 cells
-        (-0.422, 0.238), (-0.497, 0.113), (-0.472, 0.063), (-0.422, -0.012), (-0.397, -0.037), (-0.347, -0.062),
-        (-0.197, -0.062), (-0.172, -0.037), (-0.172, 0.288), (-0.222, 0.363), (-0.272, 0.363), (-0.322, 0.338),
+    "grasp": (  # 93 cells
+        (-0.4475, 0.1375, 0.1625), (-0.4225, 0.0875, 0.1125), (-0.3975, 0.0625, 0.0625), (-0.3975, 0.1125, 0.2125),
+        (-0.3725, 0.0875, 0.2625), (-0.3475, 0.0625, 0.2875), (-0.3225, 0.0125, 0.2625), (-0.2975, 0.0125, 0.2375),
+        (-0.2725, 0.0125, 0.2125), (-0.2475, -0.0125, 0.2125), (-0.2225, -0.0125, 0.1875), (-0.1975, -0.0125, 0.1875),
+        (-0.1725, 0.0125, 0.1625),
     ),
 }
 
@@ -39,30 +50,43 @@ def _check_name(name: str) -> None:
         raise ValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(WORKSPACES)}.")
 
 
+@functools.cache
+def _rectangles(names: tuple[str, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The lower and upper corners (R, 2) of the rectangles the runs of the workspaces ``names`` cover."""
+    runs = np.array([run for name in names for run in WORKSPACES[name]])
+    low = np.stack([runs[:, 0], runs[:, 1]], axis=1) - SPACING / 2
+    high = np.stack([runs[:, 0], runs[:, 2]], axis=1) + SPACING / 2
+    return low, high
+
+
+def _inside(names: tuple[str, ...], xy: np.ndarray) -> np.ndarray | bool:
+    low, high = _rectangles(names)
+    p = np.asarray(xy, dtype=float)[..., None, :]
+    inside = np.any(np.all((p >= low) & (p <= high), axis=-1), axis=-1)
+    return bool(inside) if inside.ndim == 0 else inside
+
+
 def in_workspace(name: str, xy: np.ndarray) -> np.ndarray | bool:
     """Whether the points ``xy`` [m], (2,) or (N, 2), lie in the workspace of the behaviour ``name``."""
     _check_name(name)
-    p = np.asarray(xy, dtype=float)
-    polygon = np.asarray(WORKSPACES[name])
-    edges = np.roll(polygon, -1, axis=0) - polygon
-    rel = p[..., None, :] - polygon  # (..., V, 2)
-    cross = edges[:, 0] * rel[..., 1] - edges[:, 1] * rel[..., 0]
-    inside = np.all(cross >= -1e-12, axis=-1)
-    return bool(inside) if inside.ndim == 0 else inside
+    return _inside((name,), xy)
 
 
 def in_any_workspace(xy: np.ndarray) -> np.ndarray | bool:
     """Whether the points ``xy`` [m] lie in the workspace of at least one behaviour."""
-    inside = np.any([in_workspace(name, xy) for name in WORKSPACES], axis=0)
-    return bool(inside) if np.ndim(inside) == 0 else inside
+    return _inside(tuple(WORKSPACES), xy)
 
 
-def sample_in_workspace(name: str, rng: np.random.Generator) -> np.ndarray:
-    """A point (x, y) [m] uniform in the workspace of the behaviour ``name``, drawn from ``rng``."""
-    _check_name(name)
-    polygon = np.asarray(WORKSPACES[name])
-    low, high = polygon.min(axis=0), polygon.max(axis=0)
-    while True:  # rejection from the bounding box: the polygons fill half of it or more
-        xy = rng.uniform(low, high)
-        if in_workspace(name, xy):
+def sample_in_workspace(name: str | None, rng: np.random.Generator) -> np.ndarray:
+    """A point (x, y) [m] uniform in the workspace of the behaviour ``name`` (None: in the union of all of them),
+    drawn from ``rng``."""
+    if name is not None:
+        _check_name(name)
+    names = (name,) if name is not None else tuple(WORKSPACES)
+    low, high = _rectangles(names)
+    area = np.prod(high - low, axis=1)
+    while True:  # a run by its area, a point in it; the union's overlaps are drawn once, by rejection
+        k = int(rng.choice(len(area), p=area / area.sum()))
+        xy = rng.uniform(low[k], high[k])
+        if name is not None or k == int(np.flatnonzero(np.all((xy >= low) & (xy <= high), axis=1))[0]):
             return xy
