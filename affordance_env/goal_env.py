@@ -13,7 +13,7 @@ from affordance_env.behaviors import ACTION_DIM, check_action
 from affordance_env.interactions import get_interaction
 from affordance_env.options import EnvOptions
 from affordance_env.tap_env import RESET_OPTIONS, TapAffordanceEnv
-from affordance_env.workspace import WORKSPACES, in_any_workspace
+from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
 
 #: The behaviours, in the order of the action's ``behavior`` index.
 BEHAVIORS: tuple[str, ...] = ("tap", "tap_back", "push", "grasp")
@@ -92,7 +92,9 @@ class TapAffordanceGoalEnv(gym.Env):
 
     ## Arguments
     ``object_types``, ``size_range``, ``camera_width``, ``camera_height``, ``camera_fovy``, ``roll_threshold``,
-    ``settle_timeout``, ``range_noise``: as TapAffordance-v1. ``goal_tolerance`` (0.03 m): the goal is reached
+    ``settle_timeout``, ``range_noise``: as TapAffordance-v1. ``position_range``: ``"canonical"`` (as
+    TapAffordance-v1) or ``"workspace"``: objects placed uniformly over the union of the behaviours' workspaces.
+    ``goal_tolerance`` (0.03 m): the goal is reached
     within it. ``reward_type``: ``"sparse"`` or ``"dense"``. ``render_mode``: ``"rgb_array"`` or None.
 
     ## Snapshots
@@ -117,6 +119,7 @@ class TapAffordanceGoalEnv(gym.Env):
         roll_threshold: float = EnvOptions.roll_threshold,
         settle_timeout: float = EnvOptions.settle_timeout,
         range_noise: str | None = EnvOptions.range_noise,
+        position_range: str = EnvOptions.position_range,
         goal_tolerance: float = 0.03,
         reward_type: str = "sparse",
         render_mode: str | None = None,
@@ -130,6 +133,10 @@ class TapAffordanceGoalEnv(gym.Env):
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got "
                              f"{render_mode!r}.")
+        EnvOptions(position_range=position_range)  # checked
+        #: Where objects are placed: ``"canonical"`` as in TapAffordance-v1, or ``"workspace"``: uniform over the
+        #: union of the behaviours' workspaces.
+        self.position_range = position_range
         common = dict(object_types=object_types, size_range=size_range, camera_width=camera_width,
                       camera_height=camera_height, camera_fovy=camera_fovy, roll_threshold=roll_threshold,
                       settle_timeout=settle_timeout, range_noise=range_noise, render_mode=render_mode,
@@ -212,6 +219,8 @@ class TapAffordanceGoalEnv(gym.Env):
             arm.np_random = self.np_random  # one random generator for the whole world
         self._arm = self.arms["right"]
         self.arms["left"]._initial = None
+        if self.position_range == "workspace" and not {"position", "object_pose"} & set(options):
+            options["position"] = sample_in_workspace(None, self.np_random)
         inner_obs, info = self._arm.reset(options=options)
         obs = self._observation(inner_obs, info["visible"])
         self._goal = self._draw_goal(obs["achieved_goal"]) if goal is None else goal

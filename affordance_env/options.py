@@ -18,6 +18,11 @@ from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size
 from affordance_env.pinhole import Intrinsics
 from affordance_env.range_noise import check_range_noise
 
+#: Where objects are placed: ``"canonical"``, uniform within +-3 cm of the paper's spot in front of the robot;
+#: ``"workspace"``, uniform over the workspace of the behaviour (:mod:`affordance_env.workspace`; in
+#: TapAffordanceGoal-v0, the union of the four behaviours' workspaces).
+POSITION_RANGES = ("canonical", "workspace")
+
 
 @dataclass(frozen=True)
 class EnvOptions:
@@ -36,6 +41,7 @@ class EnvOptions:
     roll_threshold: float = ROLL_THRESHOLD
     settle_timeout: float = 3.0
     range_noise: str | None = None
+    position_range: str = "canonical"
 
     def __post_init__(self) -> None:
         get_behavior(self.behavior)
@@ -66,6 +72,8 @@ class EnvOptions:
         normalised["camera_width"], normalised["camera_height"] = int(self.camera_width), int(self.camera_height)
         normalised["camera_fovy"] = float(self.camera_fovy)
         check_range_noise(self.range_noise)
+        if self.position_range not in POSITION_RANGES:
+            raise ValueError(f"position_range must be one of {POSITION_RANGES}, got {self.position_range!r}.")
         for name, value in normalised.items():
             object.__setattr__(self, name, value)
 

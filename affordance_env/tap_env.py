@@ -25,6 +25,7 @@ from affordance_env.outcome import REST_DURATION, ObjectMonitor, outcome_labels
 from affordance_env.physics import TapPhysics
 from affordance_env.range_noise import add_kinect_noise
 from affordance_env.scene import build_model
+from affordance_env.workspace import sample_in_workspace
 
 #: Region of the table where objects are placed: centre (x, y) and half-widths [m].
 PLACEMENT_CENTRE = np.array([-0.30, 0.03])
@@ -174,8 +175,9 @@ class TapAffordanceEnv(gym.Env):
 
     ## Starting State
     Robot at the ``home`` keyframe; object type uniform over ``object_types``, size uniform in ``size_range``,
-    position uniform within +-3 cm of (-0.30, 0.03) m on the table, yaw jittered by up to 0.25 rad (boxes and
-    lying cylinders; a lying cylinder's axis stays across the tap direction). All drawn from ``self.np_random``.
+    position uniform within +-3 cm of (-0.30, 0.03) m on the table (``position_range="canonical"``) or over the
+    behaviour's workspace (``"workspace"``), yaw jittered by up to 0.25 rad (boxes and lying cylinders; a lying
+    cylinder's axis stays across the tap direction). All drawn from ``self.np_random``.
     ``reset(options={...})`` may set any of them instead: ``object_type``, ``size`` [m], ``position`` (x, y) on
     the table [m], ``yaw`` [rad], or ``object_pose`` (x, y, z [m], qw, qx, qy, qz): any pose, a toppled
     standing cylinder too, from which the object settles; the behaviour then plans for the object as it rests
@@ -234,6 +236,9 @@ class TapAffordanceEnv(gym.Env):
     | ``settle_timeout`` | 3.0 | longest simulated wait for the outcome after the first touch [s] |
     | ``range_noise`` | None | ``"kinect_v1"``: the axial depth noise of a structured-light camera (Nguyen, Izadi
       and Lovell 2012, :mod:`affordance_env.range_noise`), drawn from ``self.np_random``; None: exact ranges |
+    | ``position_range`` | ``"canonical"`` | where objects are placed: within +-3 cm of the paper's spot, or
+      ``"workspace"``: uniform over the behaviour's workspace (:mod:`affordance_env.workspace`, where its canonical
+      action is within the arm's reach for every type and size), to learn how the place changes the effect |
     | ``reward_fn`` | displacement | ``callable(info) -> float`` |
     | ``render_mode`` | None | ``"rgb_array"``: a picture from an outside camera (headless EGL/OSMesa);
       ``"rgb_array_list"``: every frame of the interaction, for a video (Gymnasium's ``RecordVideo`` keeps one
@@ -269,6 +274,7 @@ class TapAffordanceEnv(gym.Env):
         roll_threshold: float = EnvOptions.roll_threshold,
         settle_timeout: float = EnvOptions.settle_timeout,
         range_noise: str | None = EnvOptions.range_noise,
+        position_range: str = EnvOptions.position_range,
         reward_fn: Callable[[dict[str, Any]], float] | None = None,
         render_mode: str | None = None,
         render_width: int = 480,
@@ -278,7 +284,7 @@ class TapAffordanceEnv(gym.Env):
         options = EnvOptions(behavior=behavior, object_types=object_types, size_range=size_range,
                              camera_width=camera_width, camera_height=camera_height, camera_fovy=camera_fovy,
                              roll_threshold=roll_threshold, settle_timeout=settle_timeout,
-                             range_noise=range_noise)  # checked and normalised
+                             range_noise=range_noise, position_range=position_range)  # checked and normalised
         self._check_render_mode(render_mode)
         #: The interaction of the behaviour (:mod:`affordance_env.interactions`).
         self.interaction = get_interaction(options.behavior)
@@ -287,6 +293,7 @@ class TapAffordanceEnv(gym.Env):
         self.size_range = options.size_range
         self.roll_threshold = options.roll_threshold
         self.range_noise = options.range_noise
+        self.position_range = options.position_range
         self.settle_timeout = options.settle_timeout
         self.reward_fn = default_reward if reward_fn is None else reward_fn
         self.render_mode = render_mode
@@ -383,6 +390,8 @@ class TapAffordanceEnv(gym.Env):
         size = float(rng.uniform(*self.size_range))
         xy = PLACEMENT_CENTRE + rng.uniform(-1.0, 1.0, 2) * PLACEMENT_HALF_WIDTH
         yaw = float(rng.uniform(-YAW_JITTER, YAW_JITTER))
+        if self.position_range == "workspace":
+            xy = sample_in_workspace(self.behavior.name, rng)
         if options is not None and not isinstance(options, Mapping):
             raise ValueError(f"options must be a dict with keys among {RESET_OPTIONS}, got {options!r}.")
         options = dict(options or {})

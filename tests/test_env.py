@@ -13,6 +13,7 @@ from affordance_env.features import FEATURE_NAMES, effect_features
 from affordance_env.options import EnvOptions
 from affordance_env.range_noise import kinect_axial_sigma
 from affordance_env.tap_env import TapAffordanceEnv
+from affordance_env.workspace import in_workspace
 
 
 @pytest.fixture(scope="module")
@@ -104,6 +105,7 @@ def test_bad_actions_get_clear_errors(env, action, match):
         ({"range_noise": "lidar"}, "kinect_v1"),
         ({"size_range": ("small", "big")}, r"size_range must be \(low, high\) in metres, got \('small', 'big'\)"),
         ({"camera_fovy": "wide"}, "camera_fovy must be a vertical field of view in degrees, got 'wide'"),
+        ({"position_range": "table"}, r"position_range must be one of \('canonical', 'workspace'\), got 'table'"),
     ],
 )
 def test_bad_options_get_clear_errors(kwargs, match, monkeypatch):
@@ -469,6 +471,31 @@ def test_reset_options_place_the_chosen_object_and_unknown_keys_are_refused():
         env.reset(seed=0, options={"size": "big"})
     with pytest.raises(ValueError, match="yaw must be a finite angle .* got 'left'"):
         env.reset(seed=0, options={"yaw": "left"})
+
+
+@pytest.mark.parametrize("behavior", ["push", "grasp"])
+def test_position_range_workspace_spreads_objects_over_the_behaviours_workspace(behavior):
+    env = TapAffordanceEnv(behavior=behavior, camera_width=32, camera_height=24, position_range="workspace")
+    canonical = TapAffordanceEnv(behavior=behavior, camera_width=32, camera_height=24)
+    spread = np.array([env.reset(seed=i)[1]["object"]["pose"][:2] for i in range(12)])
+    near = np.array([canonical.reset(seed=i)[1]["object"]["pose"][:2] for i in range(4)])
+    assert np.all(np.abs(near - (-0.30, 0.03)) < 0.035)  # the default: within +-3 cm of the paper's spot
+    assert np.all(in_workspace(behavior, spread))
+    assert np.ptp(spread, axis=0).min() > 0.10  # over the workspace, not around one spot
+    far = spread[np.abs(spread - (-0.30, 0.03)).max(axis=1) > 0.05]
+    assert len(far) >= 6
+    for i, xy in enumerate(spread[:4]):  # seen, and reachable, where they were placed
+        _, info = env.reset(seed=i)
+        assert info["visible"]
+        _, _, _, _, info = env.step(np.zeros(3, np.float32))
+        assert info["ik"]["success"], (xy, info["failure"])
+
+
+def test_an_object_out_of_view_is_searched_for_and_seen():
+    env = TapAffordanceEnv(behavior="grasp", camera_width=32, camera_height=24)
+    # 26 cm to the robot's left: outside the view of the head's first gaze, inside the grasp's workspace
+    _, info = env.reset(seed=0, options={"object_type": "sphere", "size": 0.06, "position": (-0.32, 0.26)})
+    assert info["visible"] and info["attention"]["visible"]
 
 
 def test_gym_make_refuses_a_render_mode_the_env_lacks_naming_those_it_has():
