@@ -9,7 +9,7 @@ from typing import Any
 
 #: Command-line flags that are env options, and the env keyword each one sets.
 _ENV_FLAGS = ("behavior", "object_types", "size_range", "camera_width", "camera_height", "camera_fovy",
-              "roll_threshold", "settle_timeout", "range_noise")
+              "roll_threshold", "settle_timeout", "range_noise", "position_range")
 
 
 def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -26,6 +26,11 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     parser.add_argument("--seed", type=int, default=0, help="dataset seed (default 0)")
     parser.add_argument("--workers", type=int, default=1,
                         help="worker processes, or workers of the local Dask cluster (default 1)")
+    parser.add_argument("--env", default="TapAffordance-v1", choices=("TapAffordance-v1", "TapAffordanceGoal-v0"),
+                        dest="env_id",
+                        help="TapAffordance-v1: one interaction per episode; TapAffordanceGoal-v0: goal episodes of "
+                             "up to 5 interactions, a behaviour drawn at each, one row per interaction with "
+                             "'step' and the goal's columns (default TapAffordance-v1)")
     parser.add_argument("--action", default="canonical", choices=("canonical", "random"),
                         help="the paper's canonical tap, or uniform random actions from (seed, i) "
                              "(default canonical)")
@@ -58,6 +63,10 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
                      help="longest simulated wait for the outcome after the first touch [s]")
     env.add_argument("--range-noise", default=None, choices=("kinect_v1",),
                      help="depth noise of the range camera (default: none)")
+    env.add_argument("--position-range", default=None, choices=("canonical", "workspace"),
+                     help="where objects are placed: within +-3 cm of the paper's spot (canonical), or uniformly "
+                          "over the behaviour's workspace (workspace; for TapAffordanceGoal-v0, the union of the "
+                          "four) (default canonical)")
     parser.set_defaults(func=run_collect)
     return parser
 
@@ -81,15 +90,19 @@ def run_collect(args: argparse.Namespace) -> int:
     out = collect(args.out, args.episodes, seed=args.seed, workers=args.workers, action=args.action,
                   env_options=env_options_from_args(args), chunk_size=args.chunk_size, scheduler=scheduler,
                   dask_address=args.dask_address, save_images=args.save_images,
-                  max_failure_share=args.max_failure_share)
+                  max_failure_share=args.max_failure_share, env_id=args.env_id)
     elapsed = time.perf_counter() - start
     manifest = read_manifest(out)
     failures = manifest["failures"]
     details = ""
     if failures["count"]:
         details = f" ({failure_summary(failures['episodes'])}; all reasons in {out / MANIFEST})"
-    print(f"{out}: {manifest['rows']} interactions written, {failures['count']} failed and left "
-          f"out{details}; {elapsed:.1f} s")
+    if manifest["settings"].get("env_id") == "TapAffordanceGoal-v0":
+        print(f"{out}: {manifest['episodes']} goal episodes, {manifest['rows']} interactions written; "
+              f"{failures['count']} episodes ended at a failed interaction, left out{details}; {elapsed:.1f} s")
+    else:
+        print(f"{out}: {manifest['rows']} interactions written, {failures['count']} failed and left "
+              f"out{details}; {elapsed:.1f} s")
     return 0
 
 

@@ -33,6 +33,8 @@ import pyarrow.parquet as pq
 from affordance_env.behaviors import ACTION_DIM
 from affordance_env.dataset.format import (
     CHECKSUMS,
+    ENV_IDS,
+    GOAL_ENV_ID,
     IMAGE_COLUMNS,
     MANIFEST,
     METADATA_KEY,
@@ -45,6 +47,7 @@ from affordance_env.dataset.format import (
     dataset_header,
     file_sha256,
     interaction_row,
+    is_goal_dataset,
     read_manifest,
     settings_differences,
     write_atomically,
@@ -72,23 +75,65 @@ def interaction_action(seed: int, episode: int, action: str) -> np.ndarray:
     return rng.uniform(-1.0, 1.0, ACTION_DIM).astype(np.float32)
 
 
+def goal_episode_actions(seed: int, episode: int, action: str) -> Iterator[dict[str, Any]]:
+    """The actions of goal episode ``episode``, step after step: a behaviour uniform over the four, and its
+    parameters zeros (``"canonical"``) or uniform in [-1, 1]^3, all from ``SeedSequence([seed, episode, 1])``."""
+    if action not in ACTIONS:
+        raise ValueError(f"action must be one of {ACTIONS}, got {action!r}.")
+    rng = np.random.default_rng(np.random.SeedSequence([seed, episode, 1]))
+    while True:
+        behavior = int(rng.integers(4))
+        params = rng.uniform(-1.0, 1.0, ACTION_DIM).astype(np.float32)
+        yield {"behavior": behavior, "params": params if action == "random" else np.zeros(ACTION_DIM, np.float32)}
+
+
 # --- a worker: interactions -> one chunk file --------------------------------------------------------------
 #: Per worker thread, {options: env}: building an env takes about a second, so a worker keeps its own.
 _worker = threading.local()
 
 
-def _worker_env(options_json: str):
+def _worker_env(options_json: str, env_id: str = ENV_IDS[0]):
     envs = _worker.__dict__.setdefault("envs", {})
-    if options_json not in envs:
-        from affordance_env.tap_env import TapAffordanceEnv
+    key = (env_id, options_json)
+    if key not in envs:
+        if env_id == GOAL_ENV_ID:
+            from affordance_env.goal_env import TapAffordanceGoalEnv
 
-        envs[options_json] = TapAffordanceEnv(**json.loads(options_json))
-    return envs[options_json]
+            envs[key] = TapAffordanceGoalEnv(**json.loads(options_json))
+        else:
+            from affordance_env.tap_env import TapAffordanceEnv
+
+            envs[key] = TapAffordanceEnv(**json.loads(options_json))
+    return envs[key]
 
 
-def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) -> tuple[int, int, dict, str]:
-    """Run interactions ``start .. stop-1``, write them as chunk ``index``; returns (index, n, failures, the
-    file's SHA-256)."""
+def _goal_episode_rows(env, settings: dict, episode: int) -> tuple[list[dict], str | None]:
+    """The rows of goal episode ``episode`` (one per interaction, until the episode ends or its first failed
+    interaction) and the reason of that failure, or None."""
+    from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
+
+    env_seed = interaction_seed(settings["seed"], episode)
+    before = env.reset(seed=env_seed)
+    rows = []
+    actions = goal_episode_actions(settings["seed"], episode, settings["action"])
+    for step in range(GOAL_MAX_EPISODE_STEPS):
+        action = next(actions)
+        after = env.step(action)
+        row = interaction_row(episode, env_seed, action["params"], before, after, settings["save_images"],
+                              goal_step=step)
+        if isinstance(row, str):
+            return rows, f"{row} (at step {step})"
+        rows.append(row)
+        if after[2]:  # terminated: the goal reached, or the object left the table
+            break
+        before = (after[0], after[4])
+    return rows, None
+
+
+def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict
+                   ) -> tuple[int, int, dict, str, int]:
+    """Run episodes ``start .. stop-1``, write them as chunk ``index``; returns (index, n, failures, the
+    file's SHA-256, the row count)."""
     from affordance_env import __version__
 
     if __version__ != header["package_version"]:
@@ -96,11 +141,21 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) ->
                            f"{header['package_version']}: install the same version on every worker.")
     settings = header["settings"]
     options_json = json.dumps(settings["env_options"], sort_keys=True)
-    schema = arrow_schema(settings["save_images"])
+    goal = is_goal_dataset(header)
+    schema = arrow_schema(settings["save_images"], goal=goal)
     columns: dict[str, list] = {name: [] for name in schema.names}
     failures: dict[str, str] = {}
     for episode in range(start, stop):
-        env = _worker_env(options_json)  # an env that cannot be built stops the run: not a failed interaction
+        # an env that cannot be built stops the run: not a failed interaction
+        env = _worker_env(options_json, settings.get("env_id", ENV_IDS[0]))
+        if goal:
+            rows, failure = _goal_episode_rows(env, settings, episode)
+            if failure is not None:
+                failures[str(episode)] = failure
+            for row in rows:
+                for name in schema.names:
+                    columns[name].append(row[name])
+            continue
         env_seed = interaction_seed(settings["seed"], episode)
         action = interaction_action(settings["seed"], episode, settings["action"])
         # An exception here is a bug, not a failed interaction (the env reports those in info["failure"]): it
@@ -113,7 +168,9 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) ->
             continue
         for name in schema.names:
             columns[name].append(row[name])
-    meta = {**header, "chunk": {"index": index, "start": start, "stop": stop, "failures": failures}}
+    n_rows = len(columns["episode"])
+    meta = {**header, "chunk": {"index": index, "start": start, "stop": stop, "failures": failures,
+                                "rows": n_rows}}
     table = pa.Table.from_pydict(columns, schema=schema.with_metadata({METADATA_KEY: json.dumps(meta)}))
     # zstd for the images (small); snappy for the numbers: zstd saves little there and reads twice as slowly
     codecs = {name: "zstd" if name in IMAGE_COLUMNS else "snappy" for name in schema.names}
@@ -124,16 +181,22 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) ->
         digest.append(file_sha256(tmp))  # of the bytes written, before anything else can touch them
 
     write_atomically(Path(out) / chunk_name(index), write)
-    return index, stop - start, failures, digest[0]
+    return index, stop - start, failures, digest[0], n_rows
 
 
 # --- the coordinator -------------------------------------------------------------------------------------
-def _full_options(env_options: dict[str, Any]) -> dict[str, Any]:
+def _full_options(env_options: dict[str, Any], env_id: str = ENV_IDS[0]) -> dict[str, Any]:
     """The env options with every default filled in, as JSON values, so that equal settings compare equal;
-    checked (:class:`~affordance_env.options.EnvOptions`) without building an env or importing the simulator."""
+    checked (:class:`~affordance_env.options.EnvOptions`) without building an env or importing the simulator.
+    TapAffordanceGoal-v0 chooses the behaviour at every step: it has no ``behavior`` option."""
+    if env_id == GOAL_ENV_ID and "behavior" in env_options:
+        raise ValueError(f"{GOAL_ENV_ID} chooses among all four behaviours at every step: drop the behavior "
+                         f"option (--behavior), got {env_options['behavior']!r}.")
     EnvOptions.checked(**env_options)
     full = {f.name: f.default for f in dataclasses.fields(EnvOptions)}
     full.update(env_options)
+    if env_id == GOAL_ENV_ID:
+        del full["behavior"]
     return json.loads(json.dumps(full, default=list))
 
 
@@ -167,6 +230,7 @@ def collect(
     dask_address: str | None = None,
     save_images: bool = False,
     max_failure_share: float = 0.2,
+    env_id: str = ENV_IDS[0],
 ) -> Path:
     """Collect ``episodes`` interactions into the dataset directory ``out``, resuming it if it exists.
 
@@ -192,6 +256,10 @@ def collect(
             zstd-compressed; read them with ``load_dataset(out, with_images=True)`` and :func:`images`.
         max_failure_share: Stop with :class:`FailureShareError` once more than this share of the interactions
             collected so far were marked failed by the environment, in [0, 1] (1 accepts any).
+        env_id: ``"TapAffordance-v1"`` (one interaction per episode, a row each) or ``"TapAffordanceGoal-v0"``:
+            goal episodes of up to 5 interactions (``GOAL_MAX_EPISODE_STEPS``), each a behaviour drawn uniformly
+            with its parameters by ``action``, one row per interaction with its ``step`` and the goal columns;
+            an episode is recorded up to its first failed interaction (left out; the episode counts as failed).
 
     Returns:
         The dataset directory.
@@ -205,15 +273,17 @@ def collect(
     if isinstance(max_failure_share, bool) or not (isinstance(max_failure_share, int | float | np.floating)
                                                    and 0.0 <= max_failure_share <= 1.0):
         raise ValueError(f"max_failure_share must be a share in [0, 1], got {max_failure_share!r}.")
+    if env_id not in ENV_IDS:
+        raise ValueError(f"env_id must be one of {ENV_IDS}, got {env_id!r}.")
     if scheduler not in SCHEDULERS:
         raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}.")
     if dask_address is not None:
         scheduler = "dask"
-    options = _full_options(dict(env_options or {}))
+    options = _full_options(dict(env_options or {}), env_id)
     options_json = json.dumps(options, sort_keys=True)
     if scheduler == "joblib" and workers == 1:
-        _worker_env(options_json)  # this process collects: build its env now, before any work
-    header = dataset_header(seed, action, chunk_size, options, save_images)
+        _worker_env(options_json, env_id)  # this process collects: build its env now, before any work
+    header = dataset_header(seed, action, chunk_size, options, save_images, env_id)
     out, episodes = Path(out), int(episodes)
 
     stored: dict = {}
@@ -232,20 +302,20 @@ def collect(
             found = _existing_chunk(out / chunk_name(index), header, start, stop, stored)
             if found is not None:
                 meta, digest = found
-                done[index] = (stop - start, meta["chunk"]["failures"], digest)
+                done[index] = (stop - start, meta["chunk"]["failures"], digest, meta["rows"])
         write_manifest(out, header, episodes, done)
         _check_failure_share(done, max_failure_share, out)
         tasks = [(str(out), i, start, stop, header)
                  for i, (start, stop) in enumerate(ranges) if i not in done]
-        n_failed = sum(len(f) for _, f, _ in done.values())
-        with progress_bar(progress, total=episodes, initial=sum(n for n, _, _ in done.values()),
+        n_failed = sum(len(f) for _, f, _, _ in done.values())
+        with progress_bar(progress, total=episodes, initial=sum(n for n, *_ in done.values()),
                           unit="interaction", desc=out.name, smoothing=0.05) as bar:
             bar.set_postfix(failed=n_failed, refresh=False)
-            for index, n, failures, digest in _run(tasks, scheduler, workers, dask_address):
+            for index, n, failures, digest, rows in _run(tasks, scheduler, workers, dask_address):
                 if not (out / chunk_name(index)).exists():
                     raise DatasetError(f"a worker wrote {chunk_name(index)} where this process cannot see "
                                        f"it: the Dask workers must share {out} with this machine.")
-                done[index] = (n, failures, digest)
+                done[index] = (n, failures, digest, rows)
                 write_manifest(out, header, episodes, done)
                 n_failed += len(failures)
                 bar.set_postfix(failed=n_failed, refresh=False)
@@ -271,9 +341,9 @@ class FailureShareError(DatasetError):
     """More interactions failed than the collection was told to accept."""
 
 
-def _check_failure_share(done: dict[int, tuple[int, dict, str]], max_share: float, out: Path) -> None:
-    collected = sum(n for n, _, _ in done.values())
-    failures = {k: v for _, chunk, _ in done.values() for k, v in chunk.items()}
+def _check_failure_share(done: dict[int, tuple[int, dict, str, int]], max_share: float, out: Path) -> None:
+    collected = sum(n for n, *_ in done.values())
+    failures = {k: v for _, chunk, _, _ in done.values() for k, v in chunk.items()}
     if collected and len(failures) / collected > max_share:
         raise FailureShareError(
             f"{len(failures)} of the {collected} interactions collected so far failed "
@@ -337,7 +407,7 @@ def _run(tasks: list[tuple], scheduler: str, workers: int, address: str | None) 
         )
 
 
-def _collect_chunk_in_worker(*task) -> tuple[int, int, dict, str]:
+def _collect_chunk_in_worker(*task) -> tuple[int, int, dict, str, int]:
     """:func:`_collect_chunk` in a worker process of this machine, which leaves Ctrl-C to the coordinating
     process: that one stops the workers (whole chunks stay, as always) and says so once, instead of every worker
     printing a traceback."""

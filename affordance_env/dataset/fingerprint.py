@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from affordance_env.dataset.format import GROUND_TRUTH_COLUMNS, POSE_COLUMNS
+from affordance_env.dataset.format import GROUND_TRUTH_COLUMNS, POSE_COLUMNS, with_later_defaults
 
 #: Interactions a reference fingerprint covers.
 FINGERPRINT_EPISODES = 30
@@ -60,9 +60,10 @@ def fingerprint(frame: pd.DataFrame, episodes: int = FINGERPRINT_EPISODES) -> di
 
 def fingerprint_differences(expected: dict[str, Any], found: dict[str, Any]) -> list[str]:
     """How ``found`` differs from ``expected``, for a person to read (empty: the same interactions, bit for bit).
-    The package version is not compared: the data may stay the same across versions."""
+    The package version is not compared: the data may stay the same across versions; settings added since
+    ``expected`` was made count at the value it was made with (:data:`~.format.LATER_SETTINGS`)."""
     problems = []
-    if expected.get("settings") != found.get("settings"):
+    if with_later_defaults(expected.get("settings") or {}) != with_later_defaults(found.get("settings") or {}):
         problems.append(f"collected with other settings: {found.get('settings')} instead of "
                         f"{expected.get('settings')}")
     if expected.get("failures") != found.get("failures"):

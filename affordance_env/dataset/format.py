@@ -21,7 +21,9 @@ The columns fall in namespaces that cannot be confused (:func:`arrow_schema`):
   ``true_final_<p>`` (the object's pose, ``p`` in :data:`POSE_FIELDS`) and the labels of
   :data:`GROUND_TRUTH_COLUMNS` (``type``, ``size``, ``success``, ...);
 - the action: ``action_<j>``; the images: ``image_<stage>_<kind>`` (:data:`IMAGE_COLUMNS`);
-- bookkeeping: ``episode``, ``seed``, ``behavior``.
+- bookkeeping: ``episode``, ``seed``, ``behavior``;
+- in a dataset of TapAffordanceGoal-v0 episodes (``env_id``), one row per interaction of an episode, also
+  ``step`` (0, 1, ... within the episode) and the goal: :data:`GOAL_COLUMNS`.
 """
 
 from __future__ import annotations
@@ -63,22 +65,35 @@ GROUND_TRUTH_COLUMNS = ("type", "size", "displacement", "rolling_distance", "rol
 IMAGE_COLUMNS = tuple(f"image_{stage}_{kind}" for stage in STAGES for kind in ("range", "mask"))
 #: The manifest's record of each finished chunk's SHA-256 (hex), by file name.
 CHECKSUMS = "chunk_sha256"
+#: The environments a dataset can be collected from: one interaction per episode, or goal episodes of several.
+ENV_IDS = ("TapAffordance-v1", "TapAffordanceGoal-v0")
+GOAL_ENV_ID = "TapAffordanceGoal-v0"
+#: The goal columns of a dataset of TapAffordanceGoal-v0 episodes: the goal (x, y) [m], where the object was seen
+#: after the interaction (``achieved_goal``) [m], its distance to the goal [m] and whether it reached it.
+GOAL_COLUMNS = ("goal_x", "goal_y", "achieved_x", "achieved_y", "goal_distance", "goal_reached")
+#: Settings added after the first datasets, with the value every dataset made before had: a dataset that lacks
+#: one was made with that value.
+LATER_SETTINGS = {"env_id": "TapAffordance-v1"}
+LATER_ENV_OPTIONS = {"position_range": "canonical"}
 
 
 class DatasetError(ValueError):
     """A dataset that cannot be read or extended, with the reason."""
 
 
-def arrow_schema(save_images: bool = False) -> pa.Schema:
-    """The columns of every chunk, in order: bookkeeping, action, ground truth, 3 x 49 features, images."""
-    fields = [("episode", pa.int64()), ("seed", pa.int64()), ("behavior", pa.string()),
-              ("type", pa.string()), ("size", pa.float64())]
+def arrow_schema(save_images: bool = False, goal: bool = False) -> pa.Schema:
+    """The columns of every chunk, in order: bookkeeping, action, ground truth, (goal,) 3 x 49 features, images.
+    ``goal``: a dataset of TapAffordanceGoal-v0 episodes, with ``step`` and :data:`GOAL_COLUMNS`."""
+    fields = [("episode", pa.int64())] + ([("step", pa.int64())] if goal else [])
+    fields += [("seed", pa.int64()), ("behavior", pa.string()), ("type", pa.string()), ("size", pa.float64())]
     fields += [(f"action_{j}", pa.float32()) for j in range(ACTION_DIM)]
     fields += [(column, pa.float64()) for column in POSE_COLUMNS]
     fields += [("displacement", pa.float64()), ("rolling_distance", pa.float64()), ("rolled", pa.bool_()),
                ("success", pa.bool_()), ("tilt", pa.float64()), ("toppled", pa.bool_()), ("outcome", pa.string()),
                ("outcome_time", pa.float64()), ("contact", pa.bool_()), ("hand_speed", pa.float64()),
                ("visible_initial", pa.bool_()), ("visible_final", pa.bool_()), ("ik_success", pa.bool_())]
+    if goal:
+        fields += [(column, pa.bool_() if column == "goal_reached" else pa.float64()) for column in GOAL_COLUMNS]
     fields += [(f"{stage}_{name}", pa.float64())
                for stage in ("initial", "final", "effect") for name in FEATURE_NAMES]
     if save_images:
@@ -106,15 +121,22 @@ def _record(episode: int, env_seed: int, action: np.ndarray, reset_info: dict, i
     return row
 
 
-def interaction_row(episode: int, env_seed: int, action: np.ndarray, reset: tuple, step: tuple, save_images: bool
-         ) -> dict[str, Any] | str:
+def interaction_row(episode: int, env_seed: int, action: np.ndarray, reset: tuple, step: tuple, save_images: bool,
+                    goal_step: int | None = None) -> dict[str, Any] | str:
     """The row of an interaction, from what ``env.reset`` and ``env.step`` returned, or the env's reason
     (``info["failure"]``) why it has none. A row with non-finite numbers raises RuntimeError: a bug, not a failed
-    interaction."""
+    interaction. ``goal_step``: the interaction is step ``goal_step`` of a TapAffordanceGoal-v0 episode, whose
+    ``reset`` is the observation and info before it (its ``observation`` holds the range image)."""
     (obs_initial, reset_info), (obs_final, *_, info) = reset, step
     if info["failure"] is not None:
         return info["failure"]
     row = _record(episode, env_seed, action, reset_info, info)
+    if goal_step is not None:
+        row["step"] = int(goal_step)
+        row.update(goal_x=float(obs_final["desired_goal"][0]), goal_y=float(obs_final["desired_goal"][1]),
+                   achieved_x=float(obs_final["achieved_goal"][0]), achieved_y=float(obs_final["achieved_goal"][1]),
+                   goal_distance=float(info["distance"]), goal_reached=bool(info["is_success"]))
+        obs_initial, obs_final = obs_initial["observation"], obs_final["observation"]
     bad = [k for k, v in row.items() if isinstance(v, float | np.floating) and not np.isfinite(v)]
     if bad:  # the env promises finite numbers for every interaction it does not mark failed: this is a bug
         raise RuntimeError(f"interaction {episode} (env seed {env_seed}) was not marked failed but has "
@@ -134,20 +156,35 @@ def chunk_ranges(episodes: int, chunk_size: int) -> list[tuple[int, int]]:
     return [(s, min(s + chunk_size, episodes)) for s in range(0, episodes, chunk_size)]
 
 
-def dataset_header(seed: int, action: str, chunk_size: int, env_options: dict, save_images: bool) -> dict[str, Any]:
+def dataset_header(seed: int, action: str, chunk_size: int, env_options: dict, save_images: bool,
+                   env_id: str = ENV_IDS[0]) -> dict[str, Any]:
     """What a dataset is: written to the manifest and to every chunk."""
     from affordance_env import __version__
 
     settings = {"seed": int(seed), "action": action, "chunk_size": int(chunk_size),
-                "save_images": bool(save_images), "env_options": env_options}
+                "save_images": bool(save_images), "env_id": env_id, "env_options": env_options}
     return {"format": FORMAT, "schema_version": SCHEMA_VERSION, "package_version": __version__,
             "settings": settings, "feature_names": list(FEATURE_NAMES),
             "feature_groups": dict(FEATURE_GROUPS)}
 
 
+def is_goal_dataset(description: dict) -> bool:
+    """Whether the dataset (its manifest, or a chunk's metadata) holds TapAffordanceGoal-v0 episodes."""
+    settings = description.get("settings")
+    return isinstance(settings, dict) and settings.get("env_id") == GOAL_ENV_ID
+
+
+def with_later_defaults(settings: dict) -> dict[str, Any]:
+    """A dataset's settings with those added after it was made (:data:`LATER_SETTINGS`) at their old values."""
+    settings = {**LATER_SETTINGS, **settings}
+    if isinstance(settings.get("env_options"), dict):
+        settings["env_options"] = {**LATER_ENV_OPTIONS, **settings["env_options"]}
+    return settings
+
+
 def _flat_settings(description: dict) -> dict[str, Any]:
     settings = description.get("settings")
-    settings = dict(settings) if isinstance(settings, dict) else {}
+    settings = with_later_defaults(settings) if isinstance(settings, dict) else {}
     env_options = settings.pop("env_options", None)
     return {"schema_version": description.get("schema_version"),
             "package_version": description.get("package_version"),
@@ -184,6 +221,8 @@ def collect_command(path: str | os.PathLike, manifest: dict) -> str:
                         ("--chunk-size", settings.get("chunk_size"))):
         if value is not None:  # a manifest that lacks it: the collection's own default
             words += [flag, str(value)]
+    if settings.get("env_id", ENV_IDS[0]) != ENV_IDS[0]:
+        words += ["--env", str(settings["env_id"])]
     if settings.get("action", "canonical") != "canonical":
         words += ["--action", str(settings["action"])]
     if settings.get("save_images"):
@@ -198,14 +237,14 @@ def collect_command(path: str | os.PathLike, manifest: dict) -> str:
     return shlex.join(words)
 
 
-def write_manifest(out: Path, header: dict, episodes: int, done: dict[int, tuple[int, dict, str]]) -> None:
-    """Write the manifest of the dataset ``out``; ``done`` maps the index of each finished chunk to its
-    interaction count, its failures (episode -> reason) and its SHA-256."""
-    failures = {k: v for _, chunk_failures, _ in done.values() for k, v in chunk_failures.items()}
+def write_manifest(out: Path, header: dict, episodes: int, done: dict[int, tuple[int, dict, str, int]]) -> None:
+    """Write the manifest of the dataset ``out``; ``done`` maps the index of each finished chunk to its episode
+    count, its failures (episode -> reason), its SHA-256 and its row count."""
+    failures = {k: v for _, chunk_failures, _, _ in done.values() for k, v in chunk_failures.items()}
     kinds = Counter(reason.split(":", 1)[0] for reason in failures.values())
     n_chunks = len(chunk_ranges(episodes, header["settings"]["chunk_size"]))
     manifest = {**header, "episodes": episodes, "chunks": n_chunks, "chunks_done": len(done),
-                "complete": len(done) == n_chunks, "rows": sum(n - len(f) for n, f, _ in done.values()),
+                "complete": len(done) == n_chunks, "rows": sum(rows for *_, rows in done.values()),
                 "failures": {"count": len(failures), "by_kind": dict(sorted(kinds.items())),
                              "episodes": {k: failures[k] for k in sorted(failures, key=int)}},
                 CHECKSUMS: {chunk_name(i): done[i][2] for i in sorted(done)}}
@@ -279,7 +318,11 @@ def check_chunk(path: Path, header: dict, start: int, stop: int) -> dict:
     diffs = settings_differences(meta, header)
     if diffs:
         raise DatasetError(f"{path} was made with other settings than its dataset ({'; '.join(diffs)}).")
-    if rows + len(chunk["failures"]) != stop - start:
+    if is_goal_dataset(header):  # goal episodes: a row per interaction, as many as the chunk recorded
+        if rows != chunk.get("rows"):
+            raise DatasetError(f"{path} is inconsistent: {rows} rows, its metadata recorded {chunk.get('rows')!r}.")
+    elif rows + len(chunk["failures"]) != stop - start:
         raise DatasetError(f"{path} is inconsistent: {rows} rows and {len(chunk['failures'])} failures for "
                            f"{stop - start} interactions.")
+    meta["rows"] = rows
     return meta

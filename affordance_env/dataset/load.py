@@ -29,6 +29,7 @@ from affordance_env.dataset.format import (
     chunk_name,
     chunk_ranges,
     collect_command,
+    is_goal_dataset,
     read_manifest,
 )
 
@@ -182,7 +183,8 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
                            f"({', '.join(missing[:3])}{', ...' if len(missing) > 3 else ''}); finish it with "
                            f"`{redo}`, or pass allow_incomplete=True.")
     if not tables:
-        tables = [arrow_schema(with_images and manifest["settings"].get("save_images", False)).empty_table()]
+        tables = [arrow_schema(with_images and manifest["settings"].get("save_images", False),
+                               goal=is_goal_dataset(manifest)).empty_table()]
     frame = pa.concat_tables(tables).to_pandas()
     frame = frame.rename(columns=renames)
     if "success" not in frame.columns:  # versions 1 to 3: derived, in the column's place after rolled
