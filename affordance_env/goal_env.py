@@ -10,7 +10,6 @@ import numpy as np
 from gymnasium import spaces
 
 from affordance_env.behaviors import ACTION_DIM, check_action
-from affordance_env.interactions import get_interaction
 from affordance_env.options import EnvOptions
 from affordance_env.tap_env import RESET_OPTIONS, TapAffordanceEnv
 from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
@@ -218,7 +217,7 @@ class TapAffordanceGoalEnv(gym.Env):
         for arm in self.arms.values():
             arm.np_random = self.np_random  # one random generator for the whole world
         self._arm = self.arms["right"]
-        self.arms["left"]._initial = None
+        self.arms["left"].forget()
         if self.position_range == "workspace" and not {"position", "object_pose"} & set(options):
             options["position"] = sample_in_workspace(None, self.np_random)
         inner_obs, info = self._arm.reset(options=options)
@@ -250,9 +249,7 @@ class TapAffordanceGoalEnv(gym.Env):
         """The arm env of behaviour ``name``, in the world as it is now."""
         arm = self.arms[ARM_OF[name]]
         if arm is not self._arm:
-            arm.physics.adopt(self._arm.physics)
-            arm._q_home = arm.physics.joint_targets()
-            arm._initial, self._arm._initial = self._arm._initial, None
+            arm.take_over(self._arm)
             self._arm = arm
         if arm.behavior.name != name:
             arm.use_behavior(name)
@@ -262,19 +259,9 @@ class TapAffordanceGoalEnv(gym.Env):
         """Whether the arm can reach every pose of ``behavior`` with ``params`` on the object where it is now, from
         the kinematics alone (no physics step); False: the interaction would fail with ``"ik: ..."``."""
         name, a = self._check_action({"behavior": behavior, "params": params})
-        if self._obs is None or self._arm._initial is None:
+        if self._obs is None:
             raise RuntimeError("feasible() needs an object: call reset() first.")
-        initial = self._arm._initial
-        arm = self.arms[ARM_OF[name]]
-        interaction = get_interaction(name)
-        plan = interaction.plan(initial["geometry"], initial["pose"][:3], initial["yaw"], arm.physics.table_top, a)
-        motion = arm.motion
-        saved = motion.approach_posture
-        motion.approach_posture = arm._postures[name]
-        try:
-            return bool(interaction.reachable(motion, plan))
-        finally:
-            motion.approach_posture = saved
+        return self.arms[ARM_OF[name]].feasible(a, behavior=name, seen_by=self._arm)
 
     def step(self, action):
         """Run one interaction with the chosen behaviour and parameters; the object stays where it ends."""
@@ -282,14 +269,13 @@ class TapAffordanceGoalEnv(gym.Env):
             raise RuntimeError("step() called before reset() or after the episode ended; call reset() first.")
         name, params = self._check_action(action)
         arm = self._switch_to(name)
-        _, _, _, _, info = arm.step(params)
+        inner_obs, _, _, _, info = arm.step(params)
         fault = info["outcome"] == "fault"
         off_table = info["outcome"] == "off_table"
-        if fault or off_table:  # nothing more to see: the episode ends
-            inner_obs = arm._blank_observation() if fault else arm._snapshot()[0]
+        if fault or off_table:  # nothing more to see: the episode ends on the interaction's final observation
             obs = self._observation(inner_obs, False)
         else:  # the head turns to the object where it rests, for the next interaction
-            inner_obs, seen = arm._observe()
+            inner_obs, seen = arm.observe()
             obs = self._observation(inner_obs, seen["visible"])
         distance = float(goal_distance(obs["achieved_goal"], self._goal))
         info.update(behavior=name, distance=distance, is_success=bool(distance <= self.goal_tolerance))
@@ -315,13 +301,13 @@ class TapAffordanceGoalEnv(gym.Env):
             self._arm.use_behavior(state["behavior"])
         for arm in self.arms.values():
             if arm is not self._arm:
-                arm._initial = None
+                arm.forget()
         self._goal = state["goal"].copy()
         self._obs = state["obs"]
 
     def render(self):
         """A picture of the scene from the ``overview`` camera (``render_mode="rgb_array"``), else None."""
-        return self._arm._picture() if self.render_mode == "rgb_array" else None
+        return self._arm.render() if self.render_mode == "rgb_array" else None
 
     def close(self) -> None:
         for arm in self.arms.values():

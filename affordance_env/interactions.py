@@ -32,9 +32,11 @@ from affordance_env.behaviors import (
     plan_grasp,
     plan_stroke,
 )
-from affordance_env.motion import GraspOutcome, MotionExecutor, ReachOutcome, StrokeOutcome
+from affordance_env.grasping import GraspOutcome, grasp_reachable, run_grasp
+from affordance_env.motion import MotionExecutor, ReachOutcome
 from affordance_env.objects import ObjectGeometry, object_geometry
 from affordance_env.outcome import Labels, grasp_success
+from affordance_env.stroke import StrokeOutcome, run_stroke, stroke_reachable
 
 #: The hand may start the stroke at most this far from the planned pre-stroke pose [m], and may have moved
 #: the object at most this much before the stroke [m]; otherwise the interaction is marked failed.
@@ -109,10 +111,10 @@ class StrokeInteraction:
         return plan_stroke(self.behavior, geometry, p_object, yaw, table_top, action)
 
     def execute(self, motion: MotionExecutor, plan: StrokePlan) -> StrokeOutcome:
-        return motion.stroke(plan)
+        return run_stroke(motion, plan)
 
     def reachable(self, motion: MotionExecutor, plan: StrokePlan) -> bool:
-        return motion.stroke_reachable(plan)
+        return stroke_reachable(motion, plan)
 
     def via_home(self, outcome: StrokeOutcome) -> np.ndarray | None:
         return outcome.q_withdraw
@@ -154,10 +156,10 @@ class GraspInteraction:
         return plan_grasp(self.behavior, geometry, p_object, yaw, table_top, action)
 
     def execute(self, motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
-        return motion.grasp(plan)
+        return run_grasp(motion, plan)
 
     def reachable(self, motion: MotionExecutor, plan: GraspPlan) -> bool:
-        return motion.grasp_reachable(plan)
+        return grasp_reachable(motion, plan)
 
     def via_home(self, outcome: GraspOutcome) -> np.ndarray | None:
         return outcome.q_retreat

@@ -13,7 +13,7 @@ the hand does to an object is bounded by what its motors give.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 
@@ -61,32 +61,6 @@ IK_SPACING = 0.02
 IK_POSITION_TOLERANCE, IK_ORIENTATION_TOLERANCE = 0.005, 0.35
 #: A line of the palm starting from rest reaches its speed, and one ending at rest leaves it, in this time [s].
 LINE_RAMP = 0.1
-#: The stroke reaches its speed in this time [s] from rest, within the first 3 cm (the clearance before the
-#: object) even at its fastest.
-STROKE_RAMP = 0.1
-#: Speed of the grasp's guarded moves [m/s]: the hand's final approach to the object, with its lowest point
-#: within GUARD_CLEARANCE of the object's top, and the put-down of a held object. A careful robot's speed near
-#: what it touches: the first touch is at most this fast, and stops the move (the fingertips' and palm's tactile
-#: skin of the mk3 hand sense it; the put-down's touch of the table is sensed as the load leaving the arm, through
-#: the iCub's force-torque sensors).
-GUARDED_SPEED = 0.04
-#: Speed of the grasp's free lines [m/s]: the lift of a held object and the retreat of the open hand.
-LIFT_SPEED = 0.1
-#: A closing finger joint has stalled when slower than FINGER_STALL_SPEED [rad/s] and within FINGER_ARRIVED [rad]
-#: of its target or pressing with its motor's full torque.
-FINGER_STALL_SPEED, FINGER_ARRIVED = 0.05, 0.02
-#: The closing fingers press with at most this torque [N m] until every one has stalled on the object or
-#: arrived (a current limit of the hand's controller, a third of its motors' limit): a light touch that finds the
-#: object without sweeping it away. Then they squeeze with their motors' full torque.
-CLOSING_TORQUE = 0.1
-#: Share of their speed limit at which the fingers open to let down an object that does not touch the table yet.
-RELEASE_SPEED_SHARE = 0.25
-#: Once the closing fingers hold, their grip rises to the motors' full torque over this time [s].
-GRASP_SQUEEZE_TIME = 0.1
-#: The carry brings a held object to this height above where it would touch the table [m]; the guarded
-#: put-down goes on from there until it does (or PLACE_OVERTRAVEL lower).
-PLACE_APPROACH = 0.02
-PLACE_OVERTRAVEL = 0.02
 #: Way home: the arm that comes within HOME_CLEARANCE [m] of the object stops and waits for the object to
 #: come to rest (at most HOME_WAIT [s]), then goes home through a pose HOME_RAISE [m] higher above it.
 HOME_CLEARANCE, HOME_WAIT, HOME_RAISE = 0.015, 3.0, 0.06
@@ -111,52 +85,6 @@ class ReachOutcome:
     contact: bool
     contact_time: float
     hand_speed: float
-
-
-@dataclass(frozen=True)
-class StrokeOutcome(ReachOutcome):
-    """What happened during a stroke (:class:`ReachOutcome` over the pre-stroke pose and the stroke line; the
-    first touch to the physics step).
-
-    Attributes:
-        hand_travel: Distance the palm travelled along the stroke direction [m].
-        start_error: Distance of the palm from the pre-stroke pose when the stroke started [m].
-        object_moved: How far the object moved before the stroke started (touched during the reach) [m].
-        q_withdraw: Joint targets of the pose above the pre-stroke pose, which the way home passes through so that
-            it never crosses the object; None if the plan has no such pose.
-        speed: Cruise speed of the palm along the stroke [m/s]: the plan's, or lower where a joint would have
-            exceeded its velocity limit.
-    """
-
-    hand_travel: float
-    start_error: float
-    object_moved: float
-    q_withdraw: np.ndarray | None
-    speed: float
-
-
-@dataclass(frozen=True)
-class GraspOutcome(ReachOutcome):
-    """What happened during a grasp, measured in the simulation (:class:`ReachOutcome` over every pose of the
-    grasp; the first touch to the control tick).
-
-    Attributes:
-        rise: How far the object's centre had risen above its start at the end of the hold [m].
-        links_holding: Hand links touching the object at the end of the hold.
-        on_table: Whether the object touched the table at the end of the hold.
-        release_time: Simulation time when the hand had opened again [s].
-        placed: Whether the held object was put down on the table before the hand opened (False for a grasp
-            that did not hold it: the hand then opens where it is, above the table).
-        q_retreat: Joint targets of the pose straight above where the hand let go, through which the way home
-            passes.
-    """
-
-    rise: float
-    links_holding: tuple[str, ...]
-    on_table: bool
-    release_time: float
-    placed: bool
-    q_retreat: np.ndarray
 
 
 @dataclass(frozen=True)
@@ -191,7 +119,7 @@ class LineResult:
     p_touch: np.ndarray
 
 
-def _ik_verdict(results: list[IKResult]) -> tuple[bool, float, float]:
+def ik_verdict(results: list[IKResult]) -> tuple[bool, float, float]:
     """(all within IK_POSITION_TOLERANCE and IK_ORIENTATION_TOLERANCE, largest position error [m], largest
     orientation error [rad]) over IK results."""
     pos_err = max(r.position_error for r in results)
@@ -248,7 +176,7 @@ class LinePath:
         while len(self._q_ik) <= k:
             n = len(self._q_ik)
             q_init = self._q_ik[-1] if n < 2 else 2.0 * self._q_ik[-1] - self._q_ik[-2]  # extrapolated one spacing
-            result = self._executor._ik(self.p_start + self._s_ik[n] * self.direction, q_init, self._plan)
+            result = self._executor.ik(self.p_start + self._s_ik[n] * self.direction, q_init, self._plan)
             self.results.append(result)
             self._q_ik.append(result.q)
         return self._q_ik[k]
@@ -277,7 +205,7 @@ class MotionExecutor:
         self.kinematics = kinematics
         #: The palm of the arm that ``kinematics`` moves (in the scene with both arms, either arm's).
         self.palm_site = int(physics.model.site(kinematics.variant.palm_site).id)
-        self._palm = physics.data.site_xpos[self.palm_site]  # a view: the palm's position after each step
+        self.palm = physics.data.site_xpos[self.palm_site]  # a view: the palm's position after each step
         self._opt = physics.model.opt  # MuJoCo's options, read at every tick: the wrapper is made once
         self._tick_timestep, self._steps_per_tick = 0.0, 1  # the last timestep seen, and its steps per tick
         #: Velocity limit of every active joint [rad/s] (:mod:`affordance_env.motor_limits`) ...
@@ -301,7 +229,7 @@ class MotionExecutor:
         The posture does not depend on the interactions run before, so neither do the data; from it a pre-stroke
         pose anywhere in the placement region is 3-8 IK iterations away instead of 11-23 from home.
         """
-        result = self._ik(plan.p_start, self.physics.joint_targets(), plan)
+        result = self.ik(plan.p_start, self.physics.joint_targets(), plan)
         self.approach_posture = result.q
         return result
 
@@ -398,7 +326,7 @@ class MotionExecutor:
         Returns the remaining distance [m] (larger than ``tolerance`` if ``max_time`` [s] ran out).
         """
         def arrived() -> bool:
-            return float(np.linalg.norm(self._palm - p_world_target)) <= tolerance
+            return float(np.linalg.norm(self.palm - p_world_target)) <= tolerance
 
         if not arrived():
             q = self.physics.joint_targets()
@@ -407,9 +335,9 @@ class MotionExecutor:
                 self.physics.step(self.steps_per_tick)
                 if arrived():
                     break
-        return float(np.linalg.norm(self._palm - p_world_target))
+        return float(np.linalg.norm(self.palm - p_world_target))
 
-    def _ik(self, p: np.ndarray, q_init: np.ndarray, plan: StrokePlan | GraspPlan) -> IKResult:
+    def ik(self, p: np.ndarray, q_init: np.ndarray, plan: StrokePlan | GraspPlan) -> IKResult:
         """IK of a palm position with the plan's hand orientation (and joint ranges, if it has any)."""
         return self.kinematics.solve_ik(
             p, q_init, plan.R_world_hand, position_tolerance=1e-3, orientation_tolerance=IK_ORIENTATION_TOLERANCE,
@@ -426,7 +354,7 @@ class MotionExecutor:
         hand is within CONTACT_WATCH_DISTANCE of the object (the stroke: its first touch to the step).
         """
         physics = self.physics
-        palm = self._palm  # a view: the palm position after each step
+        palm = self.palm  # a view: the palm position after each step
         lead = physics.servo_lead
         n_steps = self.steps_per_tick
         dt = physics.model.opt.timestep
@@ -473,181 +401,6 @@ class MotionExecutor:
         q0 = self.physics.joint_targets() if q_start is None else q_start
         return LinePath(self, p_from, delta / length, length, orientation, speed, q0, **kwargs)
 
-    # --- the stroke --------------------------------------------------------------------------------------------
-    def plan_approach(self, plan: StrokePlan) -> tuple[IKResult | None, IKResult]:
-        """IK of the pose above the pre-stroke pose (None if the plan has none) and of the pre-stroke pose."""
-        # The pre-stroke pose first, the pose above it from there: the two differ by a short vertical move, so
-        # the descent (and the way up after the stroke) is a small joint motion, not a change of arm posture.
-        q_init = self.physics.joint_targets()  # the neck and the fingers keep their targets
-        if self.approach_posture is not None:
-            reach = self.kinematics.reach_dofs
-            q_init[reach] = self.approach_posture[reach]
-        start = self._ik(plan.p_start, q_init, plan)
-        above = None if plan.p_above is None else self._ik(plan.p_above, start.q, plan)
-        return above, start
-
-    def plan_stroke_path(self, plan: StrokePlan) -> tuple[IKResult | None, IKResult, LinePath]:
-        """The stroke's IK, solved before any move: the poses of :meth:`plan_approach` and the stroke's line."""
-        above, start = self.plan_approach(plan)
-        length = float(np.dot(plan.p_end - plan.p_start, plan.direction))
-        # The joint speeds along the whole line cap the stroke's speed.
-        path = LinePath(self, plan.p_start, plan.direction, length, plan, plan.speed, start.q, ramp=STROKE_RAMP,
-                        to_rest=False)
-        return above, start, path
-
-    def stroke_reachable(self, plan: StrokePlan) -> bool:
-        """Whether :meth:`stroke` will find every pose of ``plan`` within the IK's tolerances; kinematics only."""
-        _, start, path = self.plan_stroke_path(plan)
-        return _ik_verdict([start, *path.results])[0]
-
-    def stroke(self, plan: StrokePlan) -> StrokeOutcome:
-        """Reach, and stroke until contact plus follow-through (or full travel); not the way home."""
-        physics = self.physics
-        above, start, path = self.plan_stroke_path(plan)
-        p_object_before = physics.object_pose()[:3]
-        self.phase = "reach"
-        with self.stepping(self.free_timestep):  # the object rests and the hand moves in free space
-            self.move_through([start.q] if above is None else [above.q, start.q])  # through the pose above, if any
-            start_error = self.settle(plan.p_start)
-        object_moved = float(np.linalg.norm(physics.object_pose()[:3] - p_object_before))
-        p_hand_start = self._palm.copy()
-        self.phase = "stroke"
-        result = self.follow_line(path, physics.hand_touches_object, per_step=True,
-                                  follow_through=plan.follow_through)
-        travel = float(np.dot(self._palm.copy() - p_hand_start, plan.direction))
-        # The pose above the object is a via point that only has to clear it; the stroke itself must be exact.
-        return StrokeOutcome(*_ik_verdict([start, *path.results]), result.touched, result.time, result.speed,
-                             travel, start_error, object_moved, None if above is None else above.q, path.speed)
-
-    # --- the grasp ---------------------------------------------------------------------------------------------
-    def _with_hand(self, q: np.ndarray, hand: Mapping[str, float]) -> np.ndarray:
-        q = q.copy()
-        joints = self.kinematics.joint_names
-        for name, value in hand.items():
-            q[joints.index(name)] = value
-        return q
-
-    def _fingers(self, hand: Mapping[str, float], speed_scale: float = 1.0, until_held: bool = False) -> None:
-        """Move the driven finger joints to ``hand`` [rad] at ``speed_scale`` of their velocity limits, the arm
-        holding its targets. A finger that meets the object stops there and presses with its motor's torque; with
-        ``until_held`` the move ends once every driven finger joint is still and either there or pressing with
-        its motor's full torque (the closing of a hand that has stalled on what it holds)."""
-        physics = self.physics
-        q_to = self._with_hand(physics.joint_targets(), hand)
-        trajectory = minimum_jerk(physics.joint_targets(), [q_to], self.planned_speed * speed_scale,
-                                  CONTROL_DT, min_duration=MIN_MOVE_TIME)
-        fingers = np.array([self.kinematics.joint_names.index(name) for name in hand])
-        target = q_to[fingers]
-        limit = np.minimum(physics.torque_limit[fingers], CLOSING_TORQUE)
-
-        def held() -> bool:
-            q, qd, torque = physics.joint_positions(), physics.joint_velocities(), physics.joint_torques()
-            there = np.abs(q[fingers] - target) < FINGER_ARRIVED
-            pressing = np.abs(torque[fingers]) >= 0.98 * limit
-            return bool(np.all(np.abs(qd[fingers]) < FINGER_STALL_SPEED) and np.all(there | pressing))
-
-        if not until_held:
-            self.follow(trajectory)
-            return
-        physics.limit_torques(fingers, CLOSING_TORQUE)  # a light touch while the fingers close ...
-        try:
-            self.follow(trajectory, held)
-            # ... then the grip rises to the motors' full torque over GRASP_SQUEEZE_TIME, without a jolt
-            self.phase = "squeeze"
-            full = physics.torque_limit[fingers]
-            n = max(1, round(GRASP_SQUEEZE_TIME / CONTROL_DT))
-            for k in range(1, n + 1):
-                physics.limit_torques(fingers, CLOSING_TORQUE + (full - CLOSING_TORQUE) * k / n)
-                self.hold(CONTROL_DT)
-        finally:
-            physics.limit_torques(fingers, None)
-
-    def _grasp_poses(self, plan: GraspPlan) -> list[IKResult]:
-        """IK of the grasp's poses above the object, at the grasp and lifted, the hand open."""
-        q_open = self._with_hand(self.physics.joint_targets(), plan.hand_open)
-        results = [self._ik(plan.p_above, q_open, plan)]
-        for p in (plan.p_grasp, plan.p_lift):
-            results.append(self._ik(p, results[-1].q, plan))
-        return results
-
-    def grasp_reachable(self, plan: GraspPlan) -> bool:
-        """Whether :meth:`grasp` will find its poses within the IK's tolerances (above, at and down to the grasp,
-        the lift and the put-down beside); kinematics only."""
-        above, at, lifted = self._grasp_poses(plan)
-        descent = self.line(plan.p_above, plan.p_grasp, plan, GUARDED_SPEED, q_start=above.q)
-        lift = self.line(plan.p_grasp, plan.p_lift, plan, LIFT_SPEED, q_start=at.q)
-        place = self._ik(np.array([plan.p_place[0], plan.p_place[1], plan.p_grasp[2] + PLACE_APPROACH]), lifted.q,
-                         plan)
-        return _ik_verdict([above, at, lifted, *descent.results, *lift.results, place])[0]
-
-    def grasp(self, plan: GraspPlan) -> GraspOutcome:
-        """Reach above the object with the open hand, descend slowly until the hand touches it or is at the grasp
-        pose, close the hand, lift, hold; if the object is held, carry it beside and put it down until it rests on
-        the table; open the hand once the object rests. Not the way home, which rises first (``q_retreat``)."""
-        physics = self.physics
-        results = self._grasp_poses(plan)
-        z_start = float(physics.object_pose()[2])
-        # Reach: to above the object, fast, the hand open.
-        self.phase = "reach"
-        self.move_through([results[0].q])
-        self.settle(plan.p_above, tolerance=0.005)
-        # Descend: slowly, stopping at the first touch.
-        self.phase = "descend"
-        descent = self.line(plan.p_above, plan.p_grasp, plan, GUARDED_SPEED)
-        results += descent.results
-        touch = self.follow_line(descent, physics.hand_touches_object)
-        # Close: the fingers at the plan's share of their speed limit, until their motors' torque holds the object.
-        self.phase = "close"
-        self._fingers(plan.hand_closed, plan.close_speed, until_held=True)
-        self.phase = "lift"
-        p_from = self._palm.copy()
-        lift = self.line(p_from, p_from + (plan.p_lift - plan.p_grasp), plan, LIFT_SPEED)
-        results += lift.results
-        self.follow_line(lift)
-        self.phase = "hold"
-        self.hold(plan.hold_time)
-        rise = float(physics.object_pose()[2]) - z_start
-        holding = tuple(sorted(physics.links_touching_object()))
-        on_table = physics.object_touches_table()
-        held = rise > 0.5 * (plan.p_lift[2] - plan.p_grasp[2]) and bool(holding) and not on_table
-        placed = False
-        if held:  # carry it to above where it is put down: as high above the table as it was lifted
-            self.phase = "carry"
-            # where the object would touch the table, from how far it has risen with the hand
-            z_touch = float(self._palm[2]) - (float(physics.object_pose()[2]) - z_start)
-            p_carry = np.array([plan.p_place[0], plan.p_place[1], z_touch + PLACE_APPROACH])
-            carry = self._ik(p_carry, physics.joint_targets(), plan)
-            results.append(carry)
-            self.move_through([carry.q])
-            # Place: down until the object meets the table (sensed as the arm's load leaving it), then still until
-            # it rests. Fingertips curled under a small object meet the table first: the grip loosens to the
-            # closing's light touch, and the fingers yield and spread on the table as the hand goes on down.
-            self.phase = "place"
-            p_hand = self._palm.copy()
-            p_low = p_hand - np.array([0.0, 0.0, PLACE_APPROACH + PLACE_OVERTRAVEL])
-            down = self.line(p_hand, p_low, plan, GUARDED_SPEED)
-            placed = self.follow_line(down, lambda: physics.object_touches_table()
-                                      or physics.hand_touches_table()).touched and physics.object_touches_table()
-            if not placed:  # the fingers under the object met the table: they loosen and yield as the hand goes on
-                fingers = np.array([self.kinematics.joint_names.index(name) for name in plan.hand_closed])
-                physics.limit_torques(fingers, CLOSING_TORQUE)
-                p_hand = self._palm.copy()
-                on_down = self.line(p_hand, p_hand - np.array([0.0, 0.0, PLACE_OVERTRAVEL]), plan, GUARDED_SPEED)
-                placed = self.follow_line(on_down, physics.object_touches_table).touched
-                physics.limit_torques(fingers, None)
-            self.hold_still(also=_object_at_rest)
-        self.phase = "open"
-        # A held object the hand could not set down (the thumb under a small one met the table first) is let down
-        # slowly: the fingers open at a quarter of their speed, and it slides down them onto the table.
-        self._fingers(plan.hand_release, 1.0 if placed or not held else RELEASE_SPEED_SHARE)
-        self.hold_still(also=_object_at_rest)
-        release_time = float(physics.data.time)
-        # The way home rises first: straight up from where the hand let go.
-        p_up = self._palm.copy() + np.array([0.0, 0.0, plan.p_retreat[2] - plan.p_place[2]])
-        retreat = self._ik(p_up, physics.joint_targets(), plan)
-        return GraspOutcome(*_ik_verdict(results), touch.touched, touch.time, touch.speed, rise, holding,
-                            on_table, release_time, placed, retreat.q)
-
     # --- the way home ------------------------------------------------------------------------------------------
     def go_home(self, q_home: np.ndarray, via: np.ndarray | None = None) -> HomeOutcome:
         """Return to ``q_home`` through ``via`` (after :meth:`stroke`: up and back above the pre-stroke pose; after
@@ -674,11 +427,11 @@ class MotionExecutor:
         waited = self.move_through([q_home] if via is None else [via, q_home], until=watch(True))
         if waited:  # wait for the object to rest, then home through a pose above it
             self.phase = "wait"
-            self.hold(HOME_WAIT, until=lambda: _object_at_rest(physics) or not physics.object_on_table())
+            self.hold(HOME_WAIT, until=lambda: object_at_rest(physics) or not physics.object_on_table())
             self.phase = "home"
             q_now = physics.joint_targets()
             R_world_hand = self.kinematics.hand_pose(q_now).rotation  # straight up, the hand turned as it is
-            p_up = self._palm.copy() + np.array([0.0, 0.0, HOME_RAISE])
+            p_up = self.palm.copy() + np.array([0.0, 0.0, HOME_RAISE])
             q_up = self.kinematics.solve_ik(p_up, q_now, R_world_hand,
                                             orientation_tolerance=IK_ORIENTATION_TOLERANCE).q
             self.move_through([q_up, q_home], until=watch(False))
@@ -687,6 +440,6 @@ class MotionExecutor:
         return HomeOutcome(still, touched, waited)
 
 
-def _object_at_rest(physics: TapPhysics) -> bool:
+def object_at_rest(physics: TapPhysics) -> bool:
     """The object is still (:data:`~affordance_env.outcome.REST_SPEED`, ``REST_ANGULAR_SPEED``)."""
     return physics.object_speed() < REST_SPEED and physics.object_angular_speed() < REST_ANGULAR_SPEED

@@ -77,7 +77,9 @@ class EnvState:
     rng: dict[str, Any]
 
 
-def _object_at_rest(physics: TapPhysics) -> bool:
+def _object_still(physics: TapPhysics) -> bool:
+    """Still enough for a snapshot: REST_SPEED and REST_ANGULAR_SPEED, ten and thirty times stricter than the
+    outcome's rest (:func:`affordance_env.motion.object_at_rest`)."""
     return physics.object_speed() < REST_SPEED and physics.object_angular_speed() < REST_ANGULAR_SPEED
 
 
@@ -472,7 +474,7 @@ class TapAffordanceEnv(gym.Env):
         physics = self.physics
         with self.interaction.free_stepping(self.motion):
             attention = attend(physics, self.attention_camera, self.motion.move_joints)
-            still = self.motion.hold_still(also=_object_at_rest)
+            still = self.motion.hold_still(also=_object_still)
         self._q_home = physics.joint_targets()  # the arm's home, with the gaze on the object
         obs, features = self._snapshot()
         pose = physics.object_pose()
@@ -509,6 +511,46 @@ class TapAffordanceEnv(gym.Env):
         self.interaction = get_interaction(name)
         self.behavior = self.interaction.behavior
         self.motion.approach_posture = self._postures[name]
+
+    def observe(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
+        """Look at the object again where it is now, without placing a new one: attend to it, wait until the robot
+        and the object are still and take the initial snapshot of the next ``step``. Returns ``(obs, info)`` as
+        ``reset`` does (TapAffordanceGoal-v0 calls it after every interaction: the object stays)."""
+        return self._observe()
+
+    def take_over(self, other: TapAffordanceEnv) -> None:
+        """Continue the world of ``other``, an env of the same scene with another arm acting
+        (:meth:`TapPhysics.adopt <affordance_env.physics.TapPhysics.adopt>`: the object's state bit for bit, the
+        shared joints', the time), and its initial snapshot: the next ``step`` here acts on what ``other`` saw;
+        ``other`` needs a ``reset`` or a ``take_over`` before its next ``step``."""
+        self.physics.adopt(other.physics)
+        self._q_home = self.physics.joint_targets()
+        self._initial, other._initial = other._initial, None
+
+    def forget(self) -> None:
+        """Forget the object: the next ``step`` needs a ``reset`` (or :meth:`take_over`) first."""
+        self._initial = None
+
+    def feasible(self, params: Any, behavior: str | None = None, seen_by: TapAffordanceEnv | None = None) -> bool:
+        """Whether the arm can reach every pose of the interaction with ``params`` (``behavior``, one prepared in
+        this env, by default the current one) on the object where the last snapshot saw it (of ``seen_by``, an env
+        of the same scene, if given), from the kinematics alone: no physics step. False: ``step`` would fail with
+        ``"ik: ..."``."""
+        a = check_action(params)
+        name = self.behavior.name if behavior is None else behavior
+        if name not in self._postures:
+            raise ValueError(f"behavior {name!r} is not prepared in this env; prepared: {', '.join(self._postures)}.")
+        initial = (self if seen_by is None else seen_by)._initial
+        if initial is None:
+            raise RuntimeError("feasible() needs an object: call reset() first.")
+        interaction = get_interaction(name)
+        plan = interaction.plan(initial["geometry"], initial["pose"][:3], initial["yaw"], self.physics.table_top, a)
+        saved = self.motion.approach_posture
+        self.motion.approach_posture = self._postures[name]
+        try:
+            return bool(interaction.reachable(self.motion, plan))
+        finally:
+            self.motion.approach_posture = saved
 
     def get_state(self) -> EnvState:
         """A snapshot of the world and of the episode: the object and MuJoCo's state, what the initial snapshot

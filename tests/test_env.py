@@ -491,6 +491,19 @@ def test_position_range_workspace_spreads_objects_over_the_behaviours_workspace(
         assert info["ik"]["success"], (xy, info["failure"])
 
 
+def test_feasible_tells_from_the_kinematics_whether_the_step_will_reach():
+    env = TapAffordanceEnv(behavior="push", camera_width=32, camera_height=24)
+    for xy, reachable in (((-0.30, 0.0), True), ((-0.30, 0.30), False)):  # push cannot reach far to the left
+        env.reset(seed=0, options={"object_type": "box", "size": 0.06, "position": xy})
+        time = env.physics.data.time
+        assert env.feasible(np.zeros(3)) is reachable
+        assert env.physics.data.time == time  # no physics step
+        _, _, _, _, info = env.step(np.zeros(3, np.float32))
+        assert info["ik"]["success"] is reachable
+    with pytest.raises(ValueError, match="not prepared"):
+        env.feasible(np.zeros(3), behavior="grasp")
+
+
 def test_an_object_out_of_view_is_searched_for_and_seen():
     env = TapAffordanceEnv(behavior="grasp", camera_width=32, camera_height=24)
     # 26 cm to the robot's left: outside the view of the head's first gaze, inside the grasp's workspace

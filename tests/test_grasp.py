@@ -24,8 +24,8 @@ from affordance_env.behaviors import (
     grasp_orientation,
     plan_grasp,
 )
+from affordance_env.grasping import CLOSING_TORQUE, GUARDED_SPEED
 from affordance_env.kinematics import Kinematics
-from affordance_env.motion import CLOSING_TORQUE, GUARDED_SPEED
 from affordance_env.objects import object_geometry
 from affordance_env.robot_model import HAND_COUPLINGS, HAND_OPEN, coupled_position
 from affordance_env.scene import home_qpos

@@ -1,0 +1,93 @@
+"""The stroke of tap, tap_back and push: reach the pre-stroke pose, then a line of the palm through the object.
+
+The reach goes through the pose above the pre-stroke pose (when the plan has one), so the arm never sweeps across
+the object; the stroke is a Cartesian line turned into a joint trajectory by the arm's IK
+(:class:`~affordance_env.motion.LinePath`), its speed capped where a joint would exceed its velocity limit, and it
+is watched for the first touch at every physics step near the object. Its IK is solved before any move, so
+:func:`stroke_reachable` answers from the kinematics alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from affordance_env.behaviors import StrokePlan
+from affordance_env.kinematics import IKResult
+from affordance_env.motion import LinePath, MotionExecutor, ReachOutcome, ik_verdict
+
+#: The stroke reaches its speed in this time [s] from rest, within the first 3 cm (the clearance before the
+#: object) even at its fastest.
+STROKE_RAMP = 0.1
+
+
+@dataclass(frozen=True)
+class StrokeOutcome(ReachOutcome):
+    """What happened during a stroke (:class:`ReachOutcome` over the pre-stroke pose and the stroke line; the
+    first touch to the physics step).
+
+    Attributes:
+        hand_travel: Distance the palm travelled along the stroke direction [m].
+        start_error: Distance of the palm from the pre-stroke pose when the stroke started [m].
+        object_moved: How far the object moved before the stroke started (touched during the reach) [m].
+        q_withdraw: Joint targets of the pose above the pre-stroke pose, which the way home passes through so that
+            it never crosses the object; None if the plan has no such pose.
+        speed: Cruise speed of the palm along the stroke [m/s]: the plan's, or lower where a joint would have
+            exceeded its velocity limit.
+    """
+
+    hand_travel: float
+    start_error: float
+    object_moved: float
+    q_withdraw: np.ndarray | None
+    speed: float
+
+
+def plan_approach(motion: MotionExecutor, plan: StrokePlan) -> tuple[IKResult | None, IKResult]:
+    """IK of the pose above the pre-stroke pose (None if the plan has none) and of the pre-stroke pose."""
+    # The pre-stroke pose first, the pose above it from there: the two differ by a short vertical move, so
+    # the descent (and the way up after the stroke) is a small joint motion, not a change of arm posture.
+    q_init = motion.physics.joint_targets()  # the neck and the fingers keep their targets
+    if motion.approach_posture is not None:
+        reach = motion.kinematics.reach_dofs
+        q_init[reach] = motion.approach_posture[reach]
+    start = motion.ik(plan.p_start, q_init, plan)
+    above = None if plan.p_above is None else motion.ik(plan.p_above, start.q, plan)
+    return above, start
+
+
+def plan_stroke_path(motion: MotionExecutor, plan: StrokePlan) -> tuple[IKResult | None, IKResult, LinePath]:
+    """The stroke's IK, solved before any move: the poses of :func:`plan_approach` and the stroke's line."""
+    above, start = plan_approach(motion, plan)
+    length = float(np.dot(plan.p_end - plan.p_start, plan.direction))
+    # The joint speeds along the whole line cap the stroke's speed.
+    path = LinePath(motion, plan.p_start, plan.direction, length, plan, plan.speed, start.q, ramp=STROKE_RAMP,
+                    to_rest=False)
+    return above, start, path
+
+
+def stroke_reachable(motion: MotionExecutor, plan: StrokePlan) -> bool:
+    """Whether :func:`run_stroke` will find every pose of ``plan`` within the IK's tolerances; kinematics only."""
+    _, start, path = plan_stroke_path(motion, plan)
+    return ik_verdict([start, *path.results])[0]
+
+
+def run_stroke(motion: MotionExecutor, plan: StrokePlan) -> StrokeOutcome:
+    """Reach, and stroke until contact plus follow-through (or full travel); not the way home."""
+    physics = motion.physics
+    above, start, path = plan_stroke_path(motion, plan)
+    p_object_before = physics.object_pose()[:3]
+    motion.phase = "reach"
+    with motion.stepping(motion.free_timestep):  # the object rests and the hand moves in free space
+        motion.move_through([start.q] if above is None else [above.q, start.q])  # through the pose above, if any
+        start_error = motion.settle(plan.p_start)
+    object_moved = float(np.linalg.norm(physics.object_pose()[:3] - p_object_before))
+    p_hand_start = motion.palm.copy()
+    motion.phase = "stroke"
+    result = motion.follow_line(path, physics.hand_touches_object, per_step=True,
+                              follow_through=plan.follow_through)
+    travel = float(np.dot(motion.palm.copy() - p_hand_start, plan.direction))
+    # The pose above the object is a via point that only has to clear it; the stroke itself must be exact.
+    return StrokeOutcome(*ik_verdict([start, *path.results]), result.touched, result.time, result.speed,
+                         travel, start_error, object_moved, None if above is None else above.q, path.speed)
