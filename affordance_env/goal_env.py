@@ -106,7 +106,9 @@ class TapAffordanceGoalEnv(gym.Env):
     * v0: initial release.
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 30}
+    metadata = {"render_modes": ["rgb_array"], "render_fps": 30,
+                # a vector env resets it within the step that ends its episode: every vector step is an interaction
+                "autoreset_mode": gym.vector.AutoresetMode.SAME_STEP}
 
     def __init__(
         self,

@@ -45,10 +45,26 @@ def make_goal_env(**kwargs: Any) -> gym.Env:
     return TapAffordanceGoalEnv(**kwargs)
 
 
+def make_goal_vector_env(num_envs: int = 1, max_episode_steps: int = GOAL_MAX_EPISODE_STEPS,
+                         **kwargs: Any) -> gym.vector.VectorEnv:
+    """``gym.make_vec("TapAffordanceGoal-v0", num_envs)``: environments side by side in this process, each
+    truncated after ``max_episode_steps`` interactions and reset in the same vector step that ends its episode
+    (``AutoresetMode.SAME_STEP``, declared in the env's metadata; the episode's last observation and info are in
+    ``infos["final_obs"]`` and ``infos["final_info"]``), so that every vector step is an interaction."""
+    if isinstance(num_envs, bool) or not isinstance(num_envs, int) or num_envs < 1:
+        raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}.")
+
+    def make() -> gym.Env:
+        return gym.wrappers.TimeLimit(make_goal_env(**kwargs), max_episode_steps)
+
+    return gym.vector.SyncVectorEnv([make for _ in range(num_envs)], autoreset_mode=gym.vector.AutoresetMode.SAME_STEP)
+
+
 def register_envs() -> None:
     """Register ``TapAffordance-v1`` and ``TapAffordanceGoal-v0`` (idempotent)."""
     if GOAL_ENV_ID not in gym.registry:
         gym.register(id=GOAL_ENV_ID, entry_point="affordance_env.registration:make_goal_env",
+                     vector_entry_point="affordance_env.registration:make_goal_vector_env",
                      max_episode_steps=GOAL_MAX_EPISODE_STEPS)
     if ENV_ID not in gym.registry:
         gym.register(id=ENV_ID, entry_point="affordance_env.registration:make_tap_env",

@@ -181,3 +181,22 @@ def test_workspaces_sample_inside_themselves():
     assert not in_any_workspace(np.array([-0.7, 0.0]))  # far side of the table: out of every arm's reach
     with pytest.raises(ValueError, match="Unknown behavior"):
         in_workspace("kick", np.zeros(2))
+
+
+def test_every_vector_step_is_an_interaction():
+    envs = gym.make_vec("TapAffordanceGoal-v0", 2, camera_width=32, camera_height=24)
+    assert envs.metadata["autoreset_mode"] == gym.vector.AutoresetMode.SAME_STEP
+    envs.reset(seed=0)
+    ended = 0
+    for _ in range(6):  # more than an episode's 5 interactions: each env ends one and starts the next
+        actions = {"behavior": np.array([0, 2]), "params": np.zeros((2, 3), np.float32)}
+        obs, rewards, terminated, truncated, infos = envs.step(actions)
+        done = terminated | truncated
+        if done.any():  # the episode's last interaction, and already the next episode's first observation
+            assert list(infos["final_info"]["behavior"][done]) == list(np.array(["tap", "push"])[done])
+        if (~done).any():
+            assert list(infos["behavior"][~done]) == list(np.array(["tap", "push"])[~done])
+        ended += int(done.sum())
+        assert obs["desired_goal"].shape == (2, 2)
+    assert ended >= 2  # truncated after 5 at the latest
+    envs.close()
