@@ -73,3 +73,11 @@ def test_datasets_made_before_env_id_and_position_range_resume(tmp_path):
     assert len(load_dataset(out)) + len(load_dataset(out).attrs["failures"]) == 4
     with pytest.raises(ValueError, match="position_range"):
         collect(out, 4, **{**run, "env_options": {**SMALL, "position_range": "workspace"}})
+
+
+def test_the_minari_export_refuses_goal_episodes_with_a_reason(goal_dir):
+    pytest.importorskip("minari")
+    from affordance_env.dataset.minari_export import export_minari
+
+    with pytest.raises(ValueError, match="holds TapAffordanceGoal-v0 episodes"):
+        export_minari(goal_dir, "tap-affordance/goal-v0")

@@ -38,7 +38,7 @@ from typing import Any
 
 import numpy as np
 
-from affordance_env.dataset.format import GROUND_TRUTH_COLUMNS, POSE_FIELDS, STAGES
+from affordance_env.dataset.format import GROUND_TRUTH_COLUMNS, POSE_FIELDS, STAGES, DatasetError, is_goal_dataset
 from affordance_env.dataset.load import images, load_dataset
 from affordance_env.features import FEATURE_NAMES
 
@@ -148,6 +148,10 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
                          f"`minari delete {dataset_id}` (or remove that directory) or choose another id.")
     frame = load_dataset(dataset, with_images=True)
     manifest = frame.attrs["manifest"]
+    if is_goal_dataset(manifest):
+        raise DatasetError(f"{dataset} holds TapAffordanceGoal-v0 episodes; the Minari export writes one "
+                           "TapAffordance-v1 episode per interaction and does not take goal episodes: read them "
+                           "with load_dataset (a row per interaction, with 'episode' and 'step').")
     options = manifest["settings"]["env_options"]
     with_images = bool(manifest["settings"].get("save_images"))
     stages = {stage: frame[[f"{stage}_{n}" for n in FEATURE_NAMES]].to_numpy(np.float32) for stage in STAGES}
