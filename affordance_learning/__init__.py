@@ -32,8 +32,8 @@ from affordance_learning.som import SOMClustering
 
 #: Names loaded on first use, so that ``import affordance_learning`` stays light (no matplotlib).
 _LAZY = {
-    "make_synthetic_frame": "affordance_learning.experiment",
-    "run_protocol": "affordance_learning.experiment",
+    "make_synthetic_frame": "affordance_learning.synthetic",
+    "run_protocol": "affordance_learning.protocol",
     "write_figures": "affordance_learning.figures",
     "write_report": "affordance_learning.report",
 }

@@ -31,6 +31,26 @@ NOT_COMPUTABLE = "not computable"
 _ROLLING = ("sphere", "horizontal_cylinder")
 _RESTING = ("box", "vertical_cylinder")
 
+# Each rule's thresholds, one value read by the check and written into the rule's text.
+#: The tap's average uniformity is above this [%].
+TAP_UNIFORMITY = 80.0
+#: A trend counts at a Spearman rank correlation of at least this (uniformity rising with k), or of at most minus
+#: this (accuracy falling with k).
+TREND_RHO = 0.5
+#: The highest mean uniformity over k reaches at least this [%] (the paper: "up to 95 %").
+UNIFORMITY_PEAK = 90.0
+#: A group of features dominates the selection when its share is above this [%].
+DOMINANT_SHARE = 50.0
+#: The number of selected features is constant in k from this k on, within this coefficient of variation.
+CONSTANT_FROM_K, CONSTANT_CV = 4, 0.15
+#: In the 1 x 2 map every type has at least this share of its objects in its majority cluster, and each cluster
+#: spans at least this share of the range of object sizes.
+TYPE_SHARE, SIZE_SPAN = 0.75, 0.75
+#: Accuracy at r = 0, 0.2 and 0.4 is alike within this many percentage points ...
+ALIKE_POINTS = 2.0
+#: ... and the best r is the largest within this many points of the best accuracy: the paper's 0.4.
+BEST_R_POINTS, BEST_R = 1.0, 0.4
+
 
 @dataclass(frozen=True)
 class Claim:
@@ -112,7 +132,7 @@ def _uniformity_curve(results: Mapping[str, Any]) -> tuple[list[int], np.ndarray
 
 def _uniformity_average(results: Mapping[str, Any]) -> tuple[str, bool]:
     ks, u = _uniformity_curve(results)
-    return f"mean over k = {ks[0]}..{ks[-1]}: {u.mean():.1f} % (per k: {_fmt(u)})", bool(u.mean() > 80.0)
+    return f"mean over k = {ks[0]}..{ks[-1]}: {u.mean():.1f} % (per k: {_fmt(u)})", bool(u.mean() > TAP_UNIFORMITY)
 
 
 def _uniformity_rises(results: Mapping[str, Any]) -> tuple[str, bool]:
@@ -122,14 +142,14 @@ def _uniformity_rises(results: Mapping[str, Any]) -> tuple[str, bool]:
         return f"U is {u[0]:.1f} % for every k: no rise (rho taken as 0)", False
     return (
         f"Spearman rho(k, U) = {rho:+.2f}; U from {u[0]:.1f} % (k = {ks[0]}) to {u[-1]:.1f} % (k = {ks[-1]})",
-        rho >= 0.5,
+        rho >= TREND_RHO,
     )
 
 
 def _uniformity_peak(results: Mapping[str, Any]) -> tuple[str, bool]:
     ks, u = _uniformity_curve(results)
     best = int(np.argmax(u))
-    return f"highest mean uniformity {u[best]:.1f} % at k = {ks[best]}", bool(u[best] >= 90.0)
+    return f"highest mean uniformity {u[best]:.1f} % at k = {ks[best]}", bool(u[best] >= UNIFORMITY_PEAK)
 
 
 def _by_r(results: Mapping[str, Any], key: str) -> dict[float, tuple[list[int], np.ndarray]]:
@@ -146,7 +166,7 @@ def _group_dominates(results: Mapping[str, Any], group: str) -> tuple[str, bool]
     if not positive:
         raise _Missing("no relevancy r > 0")
     text = f"mean {group} share over k: " + ", ".join(f"r = {r}: {m:.0f} %" for r, m in means.items())
-    return text, all(m > 50.0 for m in positive.values())
+    return text, all(m > DOMINANT_SHARE for m in positive.values())
 
 
 def _shape_dominates(results: Mapping[str, Any]) -> tuple[str, bool]:
@@ -181,13 +201,13 @@ def _count_constant_in_k(results: Mapping[str, Any]) -> tuple[str, bool]:
     curves = _by_r(results, "n_selected")
     parts, ok = [], True
     for r, (ks, values) in sorted(curves.items()):
-        upper = np.array([v for k, v in zip(ks, values, strict=True) if k >= 4])
+        upper = np.array([v for k, v in zip(ks, values, strict=True) if k >= CONSTANT_FROM_K])
         if upper.size < 2:
-            raise _Missing("fewer than 2 values of k >= 4")
+            raise _Missing(f"fewer than 2 values of k >= {CONSTANT_FROM_K}")
         cv = float(upper.std() / upper.mean()) if upper.mean() > 0 else 0.0
         parts.append(f"r = {r}: {_fmt(upper)} (CV {cv:.2f})")
-        ok &= cv <= 0.15
-    return "number for k >= 4 per r: " + "; ".join(parts), ok
+        ok &= cv <= CONSTANT_CV
+    return f"number for k >= {CONSTANT_FROM_K} per r: " + "; ".join(parts), ok
 
 
 def _case(results: Mapping[str, Any], k: int) -> list[Mapping[str, Any]]:
@@ -214,7 +234,7 @@ def _two_cluster_types(results: Mapping[str, Any]) -> tuple[str, bool]:
     rolling = {home[t] for t in _ROLLING}
     resting = {home[t] for t in _RESTING}
     ok = len(rolling) == 1 and len(resting) == 1 and rolling != resting
-    ok = ok and all(share[t] >= 0.75 for t in _ROLLING + _RESTING)
+    ok = ok and all(share[t] >= TYPE_SHARE for t in _ROLLING + _RESTING)
     shares = ", ".join(f"{t} {100 * share[t]:.0f} %" for t in _ROLLING + _RESTING)
     return f"{table} (share of each type in its majority cluster: {shares})", bool(ok)
 
@@ -232,7 +252,7 @@ def _two_cluster_sizes(results: Mapping[str, Any]) -> tuple[str, bool]:
         "the size range)"
         for c, f in zip(clusters, cover, strict=True)
     )
-    return text, len(clusters) == 2 and all(f >= 0.75 for f in cover)
+    return text, len(clusters) == 2 and all(f >= SIZE_SPAN for f in cover)
 
 
 def _four_cluster_split(results: Mapping[str, Any]) -> tuple[str, bool]:
@@ -250,7 +270,7 @@ def _accuracy_falls(results: Mapping[str, Any]) -> tuple[str, bool]:
     curves = _by_r(results, "svm_accuracy")
     rhos = {r: _rho(ks, v) for r, (ks, v) in sorted(curves.items())}
     text = "Spearman rho(k, accuracy): " + ", ".join(f"r = {r}: {rho:+.2f}" for r, rho in rhos.items())
-    return text, all(rho <= -0.5 for rho in rhos.values())
+    return text, all(rho <= -TREND_RHO for rho in rhos.values())
 
 
 def _bump_at_four(results: Mapping[str, Any]) -> tuple[str, bool]:
@@ -274,25 +294,26 @@ def _low_r_alike(results: Mapping[str, Any]) -> tuple[str, bool]:
         raise _Missing("fewer than 2 of r = 0, 0.2, 0.4")
     spread = 100 * (max(low.values()) - min(low.values()))
     text = ", ".join(f"r = {r}: {100 * a:.1f} %" for r, a in sorted(low.items()))
-    return f"mean accuracy over k: {text} (spread {spread:.1f} points)", spread <= 2.0
+    return f"mean accuracy over k: {text} (spread {spread:.1f} points)", spread <= ALIKE_POINTS
 
 
 def _best_r(results: Mapping[str, Any]) -> tuple[str, bool]:
     accuracy = _accuracy_by_r(results)
     counts = {r: float(v.mean()) for r, (_, v) in _by_r(results, "n_selected").items()}
     top = max(accuracy.values())
-    near = [r for r, a in accuracy.items() if a >= top - 0.01]
+    near = [r for r, a in accuracy.items() if a >= top - BEST_R_POINTS / 100]
     choice = max(near)
     text = ", ".join(
         f"r = {r}: {100 * accuracy[r]:.1f} % with {counts.get(r, float('nan')):.1f} features"
         for r in sorted(accuracy)
     )
-    return f"{text}; fewest features within 1 point of the best accuracy: r = {choice}", choice == 0.4
+    return (f"{text}; fewest features within {BEST_R_POINTS:g} point(s) of the best accuracy: r = {choice}",
+            choice == BEST_R)
 
 
 # --- the grasp ----------------------------------------------------------------------------------------------
 #: The grasp's average uniformity: above the paper's 70 % and not above the tap's 80 %, which it sets apart.
-GRASP_UNIFORMITY = (70.0, 80.0)
+GRASP_UNIFORMITY = (70.0, TAP_UNIFORMITY)
 #: A 1 x 3 category straddles the critical size when at least this share of its objects lies on each side
 #: of it, and at least this share of its members has its less common outcome.
 STRADDLE_SHARE = 0.2
@@ -371,13 +392,13 @@ _Spec = tuple[str, str, str, _Judge]
 _UNIFORMITY_RISES: _Spec = (
     "Uniformity rises with k",
     "Uniformity of clusters increases with the number of clusters.",
-    "Spearman rank correlation of k and mean uniformity >= 0.5",
+    f"Spearman rank correlation of k and mean uniformity >= {TREND_RHO}",
     _uniformity_rises,
 )
 _UNIFORMITY_PEAK: _Spec = (
     "Uniformity peak",
     "It can reach up to 95 %.",
-    "highest mean uniformity over k >= 90 %",
+    f"highest mean uniformity over k >= {UNIFORMITY_PEAK:.0f} %",
     _uniformity_peak,
 )
 _FEWER_FEATURES: _Spec = (
@@ -389,13 +410,13 @@ _FEWER_FEATURES: _Spec = (
 _NUMBER_CONSTANT: _Spec = (
     "Number constant in k",
     "The number of selected features remains the same above some number of clusters.",
-    "for every r, the coefficient of variation over k >= 4 of the mean number <= 0.15",
+    f"for every r, the coefficient of variation over k >= {CONSTANT_FROM_K} of the mean number <= {CONSTANT_CV}",
     _count_constant_in_k,
 )
 _ACCURACY_FALLS: _Spec = (
     "SVM accuracy falls with k",
     "SVM prediction accuracy decreases as the number of effect categories grows.",
-    "for every r, Spearman rank correlation of k and mean accuracy <= -0.5",
+    f"for every r, Spearman rank correlation of k and mean accuracy <= {-TREND_RHO}",
     _accuracy_falls,
 )
 
@@ -438,8 +459,8 @@ GRASP_CLAIMS: tuple[_Spec, ...] = (
     (
         "Size features dominate",
         "The grasping behaviour is affected mostly by the size of the object to be grasped.",
-        "for every r > 0, the mean over k of the size share of the selected features > 50 % (18 of the 49 "
-        "features are size features)",
+        f"for every r > 0, the mean over k of the size share of the selected features > {DOMINANT_SHARE:.0f} % "
+        "(18 of the 49 features are size features)",
         _size_dominates,
     ),
     _FEWER_FEATURES,
@@ -451,7 +472,7 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
     (
         "Uniformity on average",
         "The average uniformity is above 80 % for tapping.",
-        "mean over k of the mean uniformity > 80 %",
+        f"mean over k of the mean uniformity > {TAP_UNIFORMITY:.0f} %",
         _uniformity_average,
     ),
     _UNIFORMITY_RISES,
@@ -459,7 +480,7 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
     (
         "Shape features dominate",
         "Shape features dominate the selected features.",
-        "for every r > 0, the mean over k of the shape share of the selected features > 50 %",
+        f"for every r > 0, the mean over k of the shape share of the selected features > {DOMINANT_SHARE:.0f} %",
         _shape_dominates,
     ),
     (
@@ -475,13 +496,13 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
         "One cluster holds spheres and horizontal cylinders (rollable), the other boxes and "
         "vertical cylinders.",
         "spheres and lying cylinders share a majority cluster, boxes and standing cylinders the "
-        "other, each type with >= 75 % of its objects there (first trial)",
+        f"other, each type with >= {100 * TYPE_SHARE:.0f} % of its objects there (first trial)",
         _two_cluster_types,
     ),
     (
         "1 x 2 map: sizes",
         "Both clusters have instances from the whole size range.",
-        "each of the 2 clusters spans >= 75 % of the range of object sizes (first trial)",
+        f"each of the 2 clusters spans >= {100 * SIZE_SPAN:.0f} % of the range of object sizes (first trial)",
         _two_cluster_sizes,
     ),
     (
@@ -500,13 +521,13 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
     (
         "r = 0, 0.2, 0.4 alike",
         "Accuracy is almost the same for relevancy values of 0 %, 20 % and 40 %.",
-        "mean accuracy over k of these r within 2 percentage points",
+        f"mean accuracy over k of these r within {ALIKE_POINTS:g} percentage points",
         _low_r_alike,
     ),
     (
         "r = 0.4 best",
         "40 % is the best relevancy: maximum accuracy with the highest perceptual economy.",
-        "the largest r whose mean accuracy over k is within 1 point of the best r's is 0.4",
+        f"the largest r whose mean accuracy over k is within {BEST_R_POINTS:g} point of the best r's is {BEST_R}",
         _best_r,
     ),
 )
@@ -543,7 +564,7 @@ def evaluate_claims(results: Mapping[str, Any], behavior: str | None = None) -> 
     """The paper's claims on a behaviour with our numbers and a verdict computed from them.
 
     Args:
-        results: The dict of :func:`affordance_learning.experiment.run_protocol` (or its JSON), or part of it.
+        results: The dict of :func:`affordance_learning.protocol.run_protocol` (or its JSON), or part of it.
         behavior: Whose claims to check; by default the results' own (:func:`results_behavior`).
     """
     results = current_results(results)

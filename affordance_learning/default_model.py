@@ -152,7 +152,7 @@ def train_default_model(
     Raises:
         ValueError: An unknown behaviour, a frame of another behaviour or of several, or missing columns.
     """
-    from affordance_learning.experiment import frame_behavior
+    from affordance_learning.schema import frame_behavior
 
     path = user_model_path(behavior) if path is None else path
     frame_behavior(df, check_behavior(behavior))

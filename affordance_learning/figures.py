@@ -287,7 +287,7 @@ def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: boo
     """Write the figures of a results dict into ``out_dir`` (created if needed); returns their paths.
 
     Args:
-        results: The dict returned by :func:`affordance_learning.experiment.run_protocol` (or read back from
+        results: The dict returned by :func:`affordance_learning.protocol.run_protocol` (or read back from
             its JSON).
         out_dir: Directory for the PNG files.
         progress: Draw a progress bar over the figures; None: a bar on a terminal, else a line every 10 s.

@@ -218,7 +218,7 @@ def write_report(results: Mapping[str, Any], out_dir: str | Path) -> Path:
     """Write ``REPORT.md`` into ``out_dir`` (created if needed), linking the PNG figures found there.
 
     Args:
-        results: The dict returned by :func:`affordance_learning.experiment.run_protocol` (or its JSON).
+        results: The dict returned by :func:`affordance_learning.protocol.run_protocol` (or its JSON).
         out_dir: Output directory.
 
     Returns:
@@ -305,7 +305,7 @@ def write_overview(runs: Mapping[str, Mapping[str, Any]], out_dir: str | Path) -
     with their verdicts, and links to its report and figures in ``out_dir/<behavior>/``.
 
     Args:
-        runs: The results dict of each behaviour (:func:`affordance_learning.experiment.run_protocol`), by
+        runs: The results dict of each behaviour (:func:`affordance_learning.protocol.run_protocol`), by
             behaviour, in the order to show them.
         out_dir: Output directory, holding one directory per behaviour.
 

@@ -6,7 +6,7 @@ and grasping. For each behaviour asked (by default :data:`DEFAULT_BEHAVIORS`), i
 1. Collect (or reuse) ``episodes`` canonical interactions with :func:`affordance_env.dataset.collect` into
    ``out/<behavior>/dataset`` (or the directory given for that behaviour); the dataset is resumable, so an
    interrupted run continues where it stopped, and a finished one is reused.
-2. Run the learning protocol (:func:`affordance_learning.experiment.run_protocol`) over k = 2..10 clusters and
+2. Run the learning protocol (:func:`affordance_learning.protocol.run_protocol`) over k = 2..10 clusters and
    relevancy r in {0, 0.2, 0.4, 0.6, 0.8}, ``trials`` times.
 3. Write ``results.json``, the figures and ``REPORT.md``.
 
@@ -126,8 +126,8 @@ def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: 
     """Collect, learn and report one behaviour into ``out/<behavior>``; returns its results."""
     from affordance_env.dataset import collect, failure_summary, load_dataset
     from affordance_env.dataset.fingerprint import fingerprint
-    from affordance_learning.experiment import run_protocol
     from affordance_learning.figures import write_figures
+    from affordance_learning.protocol import run_protocol
     from affordance_learning.report import write_report
 
     where = out / behavior

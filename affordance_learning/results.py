@@ -1,4 +1,4 @@
-"""The results of :func:`~affordance_learning.experiment.run_protocol`: their format and units, and the
+"""The results of :func:`~affordance_learning.protocol.run_protocol`: their format and units, and the
 reading of older ones.
 
 Units (:data:`UNITS`, also written into every results dict as ``config["units"]``): every share is a fraction

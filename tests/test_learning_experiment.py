@@ -11,8 +11,9 @@ import pandas as pd
 import pytest
 
 from affordance_learning import run_protocol, write_figures, write_report
-from affordance_learning.experiment import feature_groups, feature_names, make_synthetic_frame
 from affordance_learning.report import AGREES, DISAGREES, NOT_COMPUTABLE, evaluate_claims, write_overview
+from affordance_learning.schema import feature_groups, feature_names
+from affordance_learning.synthetic import make_synthetic_frame
 
 KS = (2, 3, 4)
 RS = (0.0, 0.4)

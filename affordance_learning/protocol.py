@@ -1,4 +1,4 @@
-"""The paper's experiment on a dataset of interactions: uniformity, selected features, SVM accuracy.
+"""The paper's protocol on a dataset of interactions: uniformity, selected features, SVM accuracy.
 
 Akgun et al. 2009, section V, on a pandas DataFrame in the project's dataset schema: for each feature name
 (``affordance_env.features.FEATURE_NAMES``) the columns ``initial_<name>``, ``final_<name>`` and
@@ -32,14 +32,11 @@ over fewer k gives the same numbers for those k), and the results are gathered i
 not depend on ``n_jobs``. Means and standard deviations (population, ddof = 0) are over trials.
 
 Besides, once over all rows: how success depends on object size (:func:`affordance_learning.metrics.size_success`,
-the grasp's critical size) and what the effects contain (:func:`effect_summary`).
+the grasp's critical size) and what the effects contain (:func:`affordance_learning.diagnostics.effect_summary`).
 
-:func:`make_synthetic_frame` builds a frame in the same schema without the simulator (for tests, benchmarks
-and demonstrations): taps, where spheres and lying cylinders roll and boxes and standing cylinders do not, or
-grasps, where objects smaller than a critical size are held and larger ones are not.
+:func:`affordance_learning.synthetic.make_synthetic_frame` builds a frame in the same schema without the
+simulator.
 """
-
-from __future__ import annotations
 
 import numbers
 from collections.abc import Iterable, Sequence
@@ -53,73 +50,19 @@ from sklearn.model_selection import train_test_split
 from sklearn.preprocessing import StandardScaler
 
 from affordance_learning.behaviors import ROLLED_IS_SUCCESS, outcome_words
+from affordance_learning.diagnostics import effect_summary
 from affordance_learning.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
 from affordance_learning.model import _check_int, select_features
 from affordance_learning.relieff import MULTICLASS_THRESHOLD, ReliefFScorer
 from affordance_learning.results import RESULTS_FORMAT, UNITS
+from affordance_learning.schema import OBJECT_TYPES, feature_groups, feature_names, frame_behavior, label_column
 from affordance_learning.som import SOMClustering
 from affordance_learning.validation import first_non_finite
 
-#: The object types of the paper, in the order figures and case studies list them.
-OBJECT_TYPES = ("sphere", "horizontal_cylinder", "box", "vertical_cylinder")
-#: Feature groups and their sizes in the order of ``FEATURE_NAMES`` (paper, section III.B).
-GROUP_SIZES = (("shape", 24), ("size", 18), ("relation", 7))
 DEFAULT_KS = tuple(range(2, 11))
 DEFAULT_RELEVANCIES = (0.0, 0.2, 0.4, 0.6, 0.8)
 #: Map sizes whose clusters are described: the paper's tap case studies (k = 2, 4) and the grasp's k = 3.
 CASE_STUDY_KS = (2, 3, 4)
-#: Columns a frame's success/fail label can come from, in order of preference.
-LABEL_COLUMNS = ("success", "rolled")
-
-
-def feature_names(frame: pd.DataFrame) -> list[str]:
-    """Names of the features of a dataset frame.
-
-    ``affordance_env.features.FEATURE_NAMES`` when the frame has ``initial_<name>`` and ``effect_<name>``
-    for all of them; otherwise every name with both columns, in the frame's column order.
-    """
-    columns = set(frame.columns)
-    try:
-        from affordance_env.features import FEATURE_NAMES
-    except ImportError:
-        FEATURE_NAMES = ()
-    if FEATURE_NAMES and all(f"initial_{n}" in columns and f"effect_{n}" in columns for n in FEATURE_NAMES):
-        return list(FEATURE_NAMES)
-    names = [
-        c.removeprefix("initial_") for c in frame.columns if isinstance(c, str) and c.startswith("initial_")
-    ]
-    if not names:
-        raise ValueError(
-            "the frame has no initial_<name> columns; expected the dataset schema (initial_, final_, effect_ "
-            f"columns per feature), got columns {list(frame.columns)[:8]}..."
-        )
-    missing = [f"effect_{n}" for n in names if f"effect_{n}" not in columns]
-    if missing:
-        raise ValueError(f"the frame lacks effect columns {missing[:5]} for its initial_ columns.")
-    return names
-
-
-def feature_groups(names: Sequence[str]) -> list[str]:
-    """Group ("shape", "size" or "relation") of every feature name.
-
-    From ``affordance_env.features.FEATURE_GROUPS`` when it knows every name; otherwise, for 49 features, by
-    position (the first 24 shape, the next 18 size, the last 7 relation, as in the paper).
-    """
-    try:
-        from affordance_env.features import FEATURE_GROUPS
-    except ImportError:
-        FEATURE_GROUPS = {}
-    if all(n in FEATURE_GROUPS for n in names):
-        return [FEATURE_GROUPS[n] for n in names]
-    total = sum(size for _, size in GROUP_SIZES)
-    if len(names) != total:
-        unknown = [n for n in names if n not in FEATURE_GROUPS]
-        raise ValueError(
-            f"cannot tell the group of features {unknown[:5]}: they are not in affordance_env's "
-            f"FEATURE_GROUPS and there are {len(names)} features, not the paper's {total} (24 shape, "
-            "18 size, 7 relation)."
-        )
-    return [group for group, size in GROUP_SIZES for _ in range(size)]
 
 
 @dataclass(frozen=True)
@@ -137,50 +80,6 @@ class _Data:
     left_view: np.ndarray  # (n,) bool: the object was not seen in the final snapshot (left the view or the table)
     effect_mean: np.ndarray  # (d,) the standardisation of the effects, to turn prototypes back into units
     effect_scale: np.ndarray  # (d,)
-
-
-def label_column(frame: pd.DataFrame) -> str:
-    """The column of a frame that holds its success/fail labels: ``success``, else ``rolled`` (frames made
-    before the label existed); raises ValueError when it has neither."""
-    for column in LABEL_COLUMNS:
-        if column in frame.columns:
-            return column
-    raise ValueError(
-        "the frame has no 'success' column (nor 'rolled', the tap's label in frames without it): the "
-        "success/fail labels the protocol evaluates against."
-    )
-
-
-def frame_behavior(frame: pd.DataFrame, behavior: str | None = None) -> str:
-    """The one behaviour of a frame's interactions, from its ``behavior`` column.
-
-    Args:
-        frame: A dataset frame.
-        behavior: The behaviour the caller expects; needed when the frame has no ``behavior`` column, and
-            checked against it when it has one.
-
-    Raises:
-        ValueError: The frame mixes behaviours, holds another behaviour than ``behavior``, or has no
-            ``behavior`` column and ``behavior`` is None.
-    """
-    if behavior is not None and (not isinstance(behavior, str) or not behavior):
-        raise ValueError(f"behavior must be a behaviour name such as 'tap', got {behavior!r}.")
-    if "behavior" not in frame.columns:
-        if behavior is None:
-            raise ValueError(
-                "the frame has no 'behavior' column; pass the behaviour of its interactions (behavior='tap', "
-                "'grasp', ...)."
-            )
-        return behavior
-    found = sorted(pd.unique(frame["behavior"].astype(str)).tolist())
-    if len(found) != 1:
-        raise ValueError(
-            f"the frame mixes the behaviours {found}; the model learns one behaviour at a time (a separate "
-            "map and SVM per behaviour): select one, e.g. frame[frame['behavior'] == 'tap']."
-        )
-    if behavior is not None and found[0] != behavior:
-        raise ValueError(f"the frame holds {found[0]!r} interactions, not {behavior!r} ones.")
-    return found[0]
 
 
 def _frame_data(frame: pd.DataFrame) -> _Data:
@@ -544,198 +443,3 @@ def run_protocol(
             "units": UNITS,
         },
     }
-
-
-def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:
-    """What the effects of a dataset contain, for a reader to check before any verdict.
-
-    Per object type (``by_type``): interactions, the shares of successes (the ``success`` label, or
-    ``rolled`` for a frame without it), at rest and seen in the final snapshot (``visible_final``), and left
-    the table (``outcome == "off_table"``); the median travel (``displacement``) [m], the median 3-D motion
-    seen, ``|effect of (mean_x, mean_y, mean_z)|`` [m], over the objects seen at the end, the median
-    ``|effect of pixel_count|`` [pixels] and the median change of the normal histograms (sum of ``|effect|``
-    over the 24 shape features). Overall: the share of successes whose object is seen at the end
-    (``success_visible``; at rest and seen: ``success_rest_visible``), the share of successes whose effect is
-    just minus their initial features (``success_effect_is_minus_initial``: the object vanished), and the
-    Spearman correlation of the travel with the 3-D motion seen (``travel_vs_seen_motion``). Columns the frame
-    lacks give None.
-    """
-    names = feature_names(frame)
-    groups = feature_groups(names)
-    xyz = [f"effect_{n}" for n in ("mean_x", "mean_y", "mean_z") if n in names]
-    seen_motion = (np.linalg.norm(frame[xyz].to_numpy(dtype=np.float64), axis=1) if len(xyz) == 3
-                   else np.full(len(frame), np.nan))
-    shape_change = np.abs(frame[[f"effect_{n}" for n, g in zip(names, groups, strict=True) if g == "shape"]]
-                          .to_numpy(dtype=np.float64)).sum(axis=1)
-    initial = frame[[f"initial_{n}" for n in names]].to_numpy(dtype=np.float64)
-    effect = frame[[f"effect_{n}" for n in names]].to_numpy(dtype=np.float64)
-    vanished = np.abs(effect + initial).max(axis=1) < 1e-6
-    visible = frame["visible_final"].to_numpy(dtype=bool) if "visible_final" in frame else None
-    outcome = frame["outcome"].astype(str).to_numpy() if "outcome" in frame else None
-    travel = frame["displacement"].to_numpy(dtype=np.float64) if "displacement" in frame else None
-    success = frame[label_column(frame)].to_numpy(dtype=bool)
-    pixels = (np.abs(frame["effect_pixel_count"].to_numpy(dtype=np.float64)) if "pixel_count" in names
-              else np.full(len(frame), np.nan))
-
-    def share(mask: np.ndarray | None, rows: np.ndarray) -> float | None:
-        return None if mask is None or not rows.any() else float(np.mean(mask[rows]))
-
-    def median(values: np.ndarray | None, rows: np.ndarray) -> float | None:
-        if values is None or not rows.any():
-            return None
-        finite = values[rows][np.isfinite(values[rows])]
-        return float(np.median(finite)) if finite.size else None
-
-    types = frame["type"].astype(str).to_numpy()
-    by_type = {}
-    for t in [t for t in OBJECT_TYPES if t in set(types)] + sorted(set(types) - set(OBJECT_TYPES)):
-        rows = types == t
-        seen = rows & visible if visible is not None else rows
-        by_type[t] = {
-            "n": int(rows.sum()),
-            "success": share(success, rows),
-            "rest": share(None if outcome is None else outcome == "rest", rows),
-            "visible_final": share(visible, rows),
-            "off_table": share(None if outcome is None else outcome == "off_table", rows),
-            "displacement": median(travel, rows),
-            "seen_motion": median(seen_motion, seen),
-            "pixel_count_change": median(pixels, rows),
-            "shape_change": median(shape_change, rows),
-        }
-    correlation = None
-    if travel is not None and visible is not None and visible.sum() >= 3:
-        from scipy.stats import spearmanr
-
-        correlation = float(spearmanr(travel[visible], seen_motion[visible]).statistic)
-    return {
-        "by_type": by_type,
-        "success_visible": share(visible, success),
-        "success_rest_visible": None if visible is None or outcome is None else share(
-            visible & (outcome == "rest"), success),
-        "success_effect_is_minus_initial": share(vanished, success),
-        "travel_vs_seen_motion": correlation,
-    }
-
-
-#: Behaviours :func:`make_synthetic_frame` can imitate, with their object size ranges [m].
-SYNTHETIC_SIZE_RANGES = {"tap": (0.04, 0.10), "grasp": (0.03, 0.09)}
-#: Size [m] at which a synthetic grasp holds the object half of the time, and the width of the transition [m].
-SYNTHETIC_CRITICAL_SIZE, SYNTHETIC_GRASP_SPREAD = 0.06, 0.003
-
-
-def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: str = "tap") -> pd.DataFrame:
-    """A dataset frame in the project's schema with tapping- or grasping-like structure, made without the
-    simulator.
-
-    Objects of the four types. Shape features (normal histograms, fractions) depend on the type, size features
-    on the size, relation features are jitter.
-
-    - ``"tap"``: sizes uniform in [0.04, 0.10] m. Spheres and lying cylinders roll (95 %), boxes and standing
-      cylinders do not (97 %); ``success`` is ``rolled``. As on the simulated table, a rolled object travels
-      5-22 cm and is seen where it stops: its effect moves its position, range, pixel count and image offsets
-      by its travel; 3 % of the rolled objects leave the table instead (``outcome == "off_table"``,
-      ``visible_final`` False, final features all zeros, so their effect is minus their initial features); a
-      resting object slides about 1.5 cm.
-    - ``"grasp"``: sizes uniform in [0.03, 0.09] m. Whatever its type, an object is held with probability
-      ``1 / (1 + exp((size - 0.06 m) / 3 mm))``: the critical size is 6 cm. A held object is put down about
-      6 cm from where it stood; one not held is nudged by about half a centimetre. Nothing rolls.
-
-    Feature names are ``affordance_env.features.FEATURE_NAMES`` when available, else ``f00`` ... ``f48``.
-
-    Args:
-        n_rows: Interactions, >= 8.
-        random_state: Seed.
-        behavior: ``"tap"`` or ``"grasp"`` (the ``behavior`` column).
-    """
-    if isinstance(n_rows, bool) or not isinstance(n_rows, numbers.Integral) or n_rows < 8:
-        raise ValueError(f"n_rows must be an integer >= 8, got {n_rows!r}.")
-    if behavior not in SYNTHETIC_SIZE_RANGES:
-        raise ValueError(f"behavior must be one of {tuple(SYNTHETIC_SIZE_RANGES)}, got {behavior!r}.")
-    grasp = behavior == "grasp"
-    try:
-        from affordance_env.features import FEATURE_NAMES
-
-        names = list(FEATURE_NAMES)
-    except ImportError:
-        names = [f"f{i:02d}" for i in range(49)]
-    rng = np.random.default_rng(random_state)
-    types = np.array(OBJECT_TYPES)[np.arange(n_rows) % 4]
-    rng.shuffle(types)
-    kind = np.searchsorted(np.array(sorted(OBJECT_TYPES)), types)  # 0 box, 1 horizontal, 2 sphere, 3 vertical
-    size = rng.uniform(*SYNTHETIC_SIZE_RANGES[behavior], n_rows)
-    if grasp:
-        held = rng.random(n_rows) < 1.0 / (1.0 + np.exp((size - SYNTHETIC_CRITICAL_SIZE) / SYNTHETIC_GRASP_SPREAD))
-        rolled = np.zeros(n_rows, dtype=bool)
-    else:
-        rollable = np.isin(types, ("sphere", "horizontal_cylinder"))
-        rolled = np.where(rollable, rng.random(n_rows) < 0.95, rng.random(n_rows) < 0.03)
-
-    # Shape: a latitude and a longitude histogram per type, 12 bins each, perturbed and renormalised.
-    bins = np.arange(12)
-    lat_profiles = np.stack(
-        [
-            np.exp(-0.5 * ((bins - 11) / 0.8) ** 2)
-            + np.exp(-0.5 * ((bins - 6) / 0.5) ** 2),  # box: top + sides
-            np.exp(-0.5 * ((bins - 8) / 2.5) ** 2),  # lying cylinder: a band of latitudes
-            np.exp(-0.5 * ((bins - 8) / 3.5) ** 2),  # sphere: every latitude facing the camera
-            np.exp(-0.5 * ((bins - 6) / 0.6) ** 2)
-            + 0.6 * np.exp(-0.5 * ((bins - 11) / 0.6) ** 2),  # standing
-        ]
-    )
-    lon_profiles = np.stack(
-        [
-            np.exp(-0.5 * ((bins - 6) / 0.7) ** 2),
-            np.exp(-0.5 * ((bins - 6) / 0.9) ** 2) + 0.3,
-            np.exp(-0.5 * ((bins - 6) / 3.0) ** 2),
-            np.exp(-0.5 * ((bins - 6) / 2.5) ** 2),
-        ]
-    )
-
-    def histogram(profiles: np.ndarray) -> np.ndarray:
-        h = profiles[kind] * rng.gamma(20.0, 1 / 20.0, (n_rows, 12))
-        return h / h.sum(axis=1, keepdims=True)
-
-    shape = np.hstack([histogram(lat_profiles), histogram(lon_profiles)])
-    jitter = rng.normal(0.0, 0.02, (n_rows, 3))
-    mean_xyz = np.column_stack([-0.30 + jitter[:, 0], 0.05 + jitter[:, 1], size / 2 + jitter[:, 2] * 0.1])
-    mean_range = np.linalg.norm(mean_xyz - [0.0, 0.0, 0.35], axis=1)
-    pixels = 2.0e4 * size**2 / mean_range**2 * rng.normal(1.0, 0.03, n_rows)
-    orientation = rng.uniform(-np.pi / 2, np.pi / 2, n_rows)
-    extents = (
-        size[:, None]
-        * rng.normal(1.0, 0.05, (n_rows, 12))
-        * np.array([0.7, 0.7, 0.5, 1.0, 0.3] * 2 + [40, 40])
-    )
-    size_features = np.column_stack([mean_xyz, mean_range, pixels, orientation, extents])
-    relation = rng.normal(0.0, 1.0, (n_rows, 7)) * np.array([5, 5, 7, 0.02, 0.02, 0.02, 0.03])
-    initial = np.hstack([shape, size_features, relation])
-
-    if grasp:  # Effects: put down 6 cm away when held, nudged by half a centimetre otherwise.
-        travel = np.where(held, rng.normal(0.06, 0.004, n_rows), np.abs(rng.normal(0.005, 0.003, n_rows)))
-        off_table = np.zeros(n_rows, dtype=bool)
-    else:  # Effects: travel along the tap direction for rolling objects, a 1.5 cm slide otherwise.
-        roll = np.where(types == "sphere", rng.uniform(0.10, 0.22, n_rows), rng.uniform(0.05, 0.20, n_rows))
-        travel = np.where(rolled, roll, rng.normal(0.015, 0.003, n_rows))
-        off_table = rolled & (rng.random(n_rows) < 0.03)
-    effect = rng.normal(0.0, 1.0, initial.shape) * 0.01 * (np.abs(initial).mean(axis=0) + 1e-3)
-    effect[:, 24] += 0.1 * travel  # mean_x
-    effect[:, 25] += travel  # mean_y
-    effect[:, 27] += 0.6 * travel  # mean_range
-    effect[:, 28] -= pixels * 0.8 * travel  # pixel_count: seen from a little further away
-    effect[:, 42:45] += np.column_stack([10, 300, 300]).ravel() * travel[:, None]  # image offsets [pixels]
-    effect[:, 46] += travel  # hand_dy
-    effect[:, 48] += travel  # hand_distance
-    spin = np.where(types == "horizontal_cylinder", 1.0, 0.0) * rolled
-    effect[:, 12:24] += 0.05 * spin[:, None] * rng.normal(0.0, 1.0, (n_rows, 12))
-    final = initial + effect
-    final[off_table] = 0.0  # not visible: the documented zeros
-    effect[off_table] = -initial[off_table]
-
-    columns: dict[str, Any] = {}
-    for prefix, values in (("initial_", initial), ("final_", final), ("effect_", effect)):
-        columns.update({f"{prefix}{n}": values[:, j] for j, n in enumerate(names)})
-    columns.update({"behavior": np.full(n_rows, behavior), "type": types, "size": size, "rolled": rolled,
-                    "success": held if grasp else rolled, "displacement": np.abs(travel),
-                    "rolling_distance": np.where(rolled, np.abs(travel), 0.0), "visible_final": ~off_table,
-                    "outcome": np.where(off_table, "off_table", "rest")})
-    return pd.DataFrame(columns)
