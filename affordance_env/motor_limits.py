@@ -41,13 +41,17 @@ JOINT_VELOCITY_LIMITS: dict[str, float] = {
 #: - torso, shoulder, elbow: 20 N m, the current limit of the v2.5 arm's boards (``motorPeakCurrents`` 5 A,
 #:   robots-configuration iCubGenova02 ``left_arm-eb1-j0_3-mc.xml``) times the torque constant of the Moog
 #:   brushless motor (0.041 N m/A) times its 100:1 harmonic drive;
+#: - torso pitch and roll: 40 N m, the two 20 N m motors that drive them through the torso's differential
+#:   (robots-configuration iCubGenova02 ``torso-eb5-j0_2-mec.xml``, ``matrixM2J``: each of these joints moves at
+#:   half the sum of the two motors' speeds, so by the balance of power its torque is the sum of theirs; the limit
+#:   of one joint while the other needs none, which the simulation's per-joint limits cannot share);
 #: - wrist: 2 N m, the full scale of the wrist joints' torque in the iCub's arm configuration (``TorqueMax``);
 #: - neck: 5 N m, no source: about four times the head's gravity torque at the neck pitch (1.2 N m);
 #: - fingers (the mk3 hand's 7 motors): 0.3 N m, the continuous torque of the Faulhaber 1331T012SR (3.2 mN m)
 #:   through its 159:1 gearhead (``Gearbox_M2J 159``) at 60 % efficiency.
 JOINT_TORQUE_LIMITS: dict[str, float] = {
-    **{name: 20.0 for name in ("torso_pitch", "torso_roll", "torso_yaw", "shoulder_pitch", "shoulder_roll",
-                               "shoulder_yaw", "elbow")},
+    **{name: 20.0 for name in ("torso_yaw", "shoulder_pitch", "shoulder_roll", "shoulder_yaw", "elbow")},
+    **{name: 40.0 for name in ("torso_pitch", "torso_roll")},
     **{name: 2.0 for name in ("wrist_prosup", "wrist_pitch", "wrist_yaw")},
     **{name: 5.0 for name in ("neck_pitch", "neck_roll", "neck_yaw")},
     **{name: 0.3 for name in HAND_DRIVEN_JOINTS},

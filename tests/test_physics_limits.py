@@ -21,7 +21,21 @@ def test_every_motor_has_its_torque_limit_and_carries_gravity_compensation(varia
         assert model.jnt_actfrclimited[j], name
         np.testing.assert_allclose(model.jnt_actfrcrange[j], [-limit, limit], err_msg=name)
         assert model.jnt_actgravcomp[j], name  # gravity compensation counts against the motor's torque
-    assert np.all(limits <= 20.0) and set(JOINT_TORQUE_LIMITS.values()) <= {20.0, 5.0, 2.0, 0.3}
+    assert np.all(limits <= 40.0) and set(JOINT_TORQUE_LIMITS.values()) <= {40.0, 20.0, 5.0, 2.0, 0.3}
+
+
+def test_the_torso_holds_both_arms_when_a_grasp_leans_it_over_the_table():
+    # A grasp that leans the torso 0.66 rad forward in the scene with both arms: with one 20 N m motor's torque at
+    # the torso pitch (instead of the differential's two) it fell forward onto the table on its way home.
+    env = TapAffordanceEnv(behavior="grasp", two_arms=True, camera_width=32, camera_height=24)
+    env.reset(seed=0, options={"object_type": "vertical_cylinder", "size": 0.0435, "position": (-0.3116, 0.0458)})
+    pitch = env.physics.variant.active_joints.index("torso_pitch")
+    angles, targets = [], []
+    env.physics.on_step = lambda physics: (angles.append(physics.joint_positions()[pitch]),
+                                           targets.append(physics.joint_targets()[pitch]))
+    _, _, _, _, info = env.step(np.array([0.664, 0.678, -0.721], np.float32))
+    assert info["failure"] is None and info["success"]
+    assert max(angles) < max(targets) + 0.02  # never leaning further than it was sent (it fell to 0.92 rad)
 
 
 def test_velocity_limits_name_every_joint_and_follow_the_finger_linkage():
