@@ -29,8 +29,8 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     parser.add_argument("--env", default="TapAffordance-v1", choices=("TapAffordance-v1", "TapAffordanceGoal-v0"),
                         dest="env_id",
                         help="TapAffordance-v1: one interaction per episode; TapAffordanceGoal-v0: goal episodes of "
-                             "up to 5 interactions, a behaviour drawn at each, one row per interaction with "
-                             "'step' and the goal's columns (default TapAffordance-v1)")
+                             "up to 5 interactions, a reachable behaviour and parameters drawn at each, one row per "
+                             "interaction with 'step' and the goal's columns (default TapAffordance-v1)")
     parser.add_argument("--action", default="canonical", choices=("canonical", "random"),
                         help="the paper's canonical tap, or uniform random actions from (seed, i) "
                              "(default canonical)")

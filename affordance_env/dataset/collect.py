@@ -75,6 +75,10 @@ def interaction_action(seed: int, episode: int, action: str) -> np.ndarray:
     return rng.uniform(-1.0, 1.0, ACTION_DIM).astype(np.float32)
 
 
+#: A goal episode's action is drawn again, up to this many times, until the arm can reach it (``feasible``).
+GOAL_ACTION_DRAWS = 20
+
+
 def goal_episode_actions(seed: int, episode: int, action: str) -> Iterator[dict[str, Any]]:
     """The actions of goal episode ``episode``, step after step: a behaviour uniform over the four, and its
     parameters zeros (``"canonical"``) or uniform in [-1, 1]^3, all from ``SeedSequence([seed, episode, 1])``."""
@@ -117,7 +121,10 @@ def _goal_episode_rows(env, settings: dict, episode: int) -> tuple[list[dict], s
     rows = []
     actions = goal_episode_actions(settings["seed"], episode, settings["action"])
     for step in range(GOAL_MAX_EPISODE_STEPS):
-        action = next(actions)
+        for _ in range(GOAL_ACTION_DRAWS):  # an action the arm can reach, if one of these draws is
+            action = next(actions)
+            if env.feasible(action["behavior"], action["params"]):
+                break
         after = env.step(action)
         row = interaction_row(episode, env_seed, action["params"], before, after, settings["save_images"],
                               goal_step=step)
@@ -258,7 +265,8 @@ def collect(
             collected so far were marked failed by the environment, in [0, 1] (1 accepts any).
         env_id: ``"TapAffordance-v1"`` (one interaction per episode, a row each) or ``"TapAffordanceGoal-v0"``:
             goal episodes of up to 5 interactions (``GOAL_MAX_EPISODE_STEPS``), each a behaviour drawn uniformly
-            with its parameters by ``action``, one row per interaction with its ``step`` and the goal columns;
+            with its parameters by ``action``, drawn again (up to ``GOAL_ACTION_DRAWS`` times) until the arm can
+            reach it (``feasible``), one row per interaction with its ``step`` and the goal columns;
             an episode is recorded up to its first failed interaction (left out; the episode counts as failed).
 
     Returns:
