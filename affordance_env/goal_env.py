@@ -147,6 +147,8 @@ class TapAffordanceGoalEnv(gym.Env):
         #: One TapAffordance env per arm, both of the scene with both arms; the env wires them into one world.
         self.arms: dict[str, TapAffordanceEnv] = {"right": right, "left": TapAffordanceEnv(behavior="grasp", **common)}
         self._arm = right
+        for arm in self.arms.values():  # render() draws the scene as it is: no frames recorded along the way
+            arm.physics.on_step = None
         #: The behaviours, named by the action's ``behavior`` index.
         self.behaviors = BEHAVIORS
         self.goal_tolerance = float(goal_tolerance)

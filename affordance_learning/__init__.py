@@ -9,6 +9,9 @@
   that behaviour's default model (the tap's is shipped; ``affordance train-default --behavior`` builds others).
 - :func:`run_protocol`, :func:`write_figures`, :func:`write_report`: the paper's experiment on one behaviour
   and its outputs (``affordance reproduce`` runs them end to end for the tap and the grasp).
+- Using the affordances: :class:`ActionEffectModel` ([features, action] -> outcome, with a predictive
+  distribution), the goals (:class:`Roll`, :class:`Lift`, :class:`Move`, :class:`Place`, :class:`Percept`) and
+  :class:`Planner` (``affordance plan`` measures them against baselines, :mod:`.plan_experiment`).
 """
 
 import importlib.metadata as _metadata
@@ -25,8 +28,11 @@ from affordance_learning.default_model import (  # noqa: E402 (after __version__
     predict_effect,
     train_default_model,
 )
+from affordance_learning.effect_model import ActionEffectModel
+from affordance_learning.goals import Lift, Move, Percept, Place, Roll, goal_from_dict
 from affordance_learning.metrics import adjusted_rand, cluster_purity, svm_cv_accuracy, uniformity
 from affordance_learning.model import AffordanceModel, EffectPrediction, select_features
+from affordance_learning.planner import Planner
 from affordance_learning.relieff import ReliefF, ReliefFScorer, relieff_weights
 from affordance_learning.som import SOMClustering
 
@@ -48,7 +54,15 @@ def __getattr__(name: str) -> object:
 
 
 __all__ = [
+    "ActionEffectModel",
     "AffordanceModel",
+    "Lift",
+    "Move",
+    "Percept",
+    "Place",
+    "Planner",
+    "Roll",
+    "goal_from_dict",
     "DefaultModelError",
     "DefaultModelMissingError",
     "EffectPrediction",

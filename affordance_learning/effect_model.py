@@ -1,0 +1,118 @@
+"""Action-conditioned effect models: for one behaviour, [initial features, action parameters] -> outcome, with a
+predictive distribution.
+
+:class:`ActionEffectModel` is a random forest used as a quantile regression forest (Meinshausen 2006, JMLR 7): its
+trees are grown on the motion part of the outcome (:data:`~affordance_learning.outcomes.MOTION_COLUMNS`,
+standardised), and a query's predictive distribution is the training outcomes weighted by how often they share a
+leaf with it, averaged over the trees. The distribution is over whole outcomes (motion and perceptual effect
+together), so the probability of any goal (:mod:`affordance_learning.goals`) is the weighted share of training
+outcomes that reach it, and samples are training outcomes drawn by those weights: a distribution that keeps the
+outcomes' real spread and their joint structure (a ball that rolls far also leaves the view), which a point
+prediction would lose.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from scipy import sparse
+from sklearn.base import BaseEstimator, RegressorMixin
+from sklearn.ensemble import RandomForestRegressor
+from sklearn.utils.validation import check_is_fitted, validate_data
+
+from affordance_learning.goals import Goal, Place
+
+
+class ActionEffectModel(RegressorMixin, BaseEstimator):
+    """Outcome of an interaction from the object's initial features and the action's parameters.
+
+    Args:
+        n_estimators: Trees of the forest.
+        min_samples_leaf: Training outcomes per leaf at least: each tree's neighbourhood of a query.
+        max_features: Share of the inputs tried at each split.
+        split_columns: How many of the first outcome columns the trees are grown on (the motion: ``dx``, ``dy``,
+            ``rolled``, ``off_table``, ``lifted``); None: all of them.
+        random_state: Seed of the forest.
+        n_jobs: Parallel jobs of the forest (joblib).
+
+    ``fit(X, y)``: ``X`` (n, d) inputs (:func:`~affordance_learning.outcomes.model_inputs`: 49 features and 3
+    parameters), ``y`` (n, m) outcomes (:func:`~affordance_learning.outcomes.outcome_table`; a DataFrame keeps its
+    column names in ``outcome_names_``). ``predict(X)``: the mean outcome. :meth:`predictive_weights`,
+    :meth:`goal_probability` and :meth:`sample` give the distribution.
+    """
+
+    def __init__(self, n_estimators: int = 200, min_samples_leaf: int = 3, max_features: float = 0.5,
+                 split_columns: int | None = 5, random_state: int | None = None, n_jobs: int | None = None) -> None:
+        self.n_estimators = n_estimators
+        self.min_samples_leaf = min_samples_leaf
+        self.max_features = max_features
+        self.split_columns = split_columns
+        self.random_state = random_state
+        self.n_jobs = n_jobs
+
+    def fit(self, X, y):
+        names = list(y.columns) if isinstance(y, pd.DataFrame) else None
+        X, y = validate_data(self, X, y, multi_output=True, y_numeric=True, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)
+        y2 = y.reshape(len(y), -1)
+        self.outcome_names_ = names if names is not None else [f"y{j}" for j in range(y2.shape[1])]
+        split = y2 if self.split_columns is None else y2[:, : max(1, min(self.split_columns, y2.shape[1]))]
+        scale = split.std(axis=0)
+        scale[scale == 0] = 1.0
+        self.forest_ = RandomForestRegressor(
+            n_estimators=self.n_estimators, min_samples_leaf=self.min_samples_leaf, max_features=self.max_features,
+            random_state=self.random_state, n_jobs=self.n_jobs,
+        ).fit(X, (split - split.mean(axis=0)) / scale)
+        self.outcomes_ = y2
+        self._single_output = y.ndim == 1
+        leaves = self.forest_.apply(X)  # (n, T): each training row's leaf in every tree
+        self._train_leaves = [self._leaf_onehot(leaves[:, t]) for t in range(leaves.shape[1])]
+        return self
+
+    @staticmethod
+    def _leaf_onehot(leaf_ids: np.ndarray) -> tuple[np.ndarray, sparse.csr_matrix]:
+        """(the tree's leaf ids, (n_leaves, n) row-normalised membership of the training rows)."""
+        ids, index = np.unique(leaf_ids, return_inverse=True)
+        member = sparse.csr_matrix((np.ones(len(leaf_ids)), (index, np.arange(len(leaf_ids)))),
+                                   shape=(len(ids), len(leaf_ids)))
+        counts = np.asarray(member.sum(axis=1)).ravel()
+        return ids, sparse.diags(1.0 / counts) @ member
+
+    def predictive_weights(self, X) -> np.ndarray:
+        """(m, n) weights of the training outcomes for each query (rows sum to 1): the predictive distribution."""
+        check_is_fitted(self)
+        X = validate_data(self, X, reset=False, dtype=np.float64)
+        leaves = self.forest_.apply(X)
+        weights = np.zeros((len(X), len(self.outcomes_)))
+        for t, (ids, member) in enumerate(self._train_leaves):
+            rows = np.searchsorted(ids, leaves[:, t])
+            weights += member[rows].toarray()
+        return weights / len(self._train_leaves)
+
+    def predict(self, X) -> np.ndarray:
+        """The mean outcome under the predictive distribution, (m, n_outcomes) (or (m,) for a 1-d ``y``)."""
+        mean = self.predictive_weights(X) @ self.outcomes_
+        return mean[:, 0] if self._single_output else mean
+
+    def outcome_frame(self) -> pd.DataFrame:
+        """The training outcomes, with their names: the support of every predictive distribution."""
+        check_is_fitted(self)
+        return pd.DataFrame(self.outcomes_, columns=self.outcome_names_)
+
+    def goal_probability(self, X, goal: Goal, start_xy=None) -> np.ndarray:
+        """P(goal) for each query, (m,): the weighted share of training outcomes that reach ``goal`` from
+        ``start_xy`` ((2,) or (m, 2) [m], where the object is; needed by :class:`~affordance_learning.goals.Place`)."""
+        weights = self.predictive_weights(X)
+        outcomes = self.outcome_frame()
+        if not isinstance(goal, Place):
+            return weights @ goal.reached(outcomes).astype(np.float64)
+        start = np.broadcast_to(np.asarray(start_xy, dtype=np.float64), (len(weights), 2))
+        return np.array([w @ goal.reached(outcomes, s).astype(np.float64) for w, s in zip(weights, start,
+                                                                                          strict=True)])
+
+    def sample(self, X, n_samples: int, random_state: int | np.random.Generator | None = None) -> np.ndarray:
+        """(m, n_samples, n_outcomes) outcomes drawn from each query's predictive distribution."""
+        rng = np.random.default_rng(random_state)
+        weights = self.predictive_weights(X)
+        picks = np.stack([rng.choice(len(w), size=n_samples, p=w) for w in weights])
+        return self.outcomes_[picks]

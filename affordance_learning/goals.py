@@ -1,0 +1,198 @@
+"""Goals: what a robot wants an interaction to do to an object, as small JSON-serialisable objects.
+
+Each goal says, for outcomes (:mod:`affordance_learning.outcomes`), whether they reach it: ``goal.reached(outcomes,
+start_xy)`` takes an outcome table (or a dict of its columns as arrays, one row per sample) and where the object
+was [m], and returns a boolean per row. A planner estimates P(goal) as the share of an effect model's predictive
+samples that reach it; an evaluation asks the same of the outcome the simulator measured.
+
+- :class:`Roll`: the object rolls (further than the behaviour's roll threshold).
+- :class:`Lift`: a grasp lifts and holds it.
+- :class:`Move`: its centre moves at least ``min_distance`` [m] along ``direction`` (a unit vector on the table,
+  root frame), and it stays on the table.
+- :class:`Place`: it comes to rest within ``tolerance`` [m] of ``target_xy``, on the table.
+- :class:`Percept`: the perceptual effect is within ``tolerance`` of ``target_effect`` (imitation: an effect
+  shown on one object, reproduced on another), measured as the root-mean-square of the effect difference in
+  units of ``scale`` (the effects' spread in the training data, per feature).
+
+``goal.to_dict()`` and :func:`goal_from_dict` round-trip through JSON.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+
+def _column(outcomes: Any, name: str) -> np.ndarray:
+    try:
+        return np.asarray(outcomes[name])
+    except (KeyError, IndexError):
+        raise ValueError(f"the outcomes lack {name!r} (an outcome table of affordance_learning.outcomes)") from None
+
+
+def _finite(name: str, value: Any, shape: tuple[int, ...] | None = None) -> np.ndarray:
+    array = np.asarray(value, dtype=np.float64)
+    if (shape is not None and array.shape != shape) or not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be {'a finite number' if not shape else f'{shape} finite values'}, "
+                         f"got {value!r}.")
+    return array
+
+
+@dataclass(frozen=True)
+class Roll:
+    """The object rolls."""
+
+    kind = "roll"
+
+    def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
+        return _column(outcomes, "rolled").astype(bool) & ~_column(outcomes, "off_table").astype(bool)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind}
+
+
+@dataclass(frozen=True)
+class Lift:
+    """A grasp lifts and holds the object."""
+
+    kind = "lift"
+
+    def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
+        return _column(outcomes, "lifted").astype(bool)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind}
+
+
+@dataclass(frozen=True)
+class Move:
+    """The object's centre moves at least ``min_distance`` [m] along ``direction`` (normalised) and stays on the
+    table."""
+
+    direction: tuple[float, float]
+    min_distance: float = 0.05
+    kind = "move"
+
+    def __post_init__(self) -> None:
+        d = _finite("direction", self.direction, (2,))
+        if np.linalg.norm(d) < 1e-9:
+            raise ValueError(f"direction must be a non-zero (x, y) vector, got {self.direction!r}.")
+        object.__setattr__(self, "direction", tuple(float(v) for v in d / np.linalg.norm(d)))
+        distance = float(_finite("min_distance", self.min_distance))
+        if distance <= 0:
+            raise ValueError(f"min_distance must be a positive distance [m], got {self.min_distance!r}.")
+        object.__setattr__(self, "min_distance", distance)
+
+    def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
+        along = _column(outcomes, "dx") * self.direction[0] + _column(outcomes, "dy") * self.direction[1]
+        return (along >= self.min_distance) & ~_column(outcomes, "off_table").astype(bool)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind, "direction": list(self.direction), "min_distance": self.min_distance}
+
+
+@dataclass(frozen=True)
+class Place:
+    """The object comes to rest within ``tolerance`` [m] of ``target_xy`` [m], on the table."""
+
+    target_xy: tuple[float, float]
+    tolerance: float = 0.03
+    kind = "place"
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "target_xy", tuple(float(v) for v in _finite("target_xy", self.target_xy, (2,))))
+        tolerance = float(_finite("tolerance", self.tolerance))
+        if tolerance <= 0:
+            raise ValueError(f"tolerance must be a positive distance [m], got {self.tolerance!r}.")
+        object.__setattr__(self, "tolerance", tolerance)
+
+    def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
+        if start_xy is None:
+            raise ValueError("Place needs start_xy, where the object was (x, y) [m].")
+        start = _finite("start_xy", start_xy)
+        x = start[..., 0] + _column(outcomes, "dx")
+        y = start[..., 1] + _column(outcomes, "dy")
+        near = np.hypot(x - self.target_xy[0], y - self.target_xy[1]) <= self.tolerance
+        return near & ~_column(outcomes, "off_table").astype(bool)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind, "target_xy": list(self.target_xy), "tolerance": self.tolerance}
+
+
+@dataclass(frozen=True)
+class Percept:
+    """The perceptual effect comes within ``tolerance`` of ``target_effect``: the root-mean-square over features
+    of the difference, each in units of ``scale`` (default 1: the features' own units)."""
+
+    target_effect: tuple[float, ...]
+    tolerance: float = 0.5
+    scale: tuple[float, ...] | None = field(default=None)
+    kind = "percept"
+
+    def __post_init__(self) -> None:
+        target = _finite("target_effect", self.target_effect)
+        if target.ndim != 1 or target.size == 0:
+            raise ValueError(f"target_effect must be a vector of effect features, got shape {target.shape}.")
+        object.__setattr__(self, "target_effect", tuple(float(v) for v in target))
+        if self.scale is not None:
+            scale = _finite("scale", self.scale, target.shape)
+            if np.any(scale <= 0):
+                raise ValueError("scale must be positive for every feature.")
+            object.__setattr__(self, "scale", tuple(float(v) for v in scale))
+        tolerance = float(_finite("tolerance", self.tolerance))
+        if tolerance <= 0:
+            raise ValueError(f"tolerance must be positive, got {self.tolerance!r}.")
+        object.__setattr__(self, "tolerance", tolerance)
+
+    def distance(self, effects: np.ndarray) -> np.ndarray:
+        """RMS distance of effects (..., d) to the target, in units of ``scale``."""
+        scale = np.ones(len(self.target_effect)) if self.scale is None else np.asarray(self.scale)
+        diff = (np.asarray(effects, dtype=np.float64) - np.asarray(self.target_effect)) / scale
+        return np.sqrt(np.mean(diff**2, axis=-1))
+
+    def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
+        if isinstance(outcomes, Mapping):
+            effects = np.asarray(outcomes["effect"]) if "effect" in outcomes else None
+        else:
+            columns = [c for c in outcomes.columns if str(c).startswith("effect_")]
+            effects = outcomes[columns].to_numpy(np.float64) if columns else None
+        if effects is None or effects.shape[-1] != len(self.target_effect):
+            raise ValueError(f"the outcomes lack the {len(self.target_effect)} effect columns the target has.")
+        return self.distance(effects) <= self.tolerance
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kind": self.kind, "target_effect": list(self.target_effect), "tolerance": self.tolerance,
+                "scale": None if self.scale is None else list(self.scale)}
+
+
+Goal = Roll | Lift | Move | Place | Percept
+#: Goal classes by ``kind``.
+GOAL_KINDS: dict[str, type] = {cls.kind: cls for cls in (Roll, Lift, Move, Place, Percept)}
+
+
+def goal_from_dict(data: Mapping[str, Any]) -> Goal:
+    """The goal ``goal.to_dict()`` wrote; an unknown kind or a wrong field raises ValueError naming it."""
+    if not isinstance(data, Mapping) or data.get("kind") not in GOAL_KINDS:
+        raise ValueError(f"a goal must be a dict with 'kind' one of {sorted(GOAL_KINDS)}, got {data!r}.")
+    fields = {k: v for k, v in data.items() if k != "kind"}
+    try:
+        return GOAL_KINDS[data["kind"]](**fields)
+    except TypeError as exc:
+        raise ValueError(f"bad fields for a {data['kind']!r} goal: {exc}") from None
+
+
+def describe(goal: Goal) -> str:
+    """A short text for reports: ``"move 5 cm toward -y"`` ..."""
+    if isinstance(goal, Move):
+        return f"move >= {100 * goal.min_distance:.0f} cm along ({goal.direction[0]:+.2f}, {goal.direction[1]:+.2f})"
+    if isinstance(goal, Place):
+        return f"place within {100 * goal.tolerance:.0f} cm of ({goal.target_xy[0]:.2f}, {goal.target_xy[1]:.2f})"
+    if isinstance(goal, Percept):
+        return f"reproduce an effect (RMS within {goal.tolerance:g})"
+    return goal.kind
+
+
+__all__: Sequence[str] = ["Goal", "Lift", "Move", "Percept", "Place", "Roll", "describe", "goal_from_dict"]

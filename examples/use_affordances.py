@@ -1,0 +1,56 @@
+"""Use learned affordances: a goal, a plan, an executed interaction, then a multi-step episode to a place.
+
+Needs the goal-episode dataset of an ``affordance plan`` run (``--dataset``, default ``plan/dataset``)::
+
+    affordance plan --out plan
+    python examples/use_affordances.py
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import gymnasium as gym
+import numpy as np
+
+import affordance_env  # noqa: F401  (registers the environments)
+from affordance_env import load_dataset
+from affordance_learning.goals import Move, describe
+from affordance_learning.plan_experiment import fit_models, training_frames
+from affordance_learning.planner import Planner
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--dataset", default="plan/dataset", help="goal episodes (affordance plan's OUT/dataset)")
+    parser.add_argument("--seed", type=int, default=3)
+    args = parser.parse_args()
+    planner = Planner(fit_models(training_frames(load_dataset(args.dataset), 1000), random_state=0))
+    env = gym.make("TapAffordanceGoal-v0")
+    world = env.unwrapped
+
+    obs, info = env.reset(seed=args.seed, options={"object_type": "sphere", "size": 0.06, "position": (-0.3, 0.05)})
+    goal = Move((0.0, -1.0), 0.05)  # 5 cm to the robot's right
+    choice = planner.choose(obs["observation"]["features"], goal, obs["achieved_goal"], feasible=world.feasible)
+    print(f"goal: {describe(goal)} -> {choice.behavior} {np.round(choice.params, 2)}, P = {choice.probability:.2f}")
+    obs, _, _, _, info = env.step({"behavior": choice.behavior, "params": choice.params.astype(np.float32)})
+    moved = np.asarray(info["object"]["final_pose"][:2]) - np.asarray(info["object"]["initial_pose"][:2])
+    print(f"  the {info['object']['type']} moved {np.round(100 * moved, 1)} cm")
+
+    obs, info = env.reset(seed=args.seed)
+    print(f"episode: {info['object']['type']} at {np.round(obs['achieved_goal'], 3)}, target "
+          f"{np.round(obs['desired_goal'], 3)} ({100 * info['distance']:.1f} cm)")
+    for step in range(1, 6):
+        choice = planner.toward(obs["observation"]["features"], obs["achieved_goal"], obs["desired_goal"],
+                                world.goal_tolerance, feasible=world.feasible)
+        obs, reward, terminated, truncated, info = env.step(
+            {"behavior": choice.behavior, "params": choice.params.astype(np.float32)})
+        print(f"  step {step}: {choice.behavior:<8} {np.round(choice.params, 2)} (P within 3 cm "
+              f"{choice.probability:.2f}) -> {100 * info['distance']:.1f} cm from the target")
+        if terminated or truncated:
+            break
+    print("reached" if info["is_success"] else "not reached")
+
+
+if __name__ == "__main__":
+    main()

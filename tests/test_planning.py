@@ -1,0 +1,156 @@
+"""Goals, action-conditioned effect models and the planner, on outcomes made without the simulator."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from affordance_learning.effect_model import ActionEffectModel
+from affordance_learning.goals import Lift, Move, Percept, Place, Roll, goal_from_dict
+from affordance_learning.outcomes import MOTION_COLUMNS
+from affordance_learning.planner import Planner, candidate_params
+
+
+def synthetic(n: int = 600, seed: int = 0, push: float = 0.12) -> tuple[np.ndarray, pd.DataFrame]:
+    """Objects at x on a line, seen through 3 features (x, round, noise); params (a0, a1, a2). The object moves
+    dx = push * a0 (+ noise), and a round object rolls (and moves twice as far) when a1 > 0."""
+    rng = np.random.default_rng(seed)
+    x = rng.uniform(-0.4, -0.2, n)
+    round_ = rng.integers(0, 2, n).astype(float)
+    params = rng.uniform(-1, 1, (n, 3))
+    rolled = (round_ == 1) & (params[:, 1] > 0)
+    dx = push * params[:, 0] * (1 + rolled) + rng.normal(0, 0.005, n)
+    X = np.column_stack([x, round_, rng.normal(size=n), params])
+    Y = pd.DataFrame({"dx": dx, "dy": np.zeros(n), "rolled": rolled.astype(float), "off_table": np.zeros(n),
+                      "lifted": np.zeros(n), "effect_a": dx, "effect_b": round_})
+    return X, Y
+
+
+@pytest.fixture(scope="module")
+def model():
+    X, Y = synthetic()
+    return ActionEffectModel(n_estimators=100, random_state=0).fit(X, Y)
+
+
+def test_goals_round_trip_through_json_and_refuse_bad_fields():
+    goals = [Roll(), Lift(), Move((0.0, -2.0), 0.05), Place((-0.3, 0.1), 0.03), Percept((0.1, -0.2), 0.5, (1.0, 2.0))]
+    for goal in goals:
+        assert goal_from_dict(json.loads(json.dumps(goal.to_dict()))) == goal
+    assert Move((0.0, -2.0)).direction == (0.0, -1.0)  # normalised
+    with pytest.raises(ValueError, match="kind"):
+        goal_from_dict({"kind": "fly"})
+    with pytest.raises(ValueError, match="non-zero"):
+        Move((0.0, 0.0))
+    with pytest.raises(ValueError, match="tolerance must be a positive"):
+        Place((0.0, 0.0), -1.0)
+    with pytest.raises(ValueError, match="start_xy"):
+        Place((0.0, 0.0)).reached({"dx": [0.0], "dy": [0.0], "off_table": [False]})
+
+
+def test_goals_judge_outcomes():
+    outcomes = pd.DataFrame({"dx": [0.06, 0.06, -0.10], "dy": [0.0, 0.0, 0.0], "rolled": [True, True, False],
+                             "off_table": [False, True, False], "lifted": [False, False, True],
+                             "effect_a": [0.0, 1.0, 3.0]})
+    np.testing.assert_array_equal(Move((1, 0), 0.05).reached(outcomes), [True, False, False])  # off the table
+    np.testing.assert_array_equal(Roll().reached(outcomes), [True, False, False])
+    np.testing.assert_array_equal(Lift().reached(outcomes), [False, False, True])
+    np.testing.assert_array_equal(Place((-0.2, 0.0), 0.03).reached(outcomes, (-0.26, 0.0)), [True, False, False])
+    np.testing.assert_array_equal(Percept((1.0,), 0.5).reached(outcomes), [False, True, False])
+
+
+def test_the_model_predicts_a_distribution_that_follows_the_action(model):
+    X, Y = synthetic(400, seed=1)
+    weights = model.predictive_weights(X)
+    np.testing.assert_allclose(weights.sum(axis=1), 1.0)
+    assert model.predict(X).shape == (400, Y.shape[1])
+    goal = Move((1.0, 0.0), 0.05)
+    p = model.goal_probability(X, goal)
+    truth = goal.reached(Y)
+    assert p[truth].mean() > 0.7 > 0.2 > p[~truth].mean()
+    for lo, hi in ((0.0, 0.2), (0.8, 1.0)):  # calibrated where it is sure
+        sure = (p >= lo) & (p <= hi)
+        assert abs(truth[sure].mean() - p[sure].mean()) < 0.1
+    samples = model.sample(X[:5], 50, random_state=0)
+    assert samples.shape == (5, 50, Y.shape[1])
+    assert set(np.unique(samples[:, :, 2])) <= {0.0, 1.0}  # whole training outcomes, not averages
+
+
+def test_the_planner_chooses_the_action_that_makes_the_goal_likely(model):
+    planner = Planner({"push": model}, n_candidates=32, threshold=0.5)
+    features = np.array([-0.3, 1.0, 0.0])  # a round object
+    choice = planner.choose(features, Move((1.0, 0.0), 0.15))  # only reached by rolling it: a0 > 0.6, a1 > 0
+    assert not choice.abstained and choice.behavior == "push"
+    assert choice.params[0] > 0.5 and choice.params[1] > 0 and choice.probability > 0.5
+    flat = planner.choose(np.array([-0.3, 0.0, 0.0]), Move((1.0, 0.0), 0.15))  # a box cannot go that far
+    assert flat.abstained and flat.probability < 0.5
+    refused = planner.choose(features, Move((1.0, 0.0), 0.15), feasible=lambda name, params: params[1] <= 0)
+    assert refused.params[1] <= 0 and refused.checked > 1  # the likely ones were out of reach
+    toward = planner.toward(features, (-0.3, 0.0), (-0.2, 0.0), 0.03)
+    assert toward.params[0] > 0 and toward.expected_distance < 0.05
+
+
+def test_candidates_and_errors():
+    params = candidate_params(16, 3)
+    assert params.shape == (16, 3) and np.all(params[0] == 0) and np.all(np.abs(params) <= 1)
+    np.testing.assert_array_equal(params, candidate_params(16, 3))
+    with pytest.raises(ValueError, match="threshold"):
+        Planner({"push": None}, threshold=2.0)
+    with pytest.raises(ValueError, match="at least one behaviour"):
+        Planner({})
+    assert set(MOTION_COLUMNS) == {"dx", "dy", "rolled", "off_table", "lifted"}
+
+
+def test_calibration_and_wilson_intervals():
+    from affordance_learning.plan_experiment import calibration, wilson
+
+    rng = np.random.default_rng(0)
+    p = rng.uniform(0, 1, 4000)
+    y = rng.uniform(0, 1, 4000) < p  # calibrated by construction
+    good = calibration(p, y)
+    assert good["ece"] < 0.03 and 0.7 < good["auroc"] < 0.9
+    bad = calibration(np.clip(p + 0.3, 0, 1), y)  # over-confident
+    assert bad["ece"] > 0.15
+    low, high = wilson(45, 50)
+    assert low < 0.9 < high and 0.75 < low and high < 0.97
+    assert wilson(0, 0) == (0.0, 1.0)
+
+
+def test_goals_are_judged_on_what_the_simulator_measured():
+    from affordance_learning.plan_experiment import draw_goal, reached
+
+    info = {"failure": None, "rolled": True, "outcome": "rest", "behavior": "tap", "success": True,
+            "effect": np.zeros(49), "object": {"initial_pose": np.array([-0.3, 0.0, 0.0, 1, 0, 0, 0]),
+                                               "final_pose": np.array([-0.3, -0.08, 0.0, 1, 0, 0, 0])}}
+    assert reached(Roll(), info) and not reached(Lift(), info)
+    assert reached(Move((0, -1), 0.05), info) and not reached(Move((0, 1), 0.05), info)
+    assert reached(Place((-0.3, -0.09), 0.03), info)
+    assert not reached(Roll(), {**info, "failure": "reach: ..."})  # a failed interaction reaches nothing
+    rng = np.random.default_rng(0)
+    place = draw_goal("place", np.array([-0.3, 0.0]), rng)
+    assert 0.05 <= np.hypot(place.target_xy[0] + 0.3, place.target_xy[1]) <= 0.15
+    assert draw_goal("move", np.zeros(2), rng).min_distance == 0.05
+
+
+@pytest.mark.slow
+def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
+    from affordance_learning.plan_experiment import PlanSettings, run_plan
+    from affordance_learning.plan_report import TARGETS, write_plan_figures, write_plan_report
+
+    settings = PlanSettings(episodes=40, goals=8, multi_episodes=2, oracle_candidates=2,
+                            candidates=8, som_clusters=2)
+    results = run_plan(tmp_path, seed=1, workers=1, settings=settings, camera=(40, 30), say=lambda text: None)
+    for policy in ("planner", "random", "best_fixed", "som_categories", "oracle"):
+        entry = results["single_step"][policy]
+        assert 0 <= entry["success"] <= 1 and entry["n"] >= 1
+    assert set(results["leave_one_shape_out"]) == {"sphere", "box", "horizontal_cylinder", "vertical_cylinder"}
+    for policy in ("planner", "direction", "random"):
+        assert 0 <= results["multi_step"][policy]["reach_failures"] <= 1
+    assert {"ece", "auroc"} <= set(results["calibration"])
+    assert json.loads((tmp_path / "results.json").read_text())["seed"] == 1
+    write_plan_figures(results, tmp_path)
+    report = write_plan_report(results, tmp_path).read_text()
+    assert all(name in report for name in TARGETS)
+    assert (tmp_path / "success.png").stat().st_size > 1000 and (tmp_path / "reliability.png").exists()
