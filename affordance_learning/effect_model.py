@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 from scipy import sparse
 from sklearn.base import BaseEstimator, RegressorMixin
-from sklearn.ensemble import RandomForestRegressor
+from sklearn.ensemble import ExtraTreesRegressor, RandomForestRegressor
 from sklearn.utils.validation import check_is_fitted, validate_data
 
 from affordance_learning.goals import Goal, Place
@@ -32,6 +32,8 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         max_features: Share of the inputs tried at each split.
         split_columns: How many of the first outcome columns the trees are grown on (the motion: ``dx``, ``dy``,
             ``rolled``, ``off_table``, ``lifted``); None: all of them.
+        trees: ``"random"`` (a random forest) or ``"extra"`` (extremely randomised trees; compared in
+            ``benchmarks/effect_models.py``).
         random_state: Seed of the forest.
         n_jobs: Parallel jobs of the forest (joblib).
 
@@ -42,15 +44,20 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
     """
 
     def __init__(self, n_estimators: int = 200, min_samples_leaf: int = 3, max_features: float = 0.5,
-                 split_columns: int | None = 5, random_state: int | None = None, n_jobs: int | None = None) -> None:
+                 split_columns: int | None = 5, trees: str = "random", random_state: int | None = None,
+                 n_jobs: int | None = None) -> None:
         self.n_estimators = n_estimators
         self.min_samples_leaf = min_samples_leaf
         self.max_features = max_features
         self.split_columns = split_columns
+        self.trees = trees
         self.random_state = random_state
         self.n_jobs = n_jobs
 
     def fit(self, X, y):
+        forests = {"random": RandomForestRegressor, "extra": ExtraTreesRegressor}
+        if self.trees not in forests:
+            raise ValueError(f"trees must be one of {sorted(forests)}, got {self.trees!r}.")
         names = list(y.columns) if isinstance(y, pd.DataFrame) else None
         X, y = validate_data(self, X, y, multi_output=True, y_numeric=True, dtype=np.float64)
         y = np.asarray(y, dtype=np.float64)
@@ -59,7 +66,7 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         split = y2 if self.split_columns is None else y2[:, : max(1, min(self.split_columns, y2.shape[1]))]
         scale = split.std(axis=0)
         scale[scale == 0] = 1.0
-        self.forest_ = RandomForestRegressor(
+        self.forest_ = forests[self.trees](
             n_estimators=self.n_estimators, min_samples_leaf=self.min_samples_leaf, max_features=self.max_features,
             random_state=self.random_state, n_jobs=self.n_jobs,
         ).fit(X, (split - split.mean(axis=0)) / scale)

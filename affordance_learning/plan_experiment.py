@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 
 from affordance_learning.effect_model import ActionEffectModel
-from affordance_learning.goals import Goal, Lift, Move, Place, Roll, describe, goal_from_dict
+from affordance_learning.goals import Goal, Lift, Move, Place, Roll, goal_from_dict
 from affordance_learning.outcomes import model_inputs, outcome_table
 from affordance_learning.planner import Planner, candidate_params
 
@@ -172,6 +172,14 @@ def _env(camera: tuple[int, int]):
     return _worker.env
 
 
+def _feasible_from(env, state) -> Callable[[str, np.ndarray], bool]:
+    """``feasible(behavior, params)`` of the world in ``state``, whatever the env ran since."""
+    def feasible(behavior: str, params: np.ndarray) -> bool:
+        env.set_state(state)
+        return env.feasible(behavior, params)
+    return feasible
+
+
 def _run(env, state, behavior: str, params: np.ndarray) -> dict[str, Any]:
     env.set_state(state)
     *_, info = env.step({"behavior": behavior, "params": np.asarray(params, dtype=np.float32)})
@@ -192,9 +200,7 @@ def evaluate_single(item: Mapping[str, Any], planner: Planner, som: SomBaseline 
     goal = draw_goal(item["kind"], start, rng)
     state = env.get_state()
 
-    def feasible(behavior: str, params: np.ndarray) -> bool:
-        env.set_state(state)
-        return env.feasible(behavior, params)
+    feasible = _feasible_from(env, state)
 
     executed: list[tuple[float, bool]] = []  # (model P, reached) of every action run: the calibration's data
 
@@ -242,9 +248,7 @@ def evaluate_planner(record: Mapping[str, Any], planner: Planner, camera: tuple[
     start = np.asarray(obs["achieved_goal"], dtype=np.float64)
     state = env.get_state()
 
-    def feasible(behavior: str, params: np.ndarray) -> bool:
-        env.set_state(state)
-        return env.feasible(behavior, params)
+    feasible = _feasible_from(env, state)
 
     choice = planner.choose(obs["observation"]["features"], goal, start, feasible=feasible)
     return bool(choice.behavior) and reached(goal, _run(env, state, choice.behavior, choice.params))
@@ -359,7 +363,7 @@ def _items(seed: int, part: int, n: int, options: Callable[[int], dict | None] =
     return items
 
 
-def _parallel(function, items: list, workers: int, progress, **kwargs) -> list:
+def _parallel(function, items: list, workers: int, **kwargs) -> list:
     from joblib import Parallel, delayed
 
     chunks = [items[i::workers] for i in range(workers)]
@@ -371,8 +375,6 @@ def _parallel(function, items: list, workers: int, progress, **kwargs) -> list:
     for w, chunk_results in enumerate(results):
         for j, r in enumerate(chunk_results):
             merged[w + j * workers] = r
-    if progress:
-        progress(len(items))
     return merged
 
 
@@ -410,7 +412,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
 
     t = time.perf_counter()
     items = _items(seed, 0, settings.goals)
-    records = [r for r in _parallel(evaluate_single, items, workers, None, planner=planner, som=som,
+    records = [r for r in _parallel(evaluate_single, items, workers, planner=planner, som=som,
                                     settings=settings, camera=camera) if r is not None]
     fixed_choice = best_fixed(records)
     timings["single_step"] = time.perf_counter() - t
@@ -425,7 +427,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         shape_planner = Planner(fit_models(training_frames(frame, settings.max_per_behavior, exclude_type=shape),
                                            seed, n_jobs=workers),
                                 n_candidates=settings.candidates, threshold=settings.threshold, random_state=seed)
-        outcomes = _parallel(evaluate_planner, shape_records, workers, None, planner=shape_planner, camera=camera)
+        outcomes = _parallel(evaluate_planner, shape_records, workers, planner=shape_planner, camera=camera)
         for r, ok in zip(shape_records, outcomes, strict=True):
             r["planner"] = ok
         loso[shape] = summarize(shape_records, ("planner", "best_fixed", "random", "oracle"))
@@ -437,7 +439,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
     multi_items = _items(seed, 9, settings.multi_episodes)
     multi: dict[str, Any] = {}
     for policy in MULTI_POLICIES:
-        episodes = _parallel(evaluate_episode, multi_items, workers, None, planner=planner, policy=policy,
+        episodes = _parallel(evaluate_episode, multi_items, workers, planner=planner, policy=policy,
                              camera=camera)
         n = len(episodes)
         k = sum(e["success"] for e in episodes)
@@ -503,5 +505,4 @@ def record_episode(out: str | os.PathLike, results: Mapping[str, Any], seed: int
         env.close()
 
 
-__all__ = ["PlanSettings", "run_plan", "measured_outcome", "reached", "calibration", "wilson", "describe",
-           "goal_from_dict"]
+__all__ = ["PlanSettings", "run_plan", "record_episode", "measured_outcome", "reached", "calibration", "wilson"]

@@ -5,7 +5,6 @@
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Mapping
 from pathlib import Path
@@ -194,10 +193,6 @@ def write_plan_figures(results: Mapping[str, Any], out: str | os.PathLike,
         plt.close(fig)
         written.append(out / "episode.png")
     return written
-
-
-def read_results(path: str | os.PathLike) -> dict[str, Any]:
-    return json.loads(Path(path).read_text())
 
 
 __all__ = ["TARGETS", "measured_targets", "target_met", "write_plan_report", "write_plan_figures", "SHAPES",

@@ -21,7 +21,6 @@ import argparse
 import time
 
 import numpy as np
-from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.metrics import brier_score_loss, log_loss, roc_auc_score
 from sklearn.neighbors import NearestNeighbors
 from sklearn.preprocessing import StandardScaler
@@ -33,20 +32,6 @@ from affordance_learning.outcomes import model_inputs, outcome_table
 from affordance_learning.plan_experiment import BEHAVIORS, calibration
 
 GOALS = [Roll(), Lift(), *(Move(d, 0.05) for d in ((1, 0), (-1, 0), (0, 1), (0, -1)))]
-
-
-class ExtraTreesEffectModel(ActionEffectModel):
-    def fit(self, X, y):
-        super().fit(X, y)
-        split = self.outcomes_[:, : self.split_columns]
-        scale = split.std(axis=0)
-        scale[scale == 0] = 1
-        self.forest_ = ExtraTreesRegressor(n_estimators=self.n_estimators, min_samples_leaf=self.min_samples_leaf,
-                                           max_features=self.max_features, random_state=self.random_state
-                                           ).fit(X, (split - split.mean(axis=0)) / scale)
-        leaves = self.forest_.apply(X)
-        self._train_leaves = [self._leaf_onehot(leaves[:, t]) for t in range(leaves.shape[1])]
-        return self
 
 
 class KnnEffectModel:
@@ -71,7 +56,7 @@ def main() -> None:
     args = parser.parse_args()
     frame = load_dataset(args.dataset).sort_values(["episode", "step"])
     learners = {"forest": lambda: ActionEffectModel(random_state=0), "extra_trees":
-                lambda: ExtraTreesEffectModel(random_state=0), "knn": lambda: KnnEffectModel()}
+                lambda: ActionEffectModel(trees="extra", random_state=0), "knn": lambda: KnnEffectModel()}
     scores = {name: {"p": [], "y": [], "fit": 0.0} for name in learners}
     for behavior in BEHAVIORS:
         rows = frame[frame["behavior"] == behavior]
