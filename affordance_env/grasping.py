@@ -124,13 +124,16 @@ def grasp_poses(motion: MotionExecutor, plan: GraspPlan) -> list[IKResult]:
 
 def grasp_reachable(motion: MotionExecutor, plan: GraspPlan) -> bool:
     """Whether :func:`run_grasp` will find its poses within the IK's tolerances (above, at and down to the grasp,
-    the lift and the put-down beside); kinematics only."""
+    the lift and the put-down beside); kinematics only. The descent stops at the first touch, anywhere between
+    the pose above and the grasp pose, and the lift rises from there: the lifts from both ends are checked."""
     above, at, lifted = grasp_poses(motion, plan)
     descent = motion.line(plan.p_above, plan.p_grasp, plan, GUARDED_SPEED, q_start=above.q)
     lift = motion.line(plan.p_grasp, plan.p_lift, plan, LIFT_SPEED, q_start=at.q)
+    high_lift = motion.line(plan.p_above, plan.p_above + (plan.p_lift - plan.p_grasp), plan, LIFT_SPEED,
+                            q_start=above.q)
     place = motion.ik(np.array([plan.p_place[0], plan.p_place[1], plan.p_grasp[2] + PLACE_APPROACH]), lifted.q,
                      plan)
-    return ik_verdict([above, at, lifted, *descent.results, *lift.results, place])[0]
+    return ik_verdict([above, at, lifted, *descent.results, *lift.results, *high_lift.results, place])[0]
 
 
 def run_grasp(motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:

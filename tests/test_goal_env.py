@@ -131,6 +131,18 @@ def test_feasible_agrees_with_the_interactions_ik(env):
     assert agree == len(draws)
 
 
+def test_feasible_refuses_a_grasp_whose_lift_from_a_high_first_touch_is_out_of_reach(env):
+    # A large lying cylinder at the far edge of the grasp's reach, gripped high: the descent stops at the first
+    # touch, above the grasp pose, and the lift from there leaves the arm's reach (5 cm short at its top).
+    pose = [-0.4324, 0.1631, -0.0215, 0.70561, 0.04591, 0.70561, -0.04591]
+    env.reset(seed=0, options={"object_type": "horizontal_cylinder", "size": 0.097, "object_pose": pose,
+                               "goal": (-0.365, 0.252)})
+    params = np.array([-0.89, -0.42, 0.1])
+    assert not env.feasible("grasp", params)
+    _, _, _, _, info = env.step({"behavior": "grasp", "params": params.astype(np.float32)})
+    assert not info["ik"]["success"]
+
+
 def test_bad_actions_options_and_goals_get_clear_errors(env):
     env.reset(seed=0)
     with pytest.raises(ValueError, match="Unknown behavior 'kick'"):
