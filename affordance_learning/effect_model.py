@@ -23,6 +23,16 @@ from sklearn.utils.validation import check_is_fitted, validate_data
 from affordance_learning.goals import Goal, Place
 
 
+class _Rows:
+    """Columns of a model's training outcomes at some rows, by name (what a goal reads), gathered when asked."""
+
+    def __init__(self, model: ActionEffectModel, rows: np.ndarray) -> None:
+        self._model, self._rows = model, rows
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self._model.outcomes_[self._rows, self._model.outcome_names_.index(name)]
+
+
 class ActionEffectModel(RegressorMixin, BaseEstimator):
     """Outcome of an interaction from the object's initial features and the action's parameters.
 
@@ -63,6 +73,9 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         y = np.asarray(y, dtype=np.float64)
         y2 = y.reshape(len(y), -1)
         self.outcome_names_ = names if names is not None else [f"y{j}" for j in range(y2.shape[1])]
+        #: The columns of the perceptual effect (``effect_<feature>``) among the outcomes.
+        self.effect_columns_ = np.array([j for j, n in enumerate(self.outcome_names_) if str(n).startswith("effect_")],
+                                        dtype=np.intp)
         split = y2 if self.split_columns is None else y2[:, : max(1, min(self.split_columns, y2.shape[1]))]
         scale = split.std(axis=0)
         scale[scale == 0] = 1.0
@@ -73,7 +86,17 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         self.outcomes_ = y2
         self._single_output = y.ndim == 1
         leaves = self.forest_.apply(X)  # (n, T): each training row's leaf in every tree
-        self._train_leaves = [self._leaf_onehot(leaves[:, t]) for t in range(leaves.shape[1])]
+        trees = [self._leaf_onehot(leaves[:, t]) for t in range(leaves.shape[1])]
+        # One table of every tree's leaves: leaf r of tree t is row leaf_offset[t] + r of a stacked CSR matrix.
+        stacked = sparse.vstack([member for _, member in trees], format="csr")
+        nodes = [tree.tree_.node_count for tree in self.forest_.estimators_]
+        node_offset = np.cumsum([0] + nodes[:-1])
+        node_row = np.full(sum(nodes), -1, dtype=np.int64)  # a leaf's row in ``stacked``; -1 for inner nodes
+        first = 0
+        for t, (ids, _) in enumerate(trees):
+            node_row[node_offset[t] + ids] = first + np.arange(len(ids))
+            first += len(ids)
+        self._leaf_table = (stacked.indptr, stacked.indices, stacked.data, node_offset, node_row)
         return self
 
     @staticmethod
@@ -85,16 +108,28 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         counts = np.asarray(member.sum(axis=1)).ravel()
         return ids, sparse.diags(1.0 / counts) @ member
 
-    def predictive_weights(self, X) -> np.ndarray:
-        """(m, n) weights of the training outcomes for each query (rows sum to 1): the predictive distribution."""
+    def predictive_weights(self, X, *, as_sparse: bool = False) -> np.ndarray | sparse.csr_matrix:
+        """(m, n) weights of the training outcomes for each query (rows sum to 1): the predictive distribution.
+        ``as_sparse=True`` gives a CSR matrix (a query shares leaves with a few hundred training rows at most): what
+        a planner scoring many thousands of queries wants; it may hold a training row more than once per query
+        (once per tree whose leaf has it), which every sparse operation sums."""
         check_is_fitted(self)
         X = validate_data(self, X, reset=False, dtype=np.float64)
-        leaves = self.forest_.apply(X)
-        weights = np.zeros((len(X), len(self.outcomes_)))
-        for t, (ids, member) in enumerate(self._train_leaves):
-            rows = np.searchsorted(ids, leaves[:, t])
-            weights += member[rows].toarray()
-        return weights / len(self._train_leaves)
+        leaves = self.forest_.apply(X)  # (m, T)
+        indptr, indices, data, node_offset, node_row = self._leaf_table
+        # The row of each query's leaf in every tree in one stacked table, then the training rows of those leaves.
+        rows = node_row[(leaves + node_offset[None, :]).ravel()]
+        start, counts = indptr[rows], indptr[rows + 1] - indptr[rows]
+        total = int(counts.sum())
+        within = np.arange(total) - np.repeat(np.cumsum(counts) - counts, counts)
+        take = np.repeat(start, counts) + within
+        # Entries stay grouped by query, one group per tree: a training row shared by several trees' leaves
+        # appears once per tree (every sparse operation sums such duplicates; summing them here costs a sort).
+        per_query = counts.reshape(len(X), leaves.shape[1]).sum(axis=1)
+        weights = sparse.csr_matrix((data[take] / leaves.shape[1], indices[take],
+                                     np.concatenate([[0], np.cumsum(per_query)])),
+                                    shape=(len(X), len(self.outcomes_)))
+        return weights if as_sparse else weights.toarray()
 
     def predict(self, X) -> np.ndarray:
         """The mean outcome under the predictive distribution, (m, n_outcomes) (or (m,) for a 1-d ``y``)."""
@@ -109,13 +144,29 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
     def goal_probability(self, X, goal: Goal, start_xy=None) -> np.ndarray:
         """P(goal) for each query, (m,): the weighted share of training outcomes that reach ``goal`` from
         ``start_xy`` ((2,) or (m, 2) [m], where the object is; needed by :class:`~affordance_learning.goals.Place`)."""
-        weights = self.predictive_weights(X)
+        weights = self.predictive_weights(X, as_sparse=True)
         outcomes = self.outcome_frame()
         if not isinstance(goal, Place):
-            return weights @ goal.reached(outcomes).astype(np.float64)
-        start = np.broadcast_to(np.asarray(start_xy, dtype=np.float64), (len(weights), 2))
-        return np.array([w @ goal.reached(outcomes, s).astype(np.float64) for w, s in zip(weights, start,
-                                                                                          strict=True)])
+            return np.asarray(weights @ goal.reached(outcomes).astype(np.float64)).ravel()
+        start = np.asarray(start_xy, dtype=np.float64)
+        if start.ndim == 1:  # one start for every query: each training outcome reaches the goal or not, once
+            return np.asarray(weights @ goal.reached(outcomes, start).astype(np.float64)).ravel()
+        weights.sum_duplicates()
+        start = np.broadcast_to(start, (weights.shape[0], 2))
+        return self.weighted_share(weights, self.reached_at(weights, goal, start))
+
+    def reached_at(self, weights: sparse.csr_matrix, goal: Goal, start_xy: np.ndarray) -> np.ndarray:
+        """Whether each stored entry of ``weights`` (CSR, its training outcome for its query) reaches ``goal`` from
+        the query's ``start_xy`` ((m, 2) [m])."""
+        query = np.repeat(np.arange(weights.shape[0]), np.diff(weights.indptr))
+        return np.asarray(goal.reached(_Rows(self, weights.indices), np.asarray(start_xy)[query]), dtype=bool)
+
+    @staticmethod
+    def weighted_share(weights: sparse.csr_matrix, hits: np.ndarray) -> np.ndarray:
+        """(m,) the weighted share of each query's training outcomes that ``hits`` marks, ``hits`` given for the
+        stored entries of ``weights`` (CSR, in its order)."""
+        return np.add.reduceat(np.append(weights.data * hits, 0.0), weights.indptr[:-1])[: weights.shape[0]] \
+            * (np.diff(weights.indptr) > 0)
 
     def sample(self, X, n_samples: int, random_state: int | np.random.Generator | None = None) -> np.ndarray:
         """(m, n_samples, n_outcomes) outcomes drawn from each query's predictive distribution."""

@@ -23,8 +23,10 @@
 4. Leaving each shape out in turn: the effect models refitted without that object type, judged on the goals of
    step 3 whose object is of that type, from the same start (the oracle's verdict says which are feasible).
 5. Multi-step: episodes of TapAffordanceGoal-v0 (targets 10-25 cm away, 3 cm tolerance, at most 5
-   interactions), re-planning after each interaction (:meth:`~affordance_learning.planner.Planner.toward`), against
-   random actions and a direction heuristic.
+   interactions), re-planning after each interaction with a search over two interactions
+   (:meth:`~affordance_learning.planner.Planner.toward`, the behaviours' workspaces saying where a second one can
+   act), against random actions and a direction heuristic. Where no candidate is feasible the planner stops
+   (``gave_up``) rather than run an interaction it knows would fail.
 6. Calibration of P(goal) over every action executed in step 3 (expected calibration error over 10 bins, AUROC).
 
 Every number is measured in this run; fractions are in [0, 1], distances in metres.
@@ -267,19 +269,24 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
     """One multi-step episode of ``policy`` from reset seed ``item["seed"]``: reached, interactions, reach
     failures, the final distance [m]."""
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
+    from affordance_env.workspace import in_workspace
 
     env = _env(camera)
     rng = np.random.default_rng(item["rng"])
     obs, info = env.reset(seed=item["seed"])
     tolerance = env.goal_tolerance
-    steps, failures, success = 0, 0, False
-    distance = float(info["distance"])
-    for _ in range(GOAL_MAX_EPISODE_STEPS):
+    steps, failures, success, gave_up = 0, 0, False, False
+    distance = initial = float(info["distance"])
+    for step in range(GOAL_MAX_EPISODE_STEPS):
         start, target = obs["achieved_goal"], obs["desired_goal"]
         if policy == "planner":
             choice = planner.toward(obs["observation"]["features"], start, target, tolerance,
-                                    feasible=lambda b, p: env.feasible(b, p))
-            behavior, params = (choice.behavior, choice.params) if choice.behavior else ("tap", np.zeros(3))
+                                    feasible=lambda b, p: env.feasible(b, p),
+                                    steps_left=GOAL_MAX_EPISODE_STEPS - step, reachable=in_workspace)
+            if choice.behavior is None:  # no candidate the arms reach: stop rather than run a failing one
+                gave_up = True
+                break
+            behavior, params = choice.behavior, choice.params
         elif policy == "direction":
             behavior, params = _direction_heuristic(start, target), np.zeros(3)
         else:
@@ -294,7 +301,27 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
             success = bool(info["is_success"])
             break
     return {"policy": policy, "success": success, "steps": steps, "reach_failures": failures,
-            "final_distance": distance}
+            "final_distance": distance, "gave_up": gave_up, "type": info["object"]["type"],
+            "initial_distance": initial}
+
+
+def planner_episodes_tolerance() -> float:
+    """The goal env's tolerance [m] (its default)."""
+    import inspect
+
+    from affordance_env.goal_env import TapAffordanceGoalEnv
+
+    return float(inspect.signature(TapAffordanceGoalEnv).parameters["goal_tolerance"].default)
+
+
+def step_reach(frame: pd.DataFrame, quantile: float = 0.9) -> dict[str, float]:
+    """Per object type, how far one interaction moves it [m]: the ``quantile`` of the displacement over the
+    interactions of a dataset frame that stayed on the table, whatever the behaviour and action."""
+    moved = np.hypot(frame["true_final_x"] - frame["true_initial_x"], frame["true_final_y"] - frame["true_initial_y"])
+    kept = (frame["outcome"].astype(str) != "off_table").to_numpy()
+    types = frame["type"].astype(str).to_numpy()
+    return {shape: float(np.quantile(moved[kept & (types == shape)], quantile))
+            for shape in SHAPES if (kept & (types == shape)).any()}
 
 
 # --- statistics ------------------------------------------------------------------------------------------------
@@ -387,6 +414,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
     """Run the whole experiment into ``out`` (``dataset/``, ``results.json``); returns the results."""
     from affordance_env.dataset import collect, load_dataset
     from affordance_env.goal_env import TapAffordanceGoalEnv  # noqa: F401  (fails early without the simulator)
+    from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
 
     settings = settings or PlanSettings()
     out = Path(out)
@@ -441,17 +469,27 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
     for policy in MULTI_POLICIES:
         episodes = _parallel(evaluate_episode, multi_items, workers, planner=planner, policy=policy,
                              camera=camera)
+        if policy == "planner":
+            planner_episodes = episodes
         n = len(episodes)
         k = sum(e["success"] for e in episodes)
         interactions = sum(e["steps"] for e in episodes)
         multi[policy] = {"success": k / n, "success_ci": wilson(k, n), "n": n,
                          "reach_failures": sum(e["reach_failures"] for e in episodes) / max(interactions, 1),
-                         "interactions": interactions,
+                         "interactions": interactions, "gave_up": sum(e["gave_up"] for e in episodes),
                          "median_final_distance_m": float(np.median([e["final_distance"] for e in episodes]))}
     timings["multi_step"] = time.perf_counter() - t
     say(f"[5/5] multi-step on {settings.multi_episodes} episodes ({timings['multi_step']:.0f} s): "
         + ", ".join(f"{p} {100 * multi[p]['success']:.0f} %" for p in MULTI_POLICIES))
 
+    multi["planner"]["by_type"] = {
+        shape: {"n": len(eps), "success": sum(e["success"] for e in eps) / len(eps)}
+        for shape in SHAPES if (eps := [e for e in planner_episodes if e["type"] == shape])}
+    multi["planner"]["episodes"] = [{k: e[k] for k in ("type", "initial_distance", "final_distance", "steps",
+                                                       "success", "gave_up", "reach_failures")}
+                                    for e in planner_episodes]
+    multi["step_reach_p90_m"] = step_reach(frame)
+    multi["tolerance_m"], multi["max_interactions"] = planner_episodes_tolerance(), GOAL_MAX_EPISODE_STEPS
     executed = [e for r in records for e in r["executed"]]
     placement = [r["placement_error"] for r in records if "placement_error" in r]
     oracle = single["oracle"]["success"] or 0.0

@@ -81,9 +81,31 @@ def _why(name: str, results: Mapping[str, Any]) -> str:
         return ("" if off is None else f"the largest miscalibration is at P = {off['p']:.2f}: observed "
                 f"{off['observed']:.2f} over {off['n']} actions")
     multi = results["multi_step"]["planner"]
-    return (f"{_pct(multi['success'])} of episodes reach the target; the median final distance is "
-            f"{100 * multi['median_final_distance_m']:.1f} cm and {_pct(multi['reach_failures'])} of the "
-            f"{multi['interactions']} interactions failed to reach")
+    if name.startswith("multi-step reach"):
+        return (f"{round(multi['reach_failures'] * multi['interactions'])} of {multi['interactions']} "
+                "interactions failed to reach although the kinematics said they would: the arm moved the object "
+                "before the stroke, or a grasp's lift from where its descent stopped was out of reach")
+    return multi_step_why(results)
+
+
+def multi_step_why(results: Mapping[str, Any]) -> str:
+    """Why multi-step episodes miss their targets: per object type, success and how many missed episodes needed
+    more interactions than an episode has at the 90th-percentile displacement of one interaction of that type."""
+    multi = results["multi_step"]["planner"]
+    reach = results["multi_step"].get("step_reach_p90_m", {})
+    episodes = multi.get("episodes", [])
+    missed = [e for e in episodes if not e["success"]]
+    tolerance, most = results["multi_step"]["tolerance_m"], results["multi_step"]["max_interactions"]
+    too_far = [e for e in missed
+               if e["type"] in reach and (e["initial_distance"] - tolerance) / reach[e["type"]] > most]
+    per_type = "; ".join(f"{t}: {_pct(r['success'])} of {r['n']} (one interaction moves it at most "
+                         f"{100 * reach.get(t, float('nan')):.1f} cm in 9 of 10)"
+                         for t, r in multi.get("by_type", {}).items())
+    gave_up = sum(e["gave_up"] for e in missed)
+    return (f"{_pct(multi['success'])} of episodes reach the target (median final distance "
+            f"{100 * multi['median_final_distance_m']:.1f} cm). By type: {per_type}. Of the {len(missed)} missed, "
+            f"{len(too_far)} were further than {most} such interactions can take the object, and in {gave_up} "
+            "the object ended where no candidate action was reachable")
 
 
 def write_plan_report(results: Mapping[str, Any], out: str | os.PathLike) -> Path:
@@ -128,7 +150,8 @@ def write_plan_report(results: Mapping[str, Any], out: str | os.PathLike) -> Pat
                      f"{_pct(r['random']['success'])} |")
     lines += ["", "## Multi-step", "", "| policy | targets reached [95 % CI] | reach failures per interaction | "
               "median final distance |", "|---|---|---|---|"]
-    for p, r in results["multi_step"].items():
+    for p in MULTI_POLICIES:
+        r = results["multi_step"][p]
         lines.append(f"| {p} | {_pct(r['success'])} {_ci(r['success_ci'])} | {_pct(r['reach_failures'])} | "
                      f"{100 * r['median_final_distance_m']:.1f} cm |")
     cal = results["calibration"]

@@ -22,6 +22,24 @@ from affordance_learning.goals import Goal, Place
 
 #: An outcome that leaves the table counts as this far from any place [m] when actions are ranked by distance.
 OFF_TABLE_DISTANCE = 1.0
+#: The search over two interactions (:meth:`Planner.toward`): first actions looked at (the nearest on average,
+#: and half as many of the most likely), predicted outcomes followed from each, and parameter vectors per
+#: behaviour for the second interaction (the first of the planner's candidates).
+LOOKAHEAD_ROOTS, LOOKAHEAD_OUTCOMES, LOOKAHEAD_SECOND = 16, 8, 8
+#: A first action is chosen for its value over two interactions when that value is at least this.
+MIN_SEQUENCE_VALUE = 0.1
+
+
+def _ends(model: ActionEffectModel, start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Where each training outcome of ``model`` leaves an object that was at ``start`` [m], and whether it left
+    the table."""
+    frame = model.outcome_frame()
+    return start + frame[["dx", "dy"]].to_numpy(), frame["off_table"].to_numpy(bool)
+
+
+def _reached_by_any(reachable: Callable[[str, np.ndarray], np.ndarray], names: list[str], xy: np.ndarray
+                    ) -> np.ndarray:
+    return np.any([np.asarray(reachable(name, xy), dtype=bool) for name in names], axis=0)
 
 
 def candidate_params(n: int, random_state: int = 0) -> np.ndarray:
@@ -46,6 +64,8 @@ class Choice:
         abstained: P(goal) was below the threshold.
         expected_distance: For :meth:`Planner.toward`: the mean predicted distance to the place [m]; else NaN.
         checked: How many candidates the kinematics was asked about.
+        value: For :meth:`Planner.toward`: P(within the tolerance) after this interaction and, where more are
+            left, after the best second one (:meth:`Planner.toward`); else NaN.
     """
 
     behavior: str | None
@@ -54,6 +74,7 @@ class Choice:
     abstained: bool
     expected_distance: float = float("nan")
     checked: int = 0
+    value: float = float("nan")
 
 
 class Planner:
@@ -111,29 +132,113 @@ class Planner:
         return Choice(name, self.params[k].copy(), p, p < self.threshold, checked=checked)
 
     def toward(self, features: np.ndarray, start_xy, target_xy, tolerance: float,
-               feasible: Callable[[str, np.ndarray], bool] | None = None) -> Choice:
-        """The next interaction towards ``target_xy`` [m]: the feasible action most likely to end within
-        ``tolerance`` if that is at least the threshold, else the one with the smallest mean predicted distance."""
+               feasible: Callable[[str, np.ndarray], bool] | None = None, steps_left: int = 1,
+               reachable: Callable[[str, np.ndarray], np.ndarray] | None = None) -> Choice:
+        """The next interaction towards ``target_xy`` [m], re-planned after every interaction.
+
+        With ``steps_left`` 1 (this interaction is the last): the feasible action most likely to end within
+        ``tolerance``, if that is at least the threshold, else the one whose predicted outcomes end nearest on
+        average. With 2 or more, a search over sequences of two interactions: an action's value is its
+        P(within) plus the share of its predicted outcomes that neither end within nor leave the table times the
+        best P(within) of a second interaction from there, averaged over the most likely of those outcomes (the
+        object where the outcome leaves it, seen with the initial features plus the outcome's perceptual
+        effect). An action likely enough to end within is taken at once; else the most valuable one, if its value
+        reaches ``MIN_SEQUENCE_VALUE``; else the nearest.
+
+        Args:
+            reachable: ``reachable(behavior, xy)``, (n, 2) [m] -> (n,) bool: where a behaviour can act (for
+                example :func:`affordance_env.workspace.in_workspace`). A second interaction counts only where its
+                behaviour reaches, and outcomes that leave the object where no behaviour reaches count as
+                ``OFF_TABLE_DISTANCE`` away when actions are ranked by distance. None: everywhere.
+        """
+        if isinstance(steps_left, bool) or not isinstance(steps_left, int | np.integer) or steps_left < 1:
+            raise ValueError(f"steps_left must be an integer >= 1, got {steps_left!r}.")
         goal = Place(tuple(target_xy), tolerance)
+        features = np.asarray(features, dtype=np.float64).ravel()
         X = self._inputs(features)
         start = np.asarray(start_xy, dtype=np.float64)
         target = np.asarray(target_xy, dtype=np.float64)
-        entries = []
+        names = list(self.models)
+        weights, p1, distance, ends = {}, {}, {}, {}
         for name, model in self.models.items():
-            weights = model.predictive_weights(X)
-            outcomes = model.outcome_frame()
-            end = start + outcomes[["dx", "dy"]].to_numpy()
-            distance = np.where(outcomes["off_table"].to_numpy(bool), OFF_TABLE_DISTANCE,
-                                np.linalg.norm(end - target, axis=1))
-            within = goal.reached(outcomes, start).astype(np.float64)
-            for k, (p, d) in enumerate(zip(weights @ within, weights @ distance, strict=True)):
-                entries.append((float(p), float(d), name, k))
-        likely = sorted((e for e in entries if e[0] >= self.threshold), key=lambda e: (-e[0], e[1], e[2], e[3]))
-        nearest = sorted(entries, key=lambda e: (e[1], -e[0], e[2], e[3]))
+            W = model.predictive_weights(X, as_sparse=True)
+            W.sum_duplicates()
+            end, off = _ends(model, start)
+            within = goal.reached(model.outcome_frame(), start).astype(np.float64)
+            dist = np.where(off, OFF_TABLE_DISTANCE, np.linalg.norm(end - target, axis=1))
+            if reachable is not None:
+                stuck = ~_reached_by_any(reachable, names, end) & (within == 0)
+                dist = np.where(stuck, OFF_TABLE_DISTANCE, dist)
+            weights[name], ends[name] = W, (end, off, within)
+            p1[name], distance[name] = W @ within, W @ dist
+        value = {name: p1[name].copy() for name in names}
+        if steps_left >= 2:
+            self._look_ahead(features, goal, weights, ends, p1, distance, value, reachable)
+        entries = [(float(value[n][k]), float(p1[n][k]), float(distance[n][k]), n, k)
+                   for n in names for k in range(len(self.params))]
+        finish = sorted((e for e in entries if e[1] >= self.threshold), key=lambda e: (-e[1], e[2], e[3], e[4]))
+        sequence = sorted((e for e in entries if e[0] >= MIN_SEQUENCE_VALUE), key=lambda e: (-e[0], e[2], e[3], e[4]))
+        nearest = sorted(entries, key=lambda e: (e[2], -e[0], e[3], e[4]))
         checked = 0
-        for ranked in (likely, nearest):
-            for p, d, name, k in ranked:
+        for ranked in (finish, sequence, nearest):
+            for v, p, d, name, k in ranked:
                 checked += feasible is not None
                 if feasible is None or feasible(name, self.params[k]):
-                    return Choice(name, self.params[k].copy(), p, p < self.threshold, d, checked)
-        return Choice(None, np.zeros(3), 0.0, True, float("nan"), checked)
+                    return Choice(name, self.params[k].copy(), p, p < self.threshold, d, checked, v)
+        return Choice(None, np.zeros(3), 0.0, True, float("nan"), checked, 0.0)
+
+    def _look_ahead(self, features, goal, weights, ends, p1, distance, value, reachable) -> None:
+        """Add to ``value`` (P(within) of each first action) the chance of a second interaction (see
+        :meth:`toward`), over the ``LOOKAHEAD_ROOTS`` first actions nearest on average and most likely, their
+        ``LOOKAHEAD_OUTCOMES`` most likely outcomes each, and ``LOOKAHEAD_SECOND`` parameter vectors per
+        behaviour for the second."""
+        names = list(self.models)
+        flat = [(n, k) for n in names for k in range(len(self.params))]
+        p_all = np.concatenate([p1[n] for n in names])
+        d_all = np.concatenate([distance[n] for n in names])
+        roots = list(dict.fromkeys([flat[i] for i in np.argsort(d_all, kind="stable")[:LOOKAHEAD_ROOTS]]
+                                   + [flat[i] for i in np.argsort(-p_all, kind="stable")[:LOOKAHEAD_ROOTS // 2]]))
+        # The distinct outcomes (behaviour, training row) the roots lead to, and each root's share of them.
+        states: dict[tuple[str, int], int] = {}
+        # Per root: the mass of its outcomes that leave something to do (neither within nor off the table), and
+        # the most likely of them with their weights: a sample of where the second interaction starts.
+        links: list[tuple[str, int, float, list[tuple[int, float]]]] = []
+        for name, k in roots:
+            row = weights[name].getrow(k)
+            end, off, within = ends[name]
+            open_ = ~within[row.indices].astype(bool) & ~off[row.indices]
+            if not open_.any():
+                continue
+            indices, data = row.indices[open_], row.data[open_]
+            top = np.argsort(-data, kind="stable")[:LOOKAHEAD_OUTCOMES]
+            followed = [(states.setdefault((name, int(j)), len(states)), float(w))
+                        for j, w in zip(indices[top], data[top], strict=True)]
+            links.append((name, k, float(data.sum()), followed))
+        if not states:
+            return
+        keys = list(states)
+        for name in {n for n, _ in keys}:
+            if len(self.models[name].effect_columns_) != len(features):
+                raise ValueError(f"the model of {name!r} has {len(self.models[name].effect_columns_)} effect columns "
+                                 f"for {len(features)} features: looking ahead needs models fitted on outcome tables "
+                                 "with the perceptual effect (affordance_learning.outcomes.outcome_table).")
+        xy = np.array([ends[n][0][j] for n, j in keys])
+        seen = np.array([features + self.models[n].outcomes_[j, self.models[n].effect_columns_] for n, j in keys])
+        second = self.params[: LOOKAHEAD_SECOND]
+        best = np.zeros(len(keys))
+        for name, model in self.models.items():
+            X2 = np.hstack([np.repeat(seen, len(second), axis=0), np.tile(second, (len(keys), 1))])
+            W2 = model.predictive_weights(X2, as_sparse=True)
+            end2, off2 = _ends(model, np.zeros(2))  # displacements; each state adds its own start below
+            hits = (np.linalg.norm(xy[:, None, :] + end2[None] - np.asarray(goal.target_xy), axis=2)
+                    <= goal.tolerance) & ~off2[None]
+            query = np.repeat(np.arange(W2.shape[0]), np.diff(W2.indptr))
+            p2 = np.zeros(W2.shape[0])
+            np.add.at(p2, query, W2.data * hits[query // len(second), W2.indices])
+            p2 = p2.reshape(len(keys), len(second)).max(axis=1)
+            if reachable is not None:
+                p2 = p2 * np.asarray(reachable(name, xy), dtype=bool)
+            best = np.maximum(best, p2)
+        for name, k, mass, followed in links:  # the followed outcomes stand for all that leave something to do
+            value[name][k] += mass * sum(w * best[state] for state, w in followed) / sum(w for _, w in followed)
+

@@ -15,6 +15,7 @@ import numpy as np
 
 import affordance_env  # noqa: F401  (registers the environments)
 from affordance_env import load_dataset
+from affordance_env.workspace import in_workspace
 from affordance_learning.goals import Move, describe
 from affordance_learning.plan_experiment import fit_models, training_frames
 from affordance_learning.planner import Planner
@@ -40,16 +41,23 @@ def main() -> None:
     obs, info = env.reset(seed=args.seed)
     print(f"episode: {info['object']['type']} at {np.round(obs['achieved_goal'], 3)}, target "
           f"{np.round(obs['desired_goal'], 3)} ({100 * info['distance']:.1f} cm)")
-    for step in range(1, 6):
+    steps = env.spec.max_episode_steps
+    for step in range(1, steps + 1):
+        # A search over two interactions; the workspaces say where a behaviour can act after the first.
         choice = planner.toward(obs["observation"]["features"], obs["achieved_goal"], obs["desired_goal"],
-                                world.goal_tolerance, feasible=world.feasible)
+                                world.goal_tolerance, feasible=world.feasible, steps_left=steps - step + 1,
+                                reachable=in_workspace)
+        if choice.behavior is None:
+            print("  no candidate action is reachable: stopping")
+            break
         obs, reward, terminated, truncated, info = env.step(
             {"behavior": choice.behavior, "params": choice.params.astype(np.float32)})
-        print(f"  step {step}: {choice.behavior:<8} {np.round(choice.params, 2)} (P within 3 cm "
-              f"{choice.probability:.2f}) -> {100 * info['distance']:.1f} cm from the target")
+        print(f"  step {step}: {choice.behavior:<8} {np.round(choice.params, 2)} (P within 3 cm now "
+              f"{choice.probability:.2f}, within two {choice.value:.2f}) -> {100 * info['distance']:.1f} cm from "
+              "the target")
         if terminated or truncated:
             break
-    print("reached" if info["is_success"] else "not reached")
+    print("reached" if info.get("is_success") else "not reached")
 
 
 if __name__ == "__main__":

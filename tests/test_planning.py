@@ -92,6 +92,46 @@ def test_the_planner_chooses_the_action_that_makes_the_goal_likely(model):
     assert toward.params[0] > 0 and toward.expected_distance < 0.05
 
 
+def _constant_mover(dx: float, n: int = 300, seed: int = 0) -> ActionEffectModel:
+    """A behaviour that moves every object by ``dx`` [m] along x, whatever its 2 features and the 3 parameters;
+    its perceptual effect is the motion of the first feature."""
+    rng = np.random.default_rng(seed)
+    X = np.column_stack([rng.uniform(-0.2, 0.2, n), rng.normal(size=n), rng.uniform(-1, 1, (n, 3))])
+    move = dx + rng.normal(0, 1e-4, n)
+    Y = pd.DataFrame({"dx": move, "dy": np.zeros(n), "rolled": np.zeros(n), "off_table": np.zeros(n),
+                      "lifted": np.zeros(n), "effect_x": move, "effect_n": np.zeros(n)})
+    return ActionEffectModel(n_estimators=30, random_state=seed).fit(X, Y)
+
+
+def test_toward_searches_over_two_interactions_where_the_nearest_first_step_is_a_dead_end():
+    # jump moves 5 cm, slide 7 cm; the target is 10 cm away, the tolerance 1.5 cm. Sliding ends nearest (3 cm)
+    # but no second interaction finishes from there; two jumps do.
+    planner = Planner({"jump": _constant_mover(0.05), "slide": _constant_mover(0.07, seed=1)}, n_candidates=8)
+    features, start, target = np.array([0.0, 0.0]), (0.0, 0.0), (0.10, 0.0)
+    greedy = planner.toward(features, start, target, 0.015, steps_left=1)
+    assert greedy.behavior == "slide" and greedy.probability == 0.0
+    ahead = planner.toward(features, start, target, 0.015, steps_left=2)
+    assert ahead.behavior == "jump" and ahead.value > 0.9 and ahead.probability == 0.0
+    # Where jump cannot act after the first interaction, the sequence is worth nothing: the nearest again.
+    blocked = planner.toward(features, start, target, 0.015, steps_left=2,
+                             reachable=lambda name, xy: np.full(len(xy), name != "jump"))
+    assert blocked.behavior == "slide" and blocked.value == 0.0
+    with pytest.raises(ValueError, match="steps_left"):
+        planner.toward(features, start, target, 0.015, steps_left=0)
+
+
+def test_goal_probabilities_from_sparse_weights_equal_the_dense_ones(model):
+    X, _ = synthetic(50, seed=2)
+    dense = model.predictive_weights(X)
+    np.testing.assert_allclose(model.predictive_weights(X, as_sparse=True).toarray(), dense)
+    starts = np.random.default_rng(0).uniform(-0.4, -0.2, (50, 2))
+    goal = Place((-0.3, 0.0), 0.03)
+    expected = [w @ goal.reached(model.outcome_frame(), s) for w, s in zip(dense, starts, strict=True)]
+    np.testing.assert_allclose(model.goal_probability(X, goal, starts), expected)
+    np.testing.assert_allclose(model.goal_probability(X, goal, starts[0]),
+                               dense @ goal.reached(model.outcome_frame(), starts[0]))
+
+
 def test_candidates_and_errors():
     params = candidate_params(16, 3)
     assert params.shape == (16, 3) and np.all(params[0] == 0) and np.all(np.abs(params) <= 1)
