@@ -261,7 +261,8 @@ class TapAffordanceGoalEnv(gym.Env):
 
     def feasible(self, behavior: int | str, params: Any) -> bool:
         """Whether the arm can reach every pose of ``behavior`` with ``params`` on the object where it is now, from
-        the kinematics alone (no physics step); False: the interaction would fail with ``"ik: ..."``."""
+        the kinematics alone (no physics step); False: the interaction would fail with ``"ik: ..."``, or a stroke's
+        reach would sweep the arm into the object (``"reach: ..."``)."""
         name, a = self._check_action({"behavior": behavior, "params": params})
         if self._obs is None:
             raise RuntimeError("feasible() needs an object: call reset() first.")

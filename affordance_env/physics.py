@@ -241,11 +241,12 @@ class TapPhysics:
         model, data, obj = self.model, self.data, self.active_geom
         return min(mujoco.mj_geomDistance(model, data, g, obj, max_distance, None) for g in self._hand_geom_list)
 
-    def arm_object_distance(self, max_distance: float) -> float:
+    def arm_object_distance(self, max_distance: float, data: mujoco.MjData | None = None) -> float:
         """Smallest distance between the robot's geoms that touch the world (hand, fingers, wrist, forearm) and
-        the object [m]; ``max_distance`` if they are at least that far apart. Geoms whose bounding spheres are that
-        far from the object's are not measured further."""
-        data, obj = self.data, self.active_geom
+        the object [m] (in ``data``, by default the simulated state); ``max_distance`` if they are at least that far
+        apart. Geoms whose bounding spheres are that far from the object's are not measured further."""
+        data = self.data if data is None else data
+        obj = self.active_geom
         gap = (np.linalg.norm(data.geom_xpos[self.hand_geoms] - data.geom_xpos[obj], axis=1)
                - self._hand_rbound - self.model.geom_rbound[obj])
         near = self.hand_geoms[gap < max_distance]
@@ -253,6 +254,19 @@ class TapPhysics:
             return max_distance
         model = self.model
         return min(mujoco.mj_geomDistance(model, data, int(g), obj, max_distance, None) for g in near)
+
+    def sweep_clearance(self, path: np.ndarray, max_distance: float) -> float:
+        """Smallest distance [m] between the robot's geoms that touch the world and the object over the joint
+        configurations ``path`` ((k, active joints) [rad]), the object and everything else as they are now:
+        kinematics only, on the scratch data. ``max_distance`` if never nearer."""
+        scratch = self.scratch
+        scratch.qpos[:] = self.data.qpos
+        nearest = max_distance
+        for q in np.atleast_2d(path):
+            scratch.qpos[self.robot_qpos] = q
+            mujoco.mj_kinematics(self.model, scratch)
+            nearest = min(nearest, self.arm_object_distance(nearest, scratch))
+        return nearest
 
     def hand_touches_object(self) -> bool:
         """Whether any contact joins the hand (or wrist, forearm) and the object."""

@@ -534,8 +534,9 @@ class TapAffordanceEnv(gym.Env):
     def feasible(self, params: Any, behavior: str | None = None, seen_by: TapAffordanceEnv | None = None) -> bool:
         """Whether the arm can reach every pose of the interaction with ``params`` (``behavior``, one prepared in
         this env, by default the current one) on the object where the last snapshot saw it (of ``seen_by``, an env
-        of the same scene, if given), from the kinematics alone: no physics step. False: ``step`` would fail with
-        ``"ik: ..."``."""
+        of the same scene, if given: this env then takes over its world, as :meth:`take_over` would), from the
+        kinematics alone: no physics step. False: ``step`` would fail with ``"ik: ..."``, or a stroke's reach would
+        sweep the arm into the object (``"reach: ..."``)."""
         a = check_action(params)
         name = self.behavior.name if behavior is None else behavior
         if name not in self._postures:
@@ -543,6 +544,8 @@ class TapAffordanceEnv(gym.Env):
         initial = (self if seen_by is None else seen_by)._initial
         if initial is None:
             raise RuntimeError("feasible() needs an object: call reset() first.")
+        if seen_by is not None and seen_by is not self:  # the world as it is, as a take_over would continue it
+            self.physics.adopt(seen_by.physics)
         interaction = get_interaction(name)
         plan = interaction.plan(initial["geometry"], initial["pose"][:3], initial["yaw"], self.physics.table_top, a)
         saved = self.motion.approach_posture

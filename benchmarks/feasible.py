@@ -1,11 +1,12 @@
-"""How often ``feasible()`` of TapAffordanceGoal-v0 agrees with the interaction's own IK verdict.
+"""How often ``feasible()`` of TapAffordanceGoal-v0 agrees with what the interaction then does: its own IK verdict,
+and whether its reach left the object where it was (no ``"reach: ..."`` failure).
 
     python benchmarks/feasible.py [--draws 400] [--seed 0]
 
 Each draw places an object at a uniform position over the part of the table within the arms' reach, picks a
-behaviour and params at random, asks ``feasible`` (kinematics only) and then runs the interaction, whose
-``info["ik"]["success"]`` is measured whatever else happens. Prints the agreement and the table of
-(behaviour, feasible, reached) counts.
+behaviour and params at random, asks ``feasible`` (kinematics only) and then runs the interaction: it reached when
+``info["ik"]["success"]`` (measured whatever else happens) and it did not fail with ``"reach: ..."``. Prints the
+agreement and the table of (behaviour, feasible, reached) counts.
 """
 
 from __future__ import annotations
@@ -34,7 +35,8 @@ def main() -> None:
         behavior, params = int(rng.integers(4)), rng.uniform(-1, 1, 3).astype(np.float32)
         feasible = env.feasible(behavior, params)
         _, _, _, _, info = env.step({"behavior": behavior, "params": params})
-        counts[env.behaviors[behavior], feasible, bool(info["ik"]["success"])] += 1
+        reached = bool(info["ik"]["success"]) and not str(info["failure"] or "").startswith("reach")
+        counts[env.behaviors[behavior], feasible, reached] += 1
     agree = sum(n for (_, feasible, reached), n in counts.items() if feasible == reached)
     print(f"agreement: {agree} of {args.draws} ({agree / args.draws:.1%})")
     for (behavior, feasible, reached), n in sorted(counts.items()):

@@ -504,6 +504,15 @@ def test_feasible_tells_from_the_kinematics_whether_the_step_will_reach():
         env.feasible(np.zeros(3), behavior="grasp")
 
 
+def test_feasible_refuses_a_stroke_whose_reach_sweeps_the_arm_into_the_object():
+    env = TapAffordanceEnv(behavior="tap", position_range="workspace", camera_width=40, camera_height=30)
+    env.reset(seed=91)  # a lying cylinder in the arm's way to the pre-stroke pose of this tap
+    params = np.array([-0.35, 0.383, 0.004])
+    assert not env.feasible(params)
+    _, _, _, _, info = env.step(params.astype(np.float32))  # the IK reaches every pose, but ...
+    assert info["ik"]["success"] and info["failure"].startswith("reach: the arm moved the object")
+
+
 def test_an_object_out_of_view_is_searched_for_and_seen():
     env = TapAffordanceEnv(behavior="grasp", camera_width=32, camera_height=24)
     # 26 cm to the robot's left: outside the view of the head's first gaze, inside the grasp's workspace
