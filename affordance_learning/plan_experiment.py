@@ -275,7 +275,7 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
     rng = np.random.default_rng(item["rng"])
     obs, info = env.reset(seed=item["seed"])
     tolerance = env.goal_tolerance
-    steps, failures, success, gave_up = 0, 0, False, False
+    steps, failures, success, gave_up = 0, [], False, False
     distance = initial = float(info["distance"])
     for step in range(GOAL_MAX_EPISODE_STEPS):
         start, target = obs["achieved_goal"], obs["desired_goal"]
@@ -293,14 +293,15 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
             behavior, params = BEHAVIORS[int(rng.integers(4))], rng.uniform(-1, 1, 3)
         obs, _, terminated, _, info = env.step({"behavior": behavior, "params": np.asarray(params, np.float32)})
         steps += 1
-        failures += bool(info["failure"] and info["failure"].split(":")[0] in ("ik", "reach"))
+        if info["failure"] and info["failure"].split(":")[0] in ("ik", "reach"):
+            failures.append(info["failure"])
         distance = float(info["distance"])
         if frames is not None:
             frames.append((f"{behavior}: {100 * distance:.1f} cm to go", env.render()))
         if terminated:
             success = bool(info["is_success"])
             break
-    return {"policy": policy, "success": success, "steps": steps, "reach_failures": failures,
+    return {"policy": policy, "success": success, "steps": steps, "reach_failures": len(failures), "failures": failures,
             "final_distance": distance, "gave_up": gave_up, "type": info["object"]["type"],
             "initial_distance": initial}
 
@@ -486,7 +487,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         shape: {"n": len(eps), "success": sum(e["success"] for e in eps) / len(eps)}
         for shape in SHAPES if (eps := [e for e in planner_episodes if e["type"] == shape])}
     multi["planner"]["episodes"] = [{k: e[k] for k in ("type", "initial_distance", "final_distance", "steps",
-                                                       "success", "gave_up", "reach_failures")}
+                                                       "success", "gave_up", "reach_failures", "failures")}
                                     for e in planner_episodes]
     multi["step_reach_p90_m"] = step_reach(frame)
     multi["tolerance_m"], multi["max_interactions"] = planner_episodes_tolerance(), GOAL_MAX_EPISODE_STEPS

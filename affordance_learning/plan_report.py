@@ -82,10 +82,24 @@ def _why(name: str, results: Mapping[str, Any]) -> str:
                 f"{off['observed']:.2f} over {off['n']} actions")
     multi = results["multi_step"]["planner"]
     if name.startswith("multi-step reach"):
+        kinds: dict[str, int] = {}
+        for e in multi.get("episodes", []):
+            for failure in e.get("failures", []):
+                kind = _FAILURE_KINDS.get(failure.split(" by ")[0].split(" (")[0], failure.split(":")[0])
+                kinds[kind] = kinds.get(kind, 0) + 1
+        listed = ", ".join(f"{n} {kind}" for kind, n in sorted(kinds.items(), key=lambda item: -item[1]))
         return (f"{round(multi['reach_failures'] * multi['interactions'])} of {multi['interactions']} "
-                "interactions failed to reach although the kinematics said they would: the arm moved the object "
-                "before the stroke, or a grasp's lift from where its descent stopped was out of reach")
+                f"interactions failed to reach although the kinematics said they would: {listed}")
     return multi_step_why(results)
+
+
+#: What an interaction's failure message (up to its measure) says, for the report.
+_FAILURE_KINDS = {
+    "reach: the arm moved the object": "where the arm moved the object before the stroke",
+    "reach: the stroke started": "where the stroke started more than 1 cm from its pose",
+    "ik: the grasp was not reachable": "where a grasp's pose was out of reach once the hand had touched",
+    "ik: the stroke was not reachable": "where a stroke's pose was out of reach",
+}
 
 
 def multi_step_why(results: Mapping[str, Any]) -> str:
@@ -98,14 +112,14 @@ def multi_step_why(results: Mapping[str, Any]) -> str:
     tolerance, most = results["multi_step"]["tolerance_m"], results["multi_step"]["max_interactions"]
     too_far = [e for e in missed
                if e["type"] in reach and (e["initial_distance"] - tolerance) / reach[e["type"]] > most]
-    per_type = "; ".join(f"{t}: {_pct(r['success'])} of {r['n']} (one interaction moves it at most "
-                         f"{100 * reach.get(t, float('nan')):.1f} cm in 9 of 10)"
+    per_type = "; ".join(f"{t}: {_pct(r['success'])} of {r['n']} (9 in 10 interactions move it at most "
+                         f"{100 * reach.get(t, float('nan')):.1f} cm)"
                          for t, r in multi.get("by_type", {}).items())
     gave_up = sum(e["gave_up"] for e in missed)
     return (f"{_pct(multi['success'])} of episodes reach the target (median final distance "
             f"{100 * multi['median_final_distance_m']:.1f} cm). By type: {per_type}. Of the {len(missed)} missed, "
-            f"{len(too_far)} were further than {most} such interactions can take the object, and in {gave_up} "
-            "the object ended where no candidate action was reachable")
+            f"{len(too_far)} started further from the target than {most} interactions that far take the object; in "
+            f"{gave_up} the object ended where no candidate action was reachable")
 
 
 def write_plan_report(results: Mapping[str, Any], out: str | os.PathLike) -> Path:
