@@ -277,6 +277,7 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
     tolerance = env.goal_tolerance
     steps, failures, success, gave_up = 0, [], False, False
     distance = initial = float(info["distance"])
+    start_xy, target_xy = (np.asarray(obs[key], dtype=float).tolist() for key in ("achieved_goal", "desired_goal"))
     for step in range(GOAL_MAX_EPISODE_STEPS):
         start, target = obs["achieved_goal"], obs["desired_goal"]
         if policy == "planner":
@@ -303,7 +304,7 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
             break
     return {"policy": policy, "success": success, "steps": steps, "reach_failures": len(failures), "failures": failures,
             "final_distance": distance, "gave_up": gave_up, "type": info["object"]["type"],
-            "initial_distance": initial}
+            "initial_distance": initial, "start_xy": start_xy, "target_xy": target_xy}
 
 
 def planner_episodes_tolerance() -> float:
@@ -315,14 +316,34 @@ def planner_episodes_tolerance() -> float:
     return float(inspect.signature(TapAffordanceGoalEnv).parameters["goal_tolerance"].default)
 
 
-def step_reach(frame: pd.DataFrame, quantile: float = 0.9) -> dict[str, float]:
-    """Per object type, how far one interaction moves it [m]: the ``quantile`` of the displacement over the
-    interactions of a dataset frame that stayed on the table, whatever the behaviour and action."""
-    moved = np.hypot(frame["true_final_x"] - frame["true_initial_x"], frame["true_final_y"] - frame["true_initial_y"])
+#: The directions of :func:`step_reach`: world +x (towards the robot), -x (away), +y (to its left), -y.
+DIRECTIONS = ("+x", "-x", "+y", "-y")
+
+
+def step_reach(frame: pd.DataFrame, quantile: float = 0.9) -> dict[str, dict[str, float]]:
+    """Per object type and direction (:data:`DIRECTIONS`), how far one interaction moves the object that way [m]:
+    the ``quantile`` of the displacement's component along it (0 for a move the other way) over the interactions
+    of a dataset frame that stayed on the table, whatever the behaviour and action."""
+    dx = (frame["true_final_x"] - frame["true_initial_x"]).to_numpy(np.float64)
+    dy = (frame["true_final_y"] - frame["true_initial_y"]).to_numpy(np.float64)
     kept = (frame["outcome"].astype(str) != "off_table").to_numpy()
     types = frame["type"].astype(str).to_numpy()
-    return {shape: float(np.quantile(moved[kept & (types == shape)], quantile))
-            for shape in SHAPES if (kept & (types == shape)).any()}
+    out = {}
+    for shape in SHAPES:
+        rows = kept & (types == shape)
+        if rows.any():
+            parts = dict(zip(DIRECTIONS, (dx[rows], -dx[rows], dy[rows], -dy[rows]), strict=True))
+            out[shape] = {d: float(np.quantile(np.maximum(v, 0.0), quantile)) for d, v in parts.items()}
+    return out
+
+
+def within_reach(start_xy, target_xy, reach: Mapping[str, float], tolerance: float, interactions: int) -> bool:
+    """Whether ``interactions`` that each move the object ``reach`` [m] along a direction (one type's
+    :func:`step_reach`) can bring it from ``start_xy`` to within ``tolerance`` of ``target_xy`` along both axes: a
+    generous bound (each axis gets the whole tolerance and every interaction the 90th percentile)."""
+    need = np.asarray(target_xy, dtype=float) - np.asarray(start_xy, dtype=float)
+    cap = np.array([reach["+x"] if need[0] > 0 else reach["-x"], reach["+y"] if need[1] > 0 else reach["-y"]])
+    return bool(np.all(np.maximum(np.abs(need) - tolerance, 0.0) <= interactions * cap))
 
 
 # --- statistics ------------------------------------------------------------------------------------------------
@@ -486,11 +507,18 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
     multi["planner"]["by_type"] = {
         shape: {"n": len(eps), "success": sum(e["success"] for e in eps) / len(eps)}
         for shape in SHAPES if (eps := [e for e in planner_episodes if e["type"] == shape])}
-    multi["planner"]["episodes"] = [{k: e[k] for k in ("type", "initial_distance", "final_distance", "steps",
-                                                       "success", "gave_up", "reach_failures", "failures")}
-                                    for e in planner_episodes]
-    multi["step_reach_p90_m"] = step_reach(frame)
-    multi["tolerance_m"], multi["max_interactions"] = planner_episodes_tolerance(), GOAL_MAX_EPISODE_STEPS
+    reach, tolerance = step_reach(frame), planner_episodes_tolerance()
+    multi["step_reach_p90_m"], multi["tolerance_m"], multi["max_interactions"] = (reach, tolerance,
+                                                                                  GOAL_MAX_EPISODE_STEPS)
+    multi["planner"]["episodes"] = [
+        {**{k: e[k] for k in ("type", "start_xy", "target_xy", "initial_distance", "final_distance", "steps",
+                              "success", "gave_up", "reach_failures", "failures")},
+         "within_reach": e["type"] in reach and within_reach(e["start_xy"], e["target_xy"], reach[e["type"]],
+                                                             tolerance, GOAL_MAX_EPISODE_STEPS)}
+        for e in planner_episodes]
+    inside = [e for e in multi["planner"]["episodes"] if e["within_reach"]]
+    multi["planner"]["within_reach"] = {"n": len(inside), "success": (sum(e["success"] for e in inside) / len(inside)
+                                                                      if inside else None)}
     executed = [e for r in records for e in r["executed"]]
     placement = [r["placement_error"] for r in records if "placement_error" in r]
     oracle = single["oracle"]["success"] or 0.0

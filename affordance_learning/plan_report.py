@@ -103,23 +103,28 @@ _FAILURE_KINDS = {
 
 
 def multi_step_why(results: Mapping[str, Any]) -> str:
-    """Why multi-step episodes miss their targets: per object type, success and how many missed episodes needed
-    more interactions than an episode has at the 90th-percentile displacement of one interaction of that type."""
+    """Why multi-step episodes miss their targets: per object type, success and how far one interaction moves it;
+    how many missed targets lay beyond what the episode's interactions can do (:func:`within_reach`), and the
+    planner's success on the others."""
     multi = results["multi_step"]["planner"]
     reach = results["multi_step"].get("step_reach_p90_m", {})
-    episodes = multi.get("episodes", [])
-    missed = [e for e in episodes if not e["success"]]
-    tolerance, most = results["multi_step"]["tolerance_m"], results["multi_step"]["max_interactions"]
-    too_far = [e for e in missed
-               if e["type"] in reach and (e["initial_distance"] - tolerance) / reach[e["type"]] > most]
-    per_type = "; ".join(f"{t}: {_pct(r['success'])} of {r['n']} (9 in 10 interactions move it at most "
-                         f"{100 * reach.get(t, float('nan')):.1f} cm)"
-                         for t, r in multi.get("by_type", {}).items())
+    most = results["multi_step"]["max_interactions"]
+    missed = [e for e in multi.get("episodes", []) if not e["success"]]
+    beyond = [e for e in missed if not e["within_reach"]]
+    per_type = "; ".join(
+        f"{t}: {_pct(r['success'])} of {r['n']} (9 in 10 interactions move it at most "
+        + ", ".join(f"{100 * v:.1f}" for v in reach.get(t, {}).values()) + " cm along +x, -x, +y, -y)"
+        for t, r in multi.get("by_type", {}).items())
+    towards = sum(e["target_xy"][0] - e["start_xy"][0] > reach.get(e["type"], {}).get("+x", 0.0) * most
+                  for e in beyond)
+    inside = multi.get("within_reach", {})
     gave_up = sum(e["gave_up"] for e in missed)
     return (f"{_pct(multi['success'])} of episodes reach the target (median final distance "
-            f"{100 * multi['median_final_distance_m']:.1f} cm). By type: {per_type}. Of the {len(missed)} missed, "
-            f"{len(too_far)} started further from the target than {most} interactions that far take the object; in "
-            f"{gave_up} the object ended where no candidate action was reachable")
+            f"{100 * multi['median_final_distance_m']:.1f} cm). By type: {per_type}. {len(beyond)} of the "
+            f"{len(missed)} missed targets lay further along an axis than {most} such interactions take the object "
+            f"({towards} of them towards the robot, where only rolling brings an object); on the "
+            f"{inside.get('n', 0)} targets within that reach the planner reached {_pct(inside.get('success'))}. In "
+            f"{gave_up} missed episodes the object ended where no candidate action was reachable")
 
 
 def write_plan_report(results: Mapping[str, Any], out: str | os.PathLike) -> Path:

@@ -233,8 +233,7 @@ class Planner:
             hits = (np.linalg.norm(xy[:, None, :] + end2[None] - np.asarray(goal.target_xy), axis=2)
                     <= goal.tolerance) & ~off2[None]
             query = np.repeat(np.arange(W2.shape[0]), np.diff(W2.indptr))
-            p2 = np.zeros(W2.shape[0])
-            np.add.at(p2, query, W2.data * hits[query // len(second), W2.indices])
+            p2 = np.bincount(query, weights=W2.data * hits[query // len(second), W2.indices], minlength=W2.shape[0])
             p2 = p2.reshape(len(keys), len(second)).max(axis=1)
             if reachable is not None:
                 p2 = p2 * np.asarray(reachable(name, xy), dtype=bool)

@@ -132,6 +132,21 @@ def test_goal_probabilities_from_sparse_weights_equal_the_dense_ones(model):
                                dense @ goal.reached(model.outcome_frame(), starts[0]))
 
 
+def test_step_reach_and_within_reach_bound_what_a_few_interactions_can_do():
+    from affordance_learning.plan_experiment import step_reach, within_reach
+
+    n = 100
+    moves = np.linspace(0.0, 0.05, n)  # boxes pushed away (-x) by up to 5 cm, never towards the robot
+    frame = pd.DataFrame({"true_initial_x": np.zeros(n), "true_initial_y": np.zeros(n), "true_final_x": -moves,
+                          "true_final_y": np.zeros(n), "outcome": ["rest"] * n, "type": ["box"] * n})
+    reach = step_reach(frame)["box"]
+    assert reach["+x"] == 0.0 and reach["-x"] == pytest.approx(0.045, abs=1e-3) and reach["+y"] == 0.0
+    assert within_reach((0.0, 0.0), (-0.20, 0.0), reach, 0.03, 5)  # 17 cm to go away: 5 x 4.5 cm suffice
+    assert not within_reach((0.0, 0.0), (-0.30, 0.0), reach, 0.03, 5)
+    assert not within_reach((0.0, 0.0), (0.10, 0.0), reach, 0.03, 5)  # towards the robot: nothing brings it
+    assert within_reach((0.0, 0.0), (0.02, 0.02), reach, 0.03, 5)  # already within the tolerance
+
+
 def test_candidates_and_errors():
     params = candidate_params(16, 3)
     assert params.shape == (16, 3) and np.all(params[0] == 0) and np.all(np.abs(params) <= 1)
