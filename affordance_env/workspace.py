@@ -3,8 +3,9 @@
 Measured by ``python benchmarks/workspace.py`` in the scene with both arms: a cell (``SPACING`` square) is in a
 behaviour's workspace when the canonical action of the behaviour is reachable by the arm's inverse kinematics for
 every object type at the smallest and the largest size (4 and 10 cm) and at the yaws the env draws (0, +-0.25 rad),
-and the head, attending, sees each of them there. Each workspace is stored as runs of cells along y. Pure geometry:
-nothing here needs the simulator.
+and the head, attending, sees each of them there. Whether a stroke's reach sweeps the arm through a particular
+object is not part of it: ``feasible()`` asks that per object and action. Each workspace is stored as runs of cells
+along y. Pure geometry: nothing here needs the simulator.
 """
 
 from __future__ import annotations
@@ -36,11 +37,10 @@ WORKSPACES: Mapping[str, tuple[tuple[float, float, float], ...]] = {
         (-0.2725, -0.2125, 0.1125), (-0.2475, -0.2125, 0.1125), (-0.2225, -0.1875, 0.1125), (-0.1975, -0.1875, 0.1125),
         (-0.1725, -0.1875, 0.0875),
     ),
-    "grasp": (  # 93 cells
-        (-0.4475, 0.1375, 0.1625), (-0.4225, 0.0875, 0.1125), (-0.3975, 0.0625, 0.0625), (-0.3975, 0.1125, 0.2125),
-        (-0.3725, 0.0875, 0.2625), (-0.3475, 0.0625, 0.2875), (-0.3225, 0.0125, 0.2625), (-0.2975, 0.0125, 0.2375),
-        (-0.2725, 0.0125, 0.2125), (-0.2475, -0.0125, 0.2125), (-0.2225, -0.0125, 0.1875), (-0.1975, -0.0125, 0.1875),
-        (-0.1725, 0.0125, 0.1625),
+    "grasp": (  # 85 cells
+        (-0.4225, 0.0875, 0.1125), (-0.3975, 0.0625, 0.0625), (-0.3975, 0.1125, 0.1375), (-0.3725, 0.0875, 0.2125),
+        (-0.3475, 0.0625, 0.2625), (-0.3225, 0.0125, 0.2625), (-0.2975, 0.0125, 0.2375), (-0.2725, 0.0125, 0.2125),
+        (-0.2475, -0.0125, 0.2125), (-0.2225, -0.0125, 0.1875), (-0.1975, -0.0125, 0.1875), (-0.1725, 0.0125, 0.1625),
     ),
 }
 

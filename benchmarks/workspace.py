@@ -26,6 +26,10 @@ SIZES = (0.04, 0.10)
 def reachable(env: TapAffordanceEnv, x: float, y: float) -> bool:
     """Whether the canonical action of the env's behaviour is reachable on every object at (x, y)."""
     top = env.physics.table_top
+    # The object out of the scene (a metre under the table): a workspace is where the arm's IK reaches every pose;
+    # whether a stroke's reach sweeps through the object is asked per object and action (feasible()).
+    env.physics.reset_home()
+    env.physics.set_object_pose(np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]))
     for object_type in OBJECT_TYPES:
         for size in SIZES:
             g = object_geometry(object_type, size)
