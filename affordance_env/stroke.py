@@ -25,9 +25,9 @@ STROKE_RAMP = 0.1
 #: object [m] (checked every REACH_SWEEP_STRIDE control ticks), else the stroke is not feasible: an arm that sweeps
 #: into the object moves it before the stroke (a "reach" failure). Over 150 random strokes per behaviour at
 #: positions over the workspaces, no penetration (0 m) flags 4 of 4 such failures of tap (and 4 strokes that would
-#: have moved the object less than the 3 mm allowed), 11 of 15 of tap_back (none wrongly; the other 4 started the
-#: stroke more than 1 cm from its pose) and 4 of 4 of push (1 wrongly); a 1 cm margin would refuse 8, 17 and 11
-#: strokes that work.
+#: have moved the object less than the 3 mm allowed), 11 of 15 of tap_back (none wrongly; of the other 4, 3 started
+#: the stroke more than 1 cm from its pose and 1 passed 0.8 mm from the object on its targets) and 4 of 4 of push
+#: (1 wrongly); a 1 cm margin would refuse 8, 17 and 11 strokes that work.
 REACH_CLEARANCE, REACH_SWEEP_STRIDE = 0.0, 5
 
 
