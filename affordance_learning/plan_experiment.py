@@ -304,16 +304,7 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
             break
     return {"policy": policy, "success": success, "steps": steps, "reach_failures": len(failures), "failures": failures,
             "final_distance": distance, "gave_up": gave_up, "type": info["object"]["type"],
-            "initial_distance": initial, "start_xy": start_xy, "target_xy": target_xy}
-
-
-def planner_episodes_tolerance() -> float:
-    """The goal env's tolerance [m] (its default)."""
-    import inspect
-
-    from affordance_env.goal_env import TapAffordanceGoalEnv
-
-    return float(inspect.signature(TapAffordanceGoalEnv).parameters["goal_tolerance"].default)
+            "initial_distance": initial, "start_xy": start_xy, "target_xy": target_xy, "tolerance": tolerance}
 
 
 #: The directions of :func:`step_reach`: world +x (towards the robot), -x (away), +y (to its left), -y.
@@ -507,7 +498,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
     multi["planner"]["by_type"] = {
         shape: {"n": len(eps), "success": sum(e["success"] for e in eps) / len(eps)}
         for shape in SHAPES if (eps := [e for e in planner_episodes if e["type"] == shape])}
-    reach, tolerance = step_reach(frame), planner_episodes_tolerance()
+    reach, tolerance = step_reach(frame), planner_episodes[0]["tolerance"]  # the goal env's
     multi["step_reach_p90_m"], multi["tolerance_m"], multi["max_interactions"] = (reach, tolerance,
                                                                                   GOAL_MAX_EPISODE_STEPS)
     multi["planner"]["episodes"] = [
