@@ -14,6 +14,7 @@ import mujoco
 import numpy as np
 
 from affordance_env.camera import RangeCamera, project
+from affordance_env.linalg import lstsq, norm
 from affordance_env.physics import TapPhysics
 
 #: Neck joints used for gaze: pitch (image rows) and yaw (image columns).
@@ -129,15 +130,15 @@ def attend(
     for iteration in range(1, max_iterations + 1):
         uv, p_world = seen
         error = uv - centre
-        if np.linalg.norm(error) <= tolerance:
-            return AttentionResult(True, True, float(np.linalg.norm(error)), iteration - 1)
+        if norm(error) <= tolerance:
+            return AttentionResult(True, True, norm(error), iteration - 1)
         jac = _image_jacobian(camera, physics, p_world, scratch)
         q = physics.joint_targets()
-        q[_gaze_indices(physics)] -= np.linalg.lstsq(jac, error, rcond=None)[0]
+        q[_gaze_indices(physics)] -= lstsq(jac, error)
         move_joints(q, move_time)
         move_joints(q, hold_time)
         seen = _centroid(camera, physics)
         if seen is None:
             return AttentionResult(False, False, float("inf"), iteration)
-    error = float(np.linalg.norm(seen[0] - centre))
+    error = norm(seen[0] - centre)
     return AttentionResult(error <= tolerance, True, error, max_iterations)

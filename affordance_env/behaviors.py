@@ -57,6 +57,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from affordance_env.linalg import matmul
 from affordance_env.objects import ObjectGeometry
 from affordance_env.robot_model import HAND_OPEN
 
@@ -268,7 +269,7 @@ def half_extent_along(geometry: ObjectGeometry, yaw: float, direction: np.ndarra
         return float(r)
     c, s = np.cos(yaw), np.sin(yaw)
     axes = np.array([[c, s], [-s, c]])  # the body's x and y axes in the world plane
-    return float(np.sum(r * np.abs(axes @ direction)))
+    return float(np.sum(r * np.abs(matmul(axes, direction))))
 
 
 def plan_stroke(
@@ -412,7 +413,7 @@ def plan_grasp(
     if top <= table_top:
         raise ValueError(f"the object's top ({top:.3f} m) must be above the table top ({table_top:.3f} m).")
     centre_hand = np.array([GRASP_CENTRE_HAND[0], GRASP_CENTRE_HAND[1] + a[1] * GRASP_LATERAL_RANGE, 0.0])
-    p_grasp = np.array([p_world_object[0], p_world_object[1], 0.0]) - R @ centre_hand
+    p_grasp = np.array([p_world_object[0], p_world_object[1], 0.0]) - matmul(R, centre_hand)
     p_grasp[2] = top + GRASP_GAP + a[0] * GRASP_HEIGHT_RANGE
     p_place = p_grasp + np.array([PLACE_SHIFT[0], PLACE_SHIFT[1], PLACE_CLEARANCE])
     return GraspPlan(

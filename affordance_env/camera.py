@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from affordance_env.linalg import matmul, norm
 from affordance_env.pinhole import Intrinsics
 
 #: The 8 corners of a box of half-sizes 1.
@@ -58,7 +59,7 @@ class RangeImage:
 
 def project(p_world: np.ndarray, p_world_camera: np.ndarray, R_world_camera: np.ndarray, K: Intrinsics) -> np.ndarray:
     """Pinhole projection of a world point to (u, v) pixels (NaN when the point is behind the camera)."""
-    p_camera = R_world_camera.T @ (np.asarray(p_world, dtype=float) - p_world_camera)
+    p_camera = matmul(np.asarray(p_world, dtype=float) - p_world_camera, R_world_camera)
     depth = -p_camera[2]
     if depth <= 1e-9:
         return np.array([np.nan, np.nan])
@@ -234,7 +235,7 @@ class RangeCamera:
 
         d_geom, a_geom = cone(geoms)
         d_target, a_target = cone(targets)
-        between = np.arccos(np.minimum(np.maximum(d_geom @ d_target.T, -1.0), 1.0))  # (geoms, targets)
+        between = np.arccos(np.minimum(np.maximum(matmul(d_geom, d_target.T), -1.0), 1.0))  # (geoms, targets)
         return (between <= a_geom[:, None] + a_target[None, :]).any(axis=1)
 
     def _rectangles(self, geoms: np.ndarray, data: mujoco.MjData, p_world_camera: np.ndarray,
@@ -246,7 +247,7 @@ class RangeCamera:
         R = data.geom_xmat[geoms].reshape(-1, 3, 3)
         p_world = data.geom_xpos[geoms][:, None, :] + np.einsum(
             "gij,gcj->gci", R, aabb[:, None, :3] + aabb[:, None, 3:] * _CORNERS)
-        p_camera = (p_world - p_world_camera) @ R_world_camera  # (geoms, 8, 3)
+        p_camera = matmul(p_world - p_world_camera, R_world_camera)  # (geoms, 8, 3)
         rectangles = []
         for geom, corners in zip(geoms.tolist(), p_camera, strict=True):
             points = _in_front(corners)  # the box clipped to the part in front of the camera
@@ -275,15 +276,15 @@ class RangeCamera:
             return np.empty(0, dtype=np.intp)
         inside = np.zeros((K.height, K.width), dtype=bool)
         for geom, u0, u1, v0, v1 in self._rectangles(geoms, data, p_world_camera, R_world_camera):
-            centre = (data.geom_xpos[geom] - p_world_camera) @ R_world_camera  # camera frame
-            distance = math.sqrt(centre @ centre)
+            centre = matmul(data.geom_xpos[geom] - p_world_camera, R_world_camera)  # camera frame
+            distance = norm(centre)
             radius = float(self.model.geom_rbound[geom]) * (1.0 + 1e-6) + 1e-9  # a hair wider: never too tight
             if distance <= radius:  # the camera is inside the sphere: the whole rectangle
                 inside[v0:v1, u0:u1] = True
                 continue
             # a ray meets the sphere iff its angle to the centre is at most asin(radius / distance)
             cos_cone = math.sqrt(1.0 - (radius / distance) ** 2)
-            inside[v0:v1, u0:u1] |= self._d_camera_grid[v0:v1, u0:u1] @ (centre / distance) >= cos_cone
+            inside[v0:v1, u0:u1] |= matmul(self._d_camera_grid[v0:v1, u0:u1], centre / distance) >= cos_cone
         if candidates is not None:
             return candidates[inside.ravel()[candidates]]
         return np.flatnonzero(inside)
@@ -303,7 +304,7 @@ class RangeCamera:
         """
         K = self.intrinsics
         p_world_camera, R_world_camera = self.pose(data)
-        d_world = R_world_camera @ self._d_camera_rays_T  # (3, n): rows x, y, z
+        d_world = matmul(R_world_camera, self._d_camera_rays_T)  # (3, n): rows x, y, z
         normal = np.empty(3 * len(self._dist)) if normals else None
         self._geom_ids[:] = -1
         if window:

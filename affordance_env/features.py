@@ -43,6 +43,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from affordance_env.linalg import matmul
+
 N_FEATURES = 49
 #: Bins of each normal histogram.
 N_BINS = 12
@@ -312,7 +314,7 @@ def _size_features(
 ) -> list[float]:
     """The 18 size features from the object points (3, k) [m], ranges (k,) [m] and pixels (2, k) [pixels]."""
     duv = uv_obj - uv_centroid[:, None]
-    scatter = duv @ duv.T  # k times the covariance [pixels^2]; the angle does not depend on the scale
+    scatter = matmul(duv, duv.T)  # k times the covariance [pixels^2]; the angle does not depend on the scale
     c_uu, c_vv, c_uv = float(scatter[0, 0]), float(scatter[1, 1]), float(scatter[0, 1])
     if math.hypot(c_uu - c_vv, 2.0 * c_uv) <= _ISOTROPY_TOLERANCE * (c_uu + c_vv):
         theta = 0.0

@@ -10,13 +10,13 @@ simulation. Configurations are vectors in the variant's ``active_joints`` order;
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 import pinocchio as pin
 
+from affordance_env.linalg import matmul, norm, solve_spd
 from affordance_env.robot_model import (
     HAND_MOUNT_FRAME,
     HAND_MOUNT_POS,
@@ -188,7 +188,8 @@ class Kinematics:
             R_world_target = np.asarray(R_world_target, dtype=float)
             # a stroke asks for one orientation many times: the last one checked need not be checked again
             if not (R_world_target.shape == (3, 3) and np.array_equal(R_world_target, self._last_rotation)):
-                if R_world_target.shape != (3, 3) or np.abs(R_world_target @ R_world_target.T - np.eye(3)).max() > 1e-6:
+                if (R_world_target.shape != (3, 3)
+                        or np.abs(matmul(R_world_target, R_world_target.T) - np.eye(3)).max() > 1e-6):
                     raise ValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
                 self._last_rotation = R_world_target.copy()
         lower, upper = self.joint_limits(joint_ranges)
@@ -207,24 +208,24 @@ class Kinematics:
             J = pin.computeFrameJacobian(model, data, q, frame, pin.LOCAL_WORLD_ALIGNED)
             T_world_hand = data.oMf[frame]
             error[:3] = p_target - T_world_hand.translation
-            pos_err = math.sqrt(error[:3] @ error[:3])
+            pos_err = norm(error[:3])
             jac = J[:n_error, dofs]
             if R_world_target is None:
                 rot_err = 0.0
             else:
-                e_rot = pin.log3(R_world_target @ T_world_hand.rotation.T)
-                rot_err = math.sqrt(e_rot @ e_rot)
+                e_rot = pin.log3(matmul(R_world_target, T_world_hand.rotation.T))
+                rot_err = norm(e_rot)
                 error[3:] = orientation_weight * e_rot
                 jac[3:] *= orientation_weight
             if pos_err <= position_tolerance and rot_err <= orientation_tolerance * 0.5:
                 break
-            step = jac.T @ np.linalg.solve(jac @ jac.T + regulariser, error)
+            step = matmul(solve_spd(matmul(jac, jac.T) + regulariser, error), jac)
             q[dofs] = np.minimum(np.maximum(q[dofs] + step, lower), upper)
         else:
             pin.framesForwardKinematics(model, data, q)
             T_world_hand = data.oMf[frame]
-            pos_err = float(np.linalg.norm(p_target - T_world_hand.translation))
+            pos_err = norm(p_target - T_world_hand.translation)
             if R_world_target is not None:
-                rot_err = float(np.linalg.norm(pin.log3(R_world_target @ T_world_hand.rotation.T)))
+                rot_err = norm(pin.log3(matmul(R_world_target, T_world_hand.rotation.T)))
         success = pos_err <= position_tolerance and rot_err <= orientation_tolerance
         return IKResult(q[self._from_pin], bool(success), pos_err, rot_err, iteration)

@@ -21,6 +21,7 @@ import numpy as np
 
 from affordance_env.behaviors import GraspPlan, StrokePlan
 from affordance_env.kinematics import IKResult, Kinematics
+from affordance_env.linalg import dot, norm
 from affordance_env.motor_limits import velocity_limits
 from affordance_env.outcome import REST_ANGULAR_SPEED, REST_SPEED
 from affordance_env.physics import TapPhysics
@@ -326,7 +327,7 @@ class MotionExecutor:
         Returns the remaining distance [m] (larger than ``tolerance`` if ``max_time`` [s] ran out).
         """
         def arrived() -> bool:
-            return float(np.linalg.norm(self.palm - p_world_target)) <= tolerance
+            return norm(self.palm - p_world_target) <= tolerance
 
         if not arrived():
             q = self.physics.joint_targets()
@@ -335,7 +336,7 @@ class MotionExecutor:
                 self.physics.step(self.steps_per_tick)
                 if arrived():
                     break
-        return float(np.linalg.norm(self.palm - p_world_target))
+        return norm(self.palm - p_world_target)
 
     def ik(self, p: np.ndarray, q_init: np.ndarray, plan: StrokePlan | GraspPlan) -> IKResult:
         """IK of a palm position with the plan's hand orientation (and joint ranges, if it has any)."""
@@ -375,7 +376,7 @@ class MotionExecutor:
                 physics.step(n_steps)
                 if not touched_yet and touched():
                     touched_yet, time, p_touch = True, float(physics.data.time), palm.copy()
-                    speed = float(np.linalg.norm(palm - p_before) / (n_steps * dt))
+                    speed = norm(palm - p_before) / (n_steps * dt)
             else:  # step by step: the touch, and the follow-through after it, to the step
                 for _ in range(n_steps):
                     if not touched_yet:
@@ -383,11 +384,11 @@ class MotionExecutor:
                     physics.step()
                     if not touched_yet and touched():
                         touched_yet, time, p_touch = True, float(physics.data.time), palm.copy()
-                        speed = float(np.linalg.norm(palm - p_before) / dt)
-                    if touched_yet and np.dot(palm - p_touch, direction) >= follow_through:
+                        speed = norm(palm - p_before) / dt
+                    if touched_yet and dot(palm - p_touch, direction) >= follow_through:
                         done = True
                         break
-            if touched_yet and (done or np.dot(palm - p_touch, direction) >= follow_through):
+            if touched_yet and (done or dot(palm - p_touch, direction) >= follow_through):
                 self.stop()
                 break
         return LineResult(touched_yet, time, speed, p_touch)
@@ -397,7 +398,7 @@ class MotionExecutor:
         """The :class:`LinePath` from ``p_from`` to ``p_to`` [m] at ``speed`` [m/s], from ``q_start`` (default: the
         current servo targets)."""
         delta = np.asarray(p_to, dtype=float) - np.asarray(p_from, dtype=float)
-        length = float(np.linalg.norm(delta))
+        length = norm(delta)
         q0 = self.physics.joint_targets() if q_start is None else q_start
         return LinePath(self, p_from, delta / length, length, orientation, speed, q0, **kwargs)
 

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from affordance_env.linalg import norm
+
 #: Object types, as named in the paper.
 OBJECT_TYPES: tuple[str, ...] = ("sphere", "box", "horizontal_cylinder", "vertical_cylinder")
 #: Which primitive geom of the scene's ``object`` body each type uses.
@@ -119,9 +121,9 @@ def as_resting(geometry: ObjectGeometry, quat: np.ndarray) -> tuple[ObjectGeomet
     yaw of its faces. The shapes are such that the height above the table does not change (cylinders as long as
     they are wide, boxes cubes); what changes is the extent across a stroke and the hand's turn over a grasp."""
     q = np.asarray(quat, dtype=float)
-    if q.shape != (4,) or not np.all(np.isfinite(q)) or np.linalg.norm(q) == 0.0:
+    if q.shape != (4,) or not np.all(np.isfinite(q)) or norm(q) == 0.0:
         raise ValueError(f"quat must be a finite, non-zero quaternion (w, x, y, z), got {quat!r}.")
-    w, x, y, z = q / np.linalg.norm(q)
+    w, x, y, z = q / norm(q)
     R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                   [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
                   [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])

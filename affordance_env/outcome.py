@@ -36,6 +36,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from affordance_env.linalg import dot
+
 #: The object is still when its linear speed [m/s] and angular speed [rad/s] are below these ...
 REST_SPEED, REST_ANGULAR_SPEED = 0.01, 0.3
 #: ... and at rest once it has been still this long [s].
@@ -136,8 +138,8 @@ def tilt(quat_initial: np.ndarray, quat_final: np.ndarray) -> float:
     R0, R1 = np.empty(9), np.empty(9)
     mujoco.mju_quat2Mat(R0, np.asarray(quat_initial, dtype=np.float64))
     mujoco.mju_quat2Mat(R1, np.asarray(quat_final, dtype=np.float64))
-    up_body = R0.reshape(3, 3).T @ np.array([0.0, 0.0, 1.0])
-    return float(np.arccos(np.clip((R1.reshape(3, 3) @ up_body)[2], -1.0, 1.0)))
+    up_body = R0.reshape(3, 3)[2]  # the world's z axis in the body's frame: R0.T @ (0, 0, 1)
+    return float(np.arccos(np.clip(dot(R1.reshape(3, 3)[2], up_body), -1.0, 1.0)))
 
 
 @dataclass(frozen=True)

@@ -13,6 +13,7 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
+from affordance_env.linalg import norm
 from affordance_env.objects import PRIMITIVES, ObjectGeometry
 from affordance_env.outcome import ObjectMonitor
 from affordance_env.robot_model import HAND_COUPLINGS, coupled_position, get_variant
@@ -381,12 +382,12 @@ class TapPhysics:
     def object_speed(self) -> float:
         """Linear speed of the object [m/s]."""
         v = self.data.qvel[self.object_qvel : self.object_qvel + 3]
-        return float(np.linalg.norm(v))
+        return norm(v)
 
     def object_angular_speed(self) -> float:
         """Angular speed of the object [rad/s]."""
         w = self.data.qvel[self.object_qvel + 3 : self.object_qvel + 6]
-        return float(np.linalg.norm(w))
+        return norm(w)
 
     def object_on_table(self) -> bool:
         """Whether the object's centre is above the table top and within its extent."""

@@ -19,6 +19,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from affordance_env.linalg import matmul
+
 if TYPE_CHECKING:  # only for annotations: importing the camera would import MuJoCo
     from affordance_env.camera import RangeImage
 
@@ -61,7 +63,7 @@ def add_kinect_noise(image: RangeImage, rng: np.random.Generator) -> RangeImage:
     ranges = image.ranges.astype(np.float64)
     r = ranges[hit]
     rays = (image.p_world_points[hit] - image.p_world_camera) / r[:, None]  # unit rays, world frame
-    cos_axis = -(rays @ image.R_world_camera[:, 2])  # the camera looks along its -z axis
+    cos_axis = -matmul(rays, image.R_world_camera[:, 2])  # the camera looks along its -z axis
     depth = r * cos_axis
     incidence = np.arccos(np.clip(np.abs(np.sum(image.normals[hit] * rays, axis=1)), 0.0, 1.0))
     noisy = np.maximum(depth + rng.normal(size=depth.shape) * kinect_axial_sigma(depth, incidence), 1e-3)

@@ -14,6 +14,7 @@ import mujoco
 import numpy as np
 
 from affordance_env.assets_path import assets_dir
+from affordance_env.linalg import matmul
 from affordance_env.model_cache import cached_model
 from affordance_env.motor_limits import torque_limits
 from affordance_env.robot_model import (
@@ -208,7 +209,7 @@ def hand_inertias() -> dict[str, list[float]]:
         R = np.empty(9)
         mujoco.mju_quat2Mat(R, model.body_iquat[b])
         R = R.reshape(3, 3)
-        inertia = (urdf_mass / model.body_mass[b]) * (R @ np.diag(model.body_inertia[b]) @ R.T)
+        inertia = (urdf_mass / model.body_mass[b]) * matmul(matmul(R, np.diag(model.body_inertia[b])), R.T)
         tensors[name] = [inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]]
     return tensors
 
@@ -234,7 +235,7 @@ def phalanx_capsules() -> dict[str, tuple[tuple[float, float, float], float, flo
             R = np.empty(9)
             mujoco.mju_quat2Mat(R, model.geom_quat[g])
             start, count = model.mesh_vertadr[mesh], model.mesh_vertnum[mesh]
-            vertices.append(model.mesh_vert[start : start + count] @ R.reshape(3, 3).T + model.geom_pos[g])
+            vertices.append(matmul(model.mesh_vert[start : start + count], R.reshape(3, 3).T) + model.geom_pos[g])
         p_link_vertices = np.vstack(vertices)
         low, high = p_link_vertices.min(axis=0), p_link_vertices.max(axis=0)
         extent = high - low

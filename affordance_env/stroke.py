@@ -15,6 +15,7 @@ import numpy as np
 
 from affordance_env.behaviors import StrokePlan
 from affordance_env.kinematics import IKResult
+from affordance_env.linalg import dot, norm
 from affordance_env.motion import CONTROL_DT, MIN_MOVE_TIME, LinePath, MotionExecutor, ReachOutcome, ik_verdict
 from affordance_env.trajectory import JointTrajectory, minimum_jerk
 
@@ -69,7 +70,7 @@ def plan_approach(motion: MotionExecutor, plan: StrokePlan) -> tuple[IKResult | 
 def plan_stroke_path(motion: MotionExecutor, plan: StrokePlan) -> tuple[IKResult | None, IKResult, LinePath]:
     """The stroke's IK, solved before any move: the poses of :func:`plan_approach` and the stroke's line."""
     above, start = plan_approach(motion, plan)
-    length = float(np.dot(plan.p_end - plan.p_start, plan.direction))
+    length = dot(plan.p_end - plan.p_start, plan.direction)
     # The joint speeds along the whole line cap the stroke's speed.
     path = LinePath(motion, plan.p_start, plan.direction, length, plan, plan.speed, start.q, ramp=STROKE_RAMP,
                     to_rest=False)
@@ -103,12 +104,12 @@ def run_stroke(motion: MotionExecutor, plan: StrokePlan) -> StrokeOutcome:
     with motion.stepping(motion.free_timestep):  # the object rests and the hand moves in free space
         motion.follow(reach_trajectory(motion, above, start))  # through the pose above, if any
         start_error = motion.settle(plan.p_start)
-    object_moved = float(np.linalg.norm(physics.object_pose()[:3] - p_object_before))
+    object_moved = norm(physics.object_pose()[:3] - p_object_before)
     p_hand_start = motion.palm.copy()
     motion.phase = "stroke"
     result = motion.follow_line(path, physics.hand_touches_object, per_step=True,
                               follow_through=plan.follow_through)
-    travel = float(np.dot(motion.palm.copy() - p_hand_start, plan.direction))
+    travel = dot(motion.palm.copy() - p_hand_start, plan.direction)
     # The pose above the object is a via point that only has to clear it; the stroke itself must be exact.
     return StrokeOutcome(*ik_verdict([start, *path.results]), result.touched, result.time, result.speed,
                          travel, start_error, object_moved, None if above is None else above.q, path.speed)

@@ -18,6 +18,7 @@ from affordance_env.camera import RangeCamera
 from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
 from affordance_env.interactions import Interaction, get_interaction
 from affordance_env.kinematics import Kinematics
+from affordance_env.linalg import norm
 from affordance_env.motion import HOLD_MAX_TIME, HOLD_SPEED_TOLERANCE, MotionExecutor, ReachOutcome
 from affordance_env.objects import as_resting, check_object_type, check_size, object_geometry
 from affordance_env.options import EnvOptions
@@ -439,13 +440,13 @@ class TapAffordanceEnv(gym.Env):
         if ok:
             ok = (bool(np.all(pose[:2] >= low) and np.all(pose[:2] <= high))
                   and top + 0.5 * geometry.half_height <= pose[2] <= top + 3.0 * geometry.rbound
-                  and float(np.linalg.norm(pose[3:])) > 1e-6)
+                  and norm(pose[3:]) > 1e-6)
         if not ok:
             raise ValueError(f"object_pose must be (x, y, z, qw, qx, qy, qz): x in [{low[0]:.2f}, {high[0]:.2f}] and "
                              f"y in [{low[1]:.2f}, {high[1]:.2f}] m on the table, z [m] the object's centre above the "
                              f"table top ({top:.3f} m) by {0.5 * geometry.half_height:.3f} to "
                              f"{3.0 * geometry.rbound:.3f} m, and a non-zero quaternion; got {value!r}.")
-        pose[3:] /= np.linalg.norm(pose[3:])
+        pose[3:] /= norm(pose[3:])
         return pose
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
@@ -626,7 +627,7 @@ class TapAffordanceEnv(gym.Env):
                                   interaction)
         # Travel on the table: to where the object rests, or to where it left the table (not where it fell).
         p_end = monitor.exit_position if monitor.left_table else final_pose
-        displacement = 0.0 if fault else float(np.linalg.norm(p_end[:2] - initial["pose"][:2]))
+        displacement = 0.0 if fault else norm(p_end[:2] - initial["pose"][:2])
         labels = None if fault else outcome_labels(monitor, initial["pose"][3:], final_pose[3:],
                                                    self.roll_threshold)
         effect = (

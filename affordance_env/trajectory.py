@@ -18,6 +18,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from affordance_env.linalg import matmul
+
 #: The minimum-jerk profile 10 t^3 - 15 t^4 + 6 t^5 peaks at this multiple of its mean speed.
 PEAK_SPEED_FACTOR = 1.875
 #: Share of the shorter of two consecutive segments of a move through via points during which both run.
@@ -103,8 +105,8 @@ def minimum_jerk(q_from: np.ndarray, waypoints: list[np.ndarray] | np.ndarray, v
         rate = 30.0 * tau ** 2 * (1.0 + tau * (tau - 2.0)) / lengths
         acceleration = 60.0 * tau * (1.0 + tau * (2.0 * tau - 3.0)) / lengths ** 2
         time_scale = n * dt / end  # real seconds per unstretched second
-        return JointTrajectory(q_from + position @ deltas, (rate @ deltas) / time_scale,
-                               (acceleration @ deltas) / time_scale ** 2, dt)
+        return JointTrajectory(q_from + matmul(position, deltas), matmul(rate, deltas) / time_scale,
+                               matmul(acceleration, deltas) / time_scale ** 2, dt)
 
     trajectory = sample(1.0)
     # Overlapping segments may add up, and rounding to whole samples shortens by up to half a sample.

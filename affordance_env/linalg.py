@@ -1,0 +1,65 @@
+"""Small-matrix linear algebra that gives the same bits on every x86-64 CPU.
+
+numpy hands ``@``, ``np.dot``, ``np.linalg.norm`` of a vector, ``np.linalg.solve`` and ``np.linalg.lstsq`` to
+OpenBLAS, which chooses its kernels when it loads, by the CPU it finds (``Haswell`` on an AVX2 machine, ``SkylakeX``
+on an AVX-512 one, ...: ``threadpoolctl.threadpool_info()`` names the one in use). The kernels add their products in
+different orders, so the same product differs in its last bits from one machine to the next. A tap is a contact
+problem: a difference of 1e-12 rad in a servo target moves some objects by millimetres, and one last bit in an
+inverse-kinematics step ends as a different interaction. Everything the simulation computes with numpy therefore
+goes through these functions, which never call BLAS:
+
+- products are ``np.einsum`` without path optimisation, whose loops numpy compiles for its baseline CPU only;
+- the small linear systems are solved by Eigen (through eigenpy, which Pinocchio brings), compiled into the wheel
+  for one instruction set.
+
+Elementwise numpy arithmetic and reductions (``+``, ``*``, ``np.sum``) are exact or do not depend on the CPU, and
+stay as they are.
+"""
+
+from __future__ import annotations
+
+import math
+
+import eigenpy
+import numpy as np
+
+_SUBSCRIPTS = {(1, 1): "i,i->", (1, 2): "i,ij->j", (2, 1): "...ij,j->...i", (2, 2): "...ij,jk->...ik"}
+
+
+def matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a @ b`` for ``b`` a vector or a matrix and ``a`` a vector or a stack of matrices, in the same bits on
+    every CPU."""
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    key = (min(a.ndim, 2), b.ndim)
+    if key not in _SUBSCRIPTS or a.ndim == 0:
+        raise ValueError(f"matmul takes a vector or (a stack of) matrices times a vector or a matrix, got shapes "
+                         f"{a.shape} and {b.shape}.")
+    return np.einsum(_SUBSCRIPTS[key], a, b)
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> float:
+    """The dot product of two vectors, as a float."""
+    return float(matmul(np.ravel(a), np.ravel(b)))
+
+
+def norm(v: np.ndarray) -> float:
+    """The Euclidean norm of a vector (``np.linalg.norm`` of a 1-D array goes through BLAS)."""
+    v = np.ravel(np.asarray(v, dtype=np.float64))
+    return math.sqrt(float(np.einsum("i,i->", v, v)))
+
+
+def solve_spd(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``x`` with ``A x = b`` for a symmetric positive definite ``A`` (Cholesky, Eigen's ``LLT``)."""
+    A = np.asarray(A, dtype=np.float64)
+    decomposition = eigenpy.LLT(A)
+    if decomposition.info() != eigenpy.ComputationInfo.Success:
+        raise ValueError(f"solve_spd needs a symmetric positive definite matrix, got {A!r}.")
+    return np.asarray(decomposition.solve(np.asarray(b, dtype=np.float64)), dtype=np.float64)
+
+
+def lstsq(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The minimum-norm least-squares solution of ``A x = b``, as ``np.linalg.lstsq(A, b)[0]`` gives it
+    (Eigen's complete orthogonal decomposition, which also handles a rank-deficient ``A``)."""
+    A = np.asarray(A, dtype=np.float64)
+    return np.asarray(eigenpy.CompleteOrthogonalDecomposition(A).solve(np.asarray(b, dtype=np.float64)),
+                      dtype=np.float64)
