@@ -97,11 +97,10 @@ def _fingerprint(args: argparse.Namespace) -> int:
         if not args.check:
             print(f"{write_reference_fingerprint(where, args.workers)} written")
             continue
-        problems = check_fingerprint(where, args.workers)
-        drifted += bool(problems)
-        print(f"{where}: " + ("the same interactions, bit for bit" if not problems else
-                              f"{len(problems)} difference(s) from its fingerprint.json:"))
-        for problem in problems:
+        check = check_fingerprint(where, args.workers)
+        drifted += not check.ok
+        print(f"{where}: {check.summary()}")
+        for problem in check.problems:
             print(f"  {problem}")
     return 1 if drifted else 0
 

@@ -27,9 +27,12 @@ import json
 import time
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from affordance_env.dataset.fingerprint import FingerprintCheck
 
 #: The behaviours the paper reports on, run by default.
 DEFAULT_BEHAVIORS = ("tap", "grasp")
@@ -208,10 +211,12 @@ def write_reference_fingerprint(where: str | Path, workers: int = 1) -> Path:
     return _write_fingerprint(_collect_reference(where, workers), where)
 
 
-def check_fingerprint(where: str | Path, workers: int = 1) -> list[str]:
-    """How the first interactions that ``affordance reproduce`` collects now differ from those pinned down by the
-    ``fingerprint.json`` of the reproduction in ``where``; empty when they are the same, bit for bit."""
-    from affordance_env.dataset.fingerprint import fingerprint_differences
+def check_fingerprint(where: str | Path, workers: int = 1) -> FingerprintCheck:
+    """Collect the first interactions that ``affordance reproduce`` collects for the reproduction in ``where``
+    again and compare them with its ``fingerprint.json``: bit for bit where it was made with the versions and CPU
+    found here, otherwise by what holds across machines
+    (:func:`~affordance_env.dataset.fingerprint.compare_fingerprints`)."""
+    from affordance_env.dataset.fingerprint import compare_fingerprints
 
     where = Path(where)
     try:
@@ -219,7 +224,7 @@ def check_fingerprint(where: str | Path, workers: int = 1) -> list[str]:
     except (OSError, ValueError) as exc:
         raise ValueError(f"{where / FINGERPRINT} cannot be read ({exc}); write it with `affordance fingerprint "
                          f"{where}`.") from None
-    return fingerprint_differences(expected, _collect_reference(where, workers))
+    return compare_fingerprints(expected, _collect_reference(where, workers))
 
 
 def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, dict[str, Any]]:

@@ -29,10 +29,12 @@ def test_every_shipped_reproduction_has_a_fingerprint_of_its_settings():
 
 @pytest.mark.slow
 @pytest.mark.parametrize("where", REPRODUCTIONS, ids=[p.name for p in REPRODUCTIONS])
-def test_the_first_30_interactions_of_each_shipped_reproduction_are_collected_again_bit_for_bit(where):
+def test_the_first_30_interactions_of_each_shipped_reproduction_are_collected_again(where):
     # Fails when a change to the simulation changes the data behind docs/reproduction: regenerate the
-    # reproductions and their fingerprints (docs/reproduction/README.md says how), or undo the change.
-    assert check_fingerprint(where, workers=2) == []
+    # reproductions and their fingerprints (docs/reproduction/README.md says how), or undo the change. Bit for bit
+    # with the versions and the CPU the fingerprint records; elsewhere, what holds across machines.
+    check = check_fingerprint(where, workers=2)
+    assert check.ok, f"{check.summary()}: {check.problems}"
 
 
 @pytest.fixture(scope="module")
