@@ -150,3 +150,35 @@ def test_interactions_do_not_depend_on_the_blas_kernels_of_the_cpu():
     blas = {products for products, _ in digests.values()}
     assert len(blas) > 1, "the BLAS kernels gave the same products: OPENBLAS_CORETYPE had no effect here"
     assert len({interactions for _, interactions in digests.values()}) == 1, json.dumps(digests)
+
+
+def _results(uniformity_k3: float = 0.77, success: float = 0.5, std: float = 0.05) -> dict:
+    config = {"behavior": "tap", "seed": 0, "episodes": 1000, "ks": [2, 3], "relevancies": [0.0],
+              "range_noise": "none", "n_trials": 20, "n_rows": 1000, "success_fraction": success}
+    return {"results_format": 2, "config": config,
+            "uniformity": {"2": {"mean": 0.40, "std": 0.3}, "3": {"mean": uniformity_k3, "std": std}},
+            "svm_accuracy": {"0.0": {"2": {"mean": 0.95, "std": 0.01}, "3": {"mean": 0.92, "std": 0.01}}}}
+
+
+def test_two_reproductions_agree_within_the_trials_own_spread():
+    from affordance_learning.agreement import FLOOR, Z, compare_results
+
+    same = compare_results(_results(), _results(uniformity_k3=0.79))  # 2 points at a spread of 5 points
+    assert all(c.ok for c in same) and len(same) == 1 + 2 + 2
+    k3 = next(c for c in same if c.name == "uniformity at k = 3")
+    assert k3.tolerance == pytest.approx(Z * 0.05 * 2 ** 0.5 / 20 ** 0.5)
+    moved = compare_results(_results(), _results(uniformity_k3=0.83))
+    assert [c.name for c in moved if not c.ok] == ["uniformity at k = 3"] and "outside" in str(moved[2])
+    tight = compare_results(_results(std=0.0), _results(uniformity_k3=0.775, std=0.0))
+    assert next(c for c in tight if c.name == "uniformity at k = 3").tolerance == FLOOR  # never below a point
+    fewer = compare_results(_results(), _results(success=0.58))  # 8 points more successes of 1000
+    assert [c.name for c in fewer if not c.ok] == ["share of successes"]
+
+
+def test_only_reproductions_of_the_same_experiment_are_compared():
+    from affordance_learning.agreement import compare_results
+
+    other = _results()
+    other["config"]["seed"] = 1
+    with pytest.raises(ValueError, match="seed 1 \\(reference 0\\)"):
+        compare_results(_results(), other)

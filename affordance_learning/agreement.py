@@ -1,0 +1,83 @@
+"""Whether two reproductions of one experiment agree: the numbers a reproduction keeps across machines and versions.
+
+With the same versions on the same kind of machine a reproduction is found again bit for bit. Elsewhere contacts
+make single interactions chaotic, so what holds is statistical: each headline number of ``results.json`` lies within
+a tolerance of the reference's,
+
+- for a mean over learning trials (uniformity at each k, SVM accuracy at each k and r), :data:`Z` standard errors of
+  the difference of two such means, from the trials' own spread: ``Z * sqrt(std_a**2 + std_b**2) / sqrt(trials)``;
+- for a share of the interactions (the share of successes), :data:`Z` standard errors of the difference of two
+  binomial shares;
+
+and never tighter than :data:`FLOOR`. Between OpenBLAS's Haswell and SkylakeX kernels (two CPUs, before the
+simulation was made independent of them) the tap's uniformity moved by at most 1.5 points at one k, its SVM
+accuracy by at most 2.5; these tolerances hold those and flag a change of the method's outcome.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from affordance_learning.results import current_results
+
+#: Standard errors a number may move by (two-sided, about 0.3 % by chance for a normal difference).
+Z = 3.0
+#: The smallest tolerance [fraction]: one point, the resolution the reports print.
+FLOOR = 0.01
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """One number of two reproductions: its name, the reference's value, the value found and the tolerance."""
+
+    name: str
+    reference: float
+    found: float
+    tolerance: float
+
+    @property
+    def ok(self) -> bool:
+        return abs(self.found - self.reference) <= self.tolerance
+
+    def __str__(self) -> str:
+        return (f"{self.name}: {100 * self.found:.1f} % against {100 * self.reference:.1f} % "
+                f"(tolerance {100 * self.tolerance:.1f} points){'' if self.ok else ' -- outside'}")
+
+
+def _mean_tolerance(a: Mapping[str, Any], b: Mapping[str, Any], trials: int) -> float:
+    spread = math.sqrt(float(a.get("std") or 0.0) ** 2 + float(b.get("std") or 0.0) ** 2)
+    return max(FLOOR, Z * spread / math.sqrt(max(trials, 1)))
+
+
+def _share_tolerance(p: float, n_a: int, n_b: int) -> float:
+    return max(FLOOR, Z * math.sqrt(p * (1.0 - p) * (1.0 / max(n_a, 1) + 1.0 / max(n_b, 1))))
+
+
+def compare_results(reference: Mapping[str, Any], found: Mapping[str, Any]) -> list[Comparison]:
+    """Every headline number of ``found`` beside ``reference`` (two ``results.json`` of ``affordance reproduce``
+    for one behaviour), with its tolerance. Raises ValueError when they are not the same experiment."""
+    reference, found = current_results(reference), current_results(found)
+    ca, cb = reference.get("config", {}), found.get("config", {})
+    same = ("behavior", "seed", "episodes", "ks", "relevancies", "range_noise")
+    differ = [f"{key} {cb.get(key)!r} (reference {ca.get(key)!r})" for key in same if ca.get(key) != cb.get(key)]
+    if differ:
+        raise ValueError(f"the results are not of the same experiment: {', '.join(differ)}.")
+    trials = min(int(ca.get("n_trials") or ca.get("trials") or 1), int(cb.get("n_trials") or cb.get("trials") or 1))
+    out = []
+    p_a, p_b = float(ca["success_fraction"]), float(cb["success_fraction"])
+    out.append(Comparison("share of successes", p_a, p_b,
+                          _share_tolerance(0.5 * (p_a + p_b), int(ca["n_rows"]), int(cb["n_rows"]))))
+    for k, a in reference["uniformity"].items():
+        b = found["uniformity"].get(k, {})
+        if a.get("mean") is not None and b.get("mean") is not None:
+            out.append(Comparison(f"uniformity at k = {k}", a["mean"], b["mean"], _mean_tolerance(a, b, trials)))
+    for r, by_k in reference["svm_accuracy"].items():
+        for k, a in by_k.items():
+            b = found["svm_accuracy"].get(r, {}).get(k, {})
+            if a.get("mean") is not None and b.get("mean") is not None:
+                out.append(Comparison(f"SVM accuracy at k = {k}, r = {r}", a["mean"], b["mean"],
+                                      _mean_tolerance(a, b, trials)))
+    return out
