@@ -6,16 +6,21 @@ new process that builds an env pays the compile once: every worker of a collecti
 cache keeps the compiled model of each robot variant in a file named by a hash of all its inputs:
 
 - the MuJoCo version, the robot variant;
-- the source of the ``affordance_env`` package (the code that builds the scene) and the shipped ``assets/``;
-- the two URDFs of ``icub-models`` and every mesh file they name (their contents, not their dates).
+- the source of the ``affordance_env`` package (the code that builds the scene: its ``.py`` files) and the
+  shipped ``assets/``, each file by its contents and its path within the package, so that a source checkout and
+  an installed copy of the same version, wherever they are, share their models;
+- the two URDFs of ``icub-models`` and every mesh file they name (their contents, not their dates; the URDFs
+  name the meshes by their installed paths, which the compiled model keeps).
 
 Any change to any of these gives another name, so a cached model is always the one that compiling would give
-(``tests/test_scene.py`` checks byte for byte). A file that cannot be read is compiled again and replaced; a
-directory that cannot be written to only means compiling every time.
+(``tests/test_model_cache.py`` checks byte for byte). A file that cannot be read is compiled again and replaced;
+a directory that cannot be written to only means compiling every time.
 
 The directory is ``$TAP_AFFORDANCE_CACHE``, else ``$XDG_CACHE_HOME/tap-affordance``, else
-``~/.cache/tap-affordance``; ``TAP_AFFORDANCE_CACHE=off`` turns the cache off. A model takes about 45 MB; the
-newest :data:`KEEP` files of each variant are kept.
+``~/.cache/tap-affordance``; ``TAP_AFFORDANCE_CACHE=off`` turns the cache off. A model takes 45-55 MB. The cache
+stays bounded: after a model is written, the least recently used ones (a model read from the cache counts as
+used) are removed beyond :data:`KEEP` per variant and beyond :data:`MAX_BYTES` in all, never the one just
+written.
 """
 
 from __future__ import annotations
@@ -36,8 +41,11 @@ from affordance_env.fileio import write_atomically
 
 #: Environment variable naming the cache directory (``off``: no cache).
 CACHE_ENV = "TAP_AFFORDANCE_CACHE"
-#: Cached models kept per variant (older ones are removed when a new one is written).
-KEEP = 3
+#: Cached models kept per variant (older ones are removed when a new one is written): the current one and one
+#: other (of another version of the package or of MuJoCo in use beside it).
+KEEP = 2
+#: Bytes of cached models kept in all: the four variants' current models (about 205 MB) and little more.
+MAX_BYTES = 256 * 2**20
 #: A temporary file older than this [s] is what a killed write left: removed when the next model is written.
 STALE_TMP_AGE = 600.0
 _PACKAGE = Path(__file__).resolve().parent
@@ -64,10 +72,13 @@ def fingerprint(variant: str, urdfs: tuple[str, ...]) -> str:
 
     add("mujoco", mujoco.__version__.encode())
     add("variant", variant.encode())
-    for root in (_PACKAGE, assets_dir()):
-        for path in sorted(p for p in root.rglob("*") if p.is_file() and "__pycache__" not in p.parts
-                           and p.suffix != ".pyc"):
-            add(str(path.relative_to(root)), path.read_bytes())
+    # The package's code without its assets (an installed package holds them in affordance_env/assets, a checkout
+    # beside it: hashed once, below), and the assets; by their paths relative to their folder, not where it is.
+    sources = [p for p in _PACKAGE.rglob("*.py") if p.relative_to(_PACKAGE).parts[0] != "assets"]
+    assets = [p for p in assets_dir().rglob("*") if p.is_file() and "__pycache__" not in p.parts]
+    for label, root, paths in (("package", _PACKAGE, sources), ("assets", assets_dir(), assets)):
+        for path in sorted(paths, key=lambda p: p.relative_to(root).as_posix()):
+            add(f"{label}/{path.relative_to(root).as_posix()}", path.read_bytes())
     for text in urdfs:
         add("urdf", text.encode())
         for mesh in sorted(set(_MESH_FILE.findall(text))):
@@ -86,9 +97,13 @@ def cached_model(variant: str, urdfs: tuple[str, ...], compile_model: Callable[[
     path = directory / f"model-{variant}-{fingerprint(variant, urdfs)[:32]}.mjb"
     if path.is_file():
         try:
-            return mujoco.MjModel.from_binary_path(str(path))
+            model = mujoco.MjModel.from_binary_path(str(path))
         except Exception:  # noqa: BLE001 (truncated or corrupt: compile it again and replace it)
             pass
+        else:
+            with contextlib.suppress(OSError):  # used now: the last to be evicted (a read-only cache stays as it is)
+                os.utime(path)
+            return model
     model = compile_model()
     try:
         _store(model, path)
@@ -98,17 +113,37 @@ def cached_model(variant: str, urdfs: tuple[str, ...], compile_model: Callable[[
 
 
 def _store(model: mujoco.MjModel, path: Path) -> None:
-    """Write ``model`` to ``path`` atomically (a reader sees the whole file or none), then keep only the newest
-    KEEP models of its variant."""
+    """Write ``model`` to ``path`` atomically (a reader sees the whole file or none), then evict (:func:`evict`)."""
     path.parent.mkdir(parents=True, exist_ok=True)
     buffer = np.empty(mujoco.mj_sizeModel(model), dtype=np.uint8)
     mujoco.mj_saveModel(model, None, buffer)
     write_atomically(path, buffer.tofile)
-    variant = path.name.split("-")[1]
-    older = sorted(path.parent.glob(f"model-{variant}-*.mjb"), key=lambda p: p.stat().st_mtime, reverse=True)
-    for stale in older[KEEP:]:
-        stale.unlink(missing_ok=True)
-    for left in path.parent.glob(".model-*.tmp"):  # of writes killed midway (a write takes a tenth of a second)
+    evict(path.parent, keep=path)
+
+
+def evict(directory: Path, keep: Path | None = None) -> list[Path]:
+    """Remove the least recently used models of ``directory`` (oldest modification time first; a read refreshes
+    it) beyond :data:`KEEP` per variant and beyond :data:`MAX_BYTES` in all, never ``keep``; returns those
+    removed. A file another process removes meanwhile is skipped."""
+    entries = []
+    for path in directory.glob("model-*.mjb"):
+        with contextlib.suppress(OSError):
+            stat = path.stat()
+            entries.append((stat.st_mtime, path.name, path, stat.st_size))
+    entries.sort(reverse=True)  # newest first; the one just written leads whatever the clocks say
+    entries.sort(key=lambda e: e[2] != keep)
+    removed, total, per_variant = [], 0, {}
+    for _, name, path, size in entries:
+        variant = name.split("-")[1]
+        if path != keep and (per_variant.get(variant, 0) >= KEEP or total + size > MAX_BYTES):
+            with contextlib.suppress(OSError):
+                path.unlink()
+                removed.append(path)
+            continue
+        per_variant[variant] = per_variant.get(variant, 0) + 1
+        total += size
+    for left in directory.glob(".model-*.tmp"):  # of writes killed midway (a write takes a tenth of a second)
         with contextlib.suppress(OSError):
             if time.time() - left.stat().st_mtime > STALE_TMP_AGE:
                 left.unlink()
+    return removed

@@ -70,12 +70,17 @@ class EnvState:
         initial: What the episode's initial snapshot saw (None between episodes).
         q_home: The arm's home targets, with the gaze on the object.
         rng: The state of the env's random generator.
+        robot: The robot variant of the env's model (``TapPhysics.variant``); a state restores only into an env
+            of the same one.
+        behavior: The behaviour the env ran.
     """
 
     physics: tuple[Any, np.ndarray]
     initial: dict[str, Any] | None
     q_home: np.ndarray
     rng: dict[str, Any]
+    robot: str
+    behavior: str
 
 
 def _object_still(physics: TapPhysics) -> bool:
@@ -483,7 +488,7 @@ class TapAffordanceEnv(gym.Env):
         self._initial = {"features": features, "pose": pose, "yaw": yaw, "geometry": geometry,
                          "visible": features.visible, "still": still}
         info = {
-            "object": {"type": physics.geometry.object_type, "size": physics.geometry.size, "pose": pose},
+            "object": {"type": physics.geometry.object_type, "size": physics.geometry.size, "pose": pose.copy()},
             "attention": {"success": attention.success, "visible": attention.visible,
                           "pixel_error": attention.pixel_error},
             "visible": features.visible,
@@ -562,12 +567,20 @@ class TapAffordanceEnv(gym.Env):
         interaction, bit for bit (an oracle that tries several actions from one state does not replay the reset)."""
         initial = None if self._initial is None else dict(self._initial)
         return EnvState(self.physics.get_state(), initial, self._q_home.copy(),
-                        copy.deepcopy(self.np_random.bit_generator.state))
+                        copy.deepcopy(self.np_random.bit_generator.state), self.physics.variant.name,
+                        self.behavior.name)
 
     def set_state(self, state: EnvState) -> None:
-        """Put back the world and the episode as :meth:`get_state` saw them."""
+        """Put back the world and the episode as :meth:`get_state` saw them. The state must come from an env of
+        the same robot model (ValueError otherwise): ``behavior="grasp"`` builds another model than the tap,
+        tap back and push, and ``two_arms=True`` another again."""
         if not isinstance(state, EnvState):
             raise TypeError(f"state must be what get_state() returned (an EnvState), got {type(state).__name__}.")
+        if state.robot != self.physics.variant.name:
+            raise ValueError(f"the state was made by an env of behavior {state.behavior!r} with the {state.robot!r} "
+                             f"robot model; this env (behavior {self.behavior.name!r}) has the "
+                             f"{self.physics.variant.name!r} robot model: a state restores only into an env of the "
+                             "same robot model.")
         self.physics.set_state(state.physics)
         self._initial = None if state.initial is None else dict(state.initial)
         self._q_home = state.q_home.copy()
@@ -620,7 +633,7 @@ class TapAffordanceEnv(gym.Env):
             visible = features.visible
         else:  # the state is not to be trusted: nothing of it reaches obs or info
             obs = self._blank_observation()
-            final_features = NOT_VISIBLE_VALUES
+            final_features = NOT_VISIBLE_VALUES.copy()
             final_pose = np.full(7, np.nan)
             visible = False
         failure = _failure_reason(fault, initial["visible"], done, (initial["still"], home.still), home.touched,
@@ -640,8 +653,8 @@ class TapAffordanceEnv(gym.Env):
                                                                                  self.roll_threshold)
         info = {
             "object": {"type": initial["geometry"].object_type, "size": initial["geometry"].size,
-                       "initial_pose": initial["pose"], "final_pose": final_pose},
-            "initial_features": initial["features"].values,
+                       "initial_pose": initial["pose"].copy(), "final_pose": final_pose},
+            "initial_features": initial["features"].values.copy(),  # fresh: a restored state steps again
             "final_features": final_features,
             "effect": effect,
             "displacement": displacement,

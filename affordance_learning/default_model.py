@@ -268,8 +268,9 @@ def predict_effect(
             :func:`model_path`).
 
     Returns:
-        ``category`` (n,) int and ``effect`` (n, 49) float: the category's prototype effect (final minus
-        initial features, in each feature's unit). One (49,) vector gives n = 1.
+        For a batch, (n, 49) or a DataFrame: ``category`` (n,) int and ``effect`` (n, 49) float, the category's
+        prototype effect (final minus initial features, in each feature's unit). For one (49,) vector: one
+        result, ``category`` an int and ``effect`` (49,).
 
     Raises:
         ValueError: An unknown behaviour, or ``features`` has another shape or lacks feature columns, or holds
@@ -296,10 +297,14 @@ def predict_effect(
         raise ValueError(
             f"features must have shape ({_N_FEATURES},) or (n, {_N_FEATURES}) with n >= 1, got {X.shape}."
         )
+    single = X.ndim == 1
     X = np.atleast_2d(X).astype(np.float64)
     found = first_non_finite(X)
     if found:
         count, row, col, value = found
         raise ValueError(f"features must be finite; row {row}, feature {col} is {value} ({count} non-finite value(s)).")
     model, names = _load_checked(path, behavior)
-    return model.predict_effect(pd.DataFrame(X, columns=list(names)))
+    prediction = model.predict_effect(pd.DataFrame(X, columns=list(names)))
+    if single:  # one vector in, one result out
+        return EffectPrediction(category=int(prediction.category[0]), effect=prediction.effect[0])
+    return prediction

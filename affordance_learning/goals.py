@@ -94,6 +94,22 @@ class Move:
         return {"kind": self.kind, "direction": list(self.direction), "min_distance": self.min_distance}
 
 
+def check_start(start_xy: Any) -> np.ndarray:
+    """``start_xy``, where the object was (x, y) [m], (2,) or (n, 2), as a float array; raises ValueError naming
+    the value given otherwise (None included: a :class:`Place` goal cannot be judged without it)."""
+    if start_xy is None:
+        raise ValueError("a Place goal needs start_xy, where the object is (x, y) [m]; got None.")
+    try:
+        start = np.asarray(start_xy, dtype=np.float64)
+    except (TypeError, ValueError):
+        start = np.full(1, np.nan)
+    if start.ndim not in (1, 2) or start.shape[-1] != 2 or not np.all(np.isfinite(start)):
+        raise ValueError(f"start_xy must be where the object is, finite (x, y) [m] ((2,) or (n, 2)), got "
+                         f"{np.array2string(start, threshold=6) if start.size > 6 else start_xy!r} "
+                         f"(shape {start.shape}).")
+    return start
+
+
 @dataclass(frozen=True)
 class Place:
     """The object comes to rest within ``tolerance`` [m] of ``target_xy`` [m], on the table."""
@@ -110,9 +126,7 @@ class Place:
         object.__setattr__(self, "tolerance", tolerance)
 
     def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
-        if start_xy is None:
-            raise ValueError("Place needs start_xy, where the object was (x, y) [m].")
-        start = _finite("start_xy", start_xy)
+        start = check_start(start_xy)
         x = start[..., 0] + _column(outcomes, "dx")
         y = start[..., 1] + _column(outcomes, "dy")
         near = np.hypot(x - self.target_xy[0], y - self.target_xy[1]) <= self.tolerance
@@ -173,6 +187,16 @@ Goal = Roll | Lift | Move | Place | Percept
 GOAL_KINDS: dict[str, type] = {cls.kind: cls for cls in (Roll, Lift, Move, Place, Percept)}
 
 
+def check_goal(goal: Any) -> Goal:
+    """``goal`` if it is one of the goal classes (:data:`GOAL_KINDS`); raises TypeError naming them otherwise."""
+    if not isinstance(goal, tuple(GOAL_KINDS.values())):
+        names = ", ".join(cls.__name__ for cls in GOAL_KINDS.values())
+        hint = " (goal_from_dict makes one from a dict)" if isinstance(goal, Mapping) else ""
+        raise TypeError(f"goal must be one of {names} (affordance_learning.goals){hint}, got {goal!r} "
+                        f"({type(goal).__name__}).")
+    return goal
+
+
 def goal_from_dict(data: Mapping[str, Any]) -> Goal:
     """The goal ``goal.to_dict()`` wrote; an unknown kind or a wrong field raises ValueError naming it."""
     if not isinstance(data, Mapping) or data.get("kind") not in GOAL_KINDS:
@@ -195,4 +219,5 @@ def describe(goal: Goal) -> str:
     return goal.kind
 
 
-__all__: Sequence[str] = ["Goal", "Lift", "Move", "Percept", "Place", "Roll", "describe", "goal_from_dict"]
+__all__: Sequence[str] = ["Goal", "Lift", "Move", "Percept", "Place", "Roll", "check_goal", "describe",
+                          "goal_from_dict"]

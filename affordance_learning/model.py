@@ -48,9 +48,12 @@ class EffectPrediction:
         category: Effect category (map node index) of each row, (n,) int.
         effect: Prototype effect of that category, (n, n_effects) float, in the effect's own units (for the
             49 features of this project: final minus initial feature, in each feature's unit).
+
+    :func:`affordance_learning.predict_effect` given one feature vector gives one result: ``category`` an int and
+    ``effect`` (n_effects,).
     """
 
-    category: np.ndarray
+    category: np.ndarray | int
     effect: np.ndarray
 
 

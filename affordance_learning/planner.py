@@ -11,14 +11,16 @@ likely enough, the one whose predicted outcomes end nearest on average (re-plann
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.stats import qmc
 
+from affordance_learning.behaviors import BEHAVIORS
 from affordance_learning.effect_model import ActionEffectModel
-from affordance_learning.goals import Goal, Place
+from affordance_learning.goals import Goal, Place, check_goal, check_start
 
 #: An outcome that leaves the table counts as this far from any place [m] when actions are ranked by distance.
 OFF_TABLE_DISTANCE = 1.0
@@ -40,6 +42,36 @@ def _ends(model: ActionEffectModel, start: np.ndarray) -> tuple[np.ndarray, np.n
 def _reached_by_any(reachable: Callable[[str, np.ndarray], np.ndarray], names: list[str], xy: np.ndarray
                     ) -> np.ndarray:
     return np.any([np.asarray(reachable(name, xy), dtype=bool) for name in names], axis=0)
+
+
+@functools.cache
+def table_extent() -> tuple[tuple[float, float], tuple[float, float]]:
+    """The (lower, upper) corners (x, y) [m] of the table top of the environment's scene (``assets/scene.xml``,
+    what ``affordance_env.physics.TapPhysics.table_extent`` gives), read from the scene without the robot."""
+    import mujoco
+
+    from affordance_env.assets_path import assets_dir
+
+    model = mujoco.MjModel.from_xml_path(str(assets_dir() / "scene.xml"))
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    table = model.geom("table_top").id
+    centre, half = data.geom_xpos[table, :2], model.geom_size[table, :2]
+    return tuple(map(float, centre - half)), tuple(map(float, centre + half))
+
+
+def _check_on_table(name: str, value, xy: np.ndarray) -> None:
+    (x0, y0), (x1, y1) = table_extent()
+    if xy.shape != (2,) or not np.all(np.isfinite(xy)) or not (x0 <= xy[0] <= x1 and y0 <= xy[1] <= y1):
+        raise ValueError(f"{name} must be (x, y) [m] on the table top, x in [{x0:.2f}, {x1:.2f}] and y in "
+                         f"[{y0:.2f}, {y1:.2f}], got {value!r}.")
+
+
+def _check_start(start_xy) -> np.ndarray:
+    start = check_start(start_xy)
+    if start.shape != (2,):
+        raise ValueError(f"start_xy must be where the object is, one (x, y) [m], got shape {start.shape}.")
+    return start
 
 
 def candidate_params(n: int, random_state: int = 0) -> np.ndarray:
@@ -81,10 +113,17 @@ class Planner:
     """Chooses the behaviour and parameters that maximise P(goal).
 
     Args:
-        models: An :class:`~affordance_learning.effect_model.ActionEffectModel` per behaviour name.
+        models: A fitted :class:`~affordance_learning.effect_model.ActionEffectModel` per behaviour name (one of
+            :data:`affordance_learning.behaviors.BEHAVIORS`), each of the same inputs: the object's features (the
+            49 of ``affordance_env.FEATURE_NAMES``) and the 3 action parameters.
         n_candidates: Parameter vectors scored per behaviour.
         threshold: Abstain below this P(goal).
         random_state: Seed of the candidates.
+
+    Every method checks its inputs before any work: ``features`` must have as many values as the models take
+    (ValueError), the goal must be a goal of :mod:`affordance_learning.goals` (TypeError), a
+    :class:`~affordance_learning.goals.Place` needs ``start_xy`` and :meth:`toward` a target on the table top
+    (ValueError).
     """
 
     def __init__(self, models: Mapping[str, ActionEffectModel], n_candidates: int = 64, threshold: float = 0.5,
@@ -93,18 +132,38 @@ class Planner:
             raise ValueError("models must map at least one behaviour name to its fitted ActionEffectModel.")
         if not (isinstance(threshold, int | float) and 0.0 <= threshold <= 1.0):
             raise ValueError(f"threshold must be a probability in [0, 1], got {threshold!r}.")
+        unknown = [name for name in models if name not in BEHAVIORS]
+        if unknown:
+            raise ValueError(f"Unknown behavior(s) {', '.join(map(repr, unknown))} in models. Valid behaviors: "
+                             f"{', '.join(BEHAVIORS)}.")
+        for name, model in models.items():
+            if not isinstance(model, ActionEffectModel) or not hasattr(model, "forest_"):
+                raise TypeError(f"models[{name!r}] must be a fitted ActionEffectModel, got {type(model).__name__}.")
+        inputs = {name: model.n_features_in_ for name, model in models.items()}
+        if len(set(inputs.values())) > 1:
+            raise ValueError(f"the models must take the same inputs, got {inputs} input columns per behaviour.")
         self.models = dict(models)
         self.threshold = float(threshold)
         self.params = candidate_params(n_candidates, random_state)
+        #: How many feature values each method's ``features`` must have: the models' inputs but the parameters.
+        self.n_features = next(iter(inputs.values())) - self.params.shape[1]
 
     def _inputs(self, features: np.ndarray) -> np.ndarray:
-        x = np.asarray(features, dtype=np.float64).ravel()
+        x = np.asarray(features, dtype=np.float64)
+        if x.size != self.n_features or x.ndim > 2:
+            named = " (affordance_env.FEATURE_NAMES)" if self.n_features == 49 else ""
+            raise ValueError(f"features must be the object's {self.n_features} feature values{named}, the models' "
+                             f"inputs but the {self.params.shape[1]} action parameters; got shape {x.shape}.")
+        x = x.ravel()
         if not np.all(np.isfinite(x)):
             raise ValueError("features must be finite (the object must have been seen).")
         return np.hstack([np.repeat(x[None], len(self.params), axis=0), self.params])
 
     def scores(self, features: np.ndarray, goal: Goal, start_xy=None) -> dict[str, np.ndarray]:
         """P(goal) of every candidate, per behaviour: {behaviour: (n_candidates,)}."""
+        check_goal(goal)
+        if isinstance(goal, Place):
+            _check_start(start_xy)
         X = self._inputs(features)
         return {name: model.goal_probability(X, goal, start_xy) for name, model in self.models.items()}
 
@@ -134,7 +193,8 @@ class Planner:
     def toward(self, features: np.ndarray, start_xy, target_xy, tolerance: float,
                feasible: Callable[[str, np.ndarray], bool] | None = None, steps_left: int = 1,
                reachable: Callable[[str, np.ndarray], np.ndarray] | None = None) -> Choice:
-        """The next interaction towards ``target_xy`` [m], re-planned after every interaction.
+        """The next interaction towards ``target_xy`` [m], a place on the table top (:func:`table_extent`; another
+        is a ValueError), re-planned after every interaction.
 
         With ``steps_left`` 1 (this interaction is the last): the feasible action most likely to end within
         ``tolerance``, if that is at least the threshold, else the one whose predicted outcomes end nearest on
@@ -153,11 +213,12 @@ class Planner:
         """
         if isinstance(steps_left, bool) or not isinstance(steps_left, int | np.integer) or steps_left < 1:
             raise ValueError(f"steps_left must be an integer >= 1, got {steps_left!r}.")
-        goal = Place(tuple(target_xy), tolerance)
-        features = np.asarray(features, dtype=np.float64).ravel()
+        goal = Place(target_xy, tolerance)
+        target = np.asarray(goal.target_xy)
+        _check_on_table("target_xy", target_xy, target)
+        start = _check_start(start_xy)
         X = self._inputs(features)
-        start = np.asarray(start_xy, dtype=np.float64)
-        target = np.asarray(target_xy, dtype=np.float64)
+        features = X[0, : self.n_features]
         names = list(self.models)
         weights, p1, distance, ends = {}, {}, {}, {}
         for name, model in self.models.items():

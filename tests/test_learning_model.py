@@ -469,8 +469,8 @@ def test_default_model_predicts_one_and_many(stored_model: tuple) -> None:
     many = predict_effect(features[:5], path=path)
     assert many.category.shape == (5,) and many.effect.shape == (5, 49)
     one = predict_effect(features[3], path=path)
-    assert one.category.shape == (1,) and one.category[0] == many.category[3]
-    np.testing.assert_array_equal(one.effect, many.effect[3:4])
+    assert isinstance(one.category, int) and one.category == many.category[3]
+    np.testing.assert_array_equal(one.effect, many.effect[3])
     as_frame = pd.DataFrame(features[:5], columns=model.feature_names_in_).iloc[:, ::-1]
     np.testing.assert_array_equal(predict_effect(as_frame, path=path).category, many.category)
     assert load_default_model(path) is load_default_model(path)  # cached

@@ -132,3 +132,72 @@ def test_the_default_directory_follows_xdg(tmp_path, monkeypatch):
     monkeypatch.delenv("XDG_CACHE_HOME")
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
     assert model_cache.cache_dir() == tmp_path / "home" / ".cache" / "tap-affordance"
+
+
+def _layout(root, installed: bool):
+    """A copy of the package as a checkout has it (assets beside the package) or as an installed wheel has it
+    (assets inside it, affordance_env/assets); returns (package, assets)."""
+    package = root / "affordance_env"
+    shutil.copytree(model_cache._PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__", "assets"))
+    assets = package / "assets" if installed else root / "assets"
+    shutil.copytree(model_cache.assets_dir(), assets)
+    return package, assets
+
+
+def test_the_key_does_not_depend_on_where_the_package_lives(tmp_path, monkeypatch):
+    urdf = icub_urdf()
+    key = model_cache.fingerprint("tap", (urdf,))
+    for root, installed in ((tmp_path / "checkout", False), (tmp_path / "venv" / "site-packages", True)):
+        package, assets = _layout(root, installed)
+        monkeypatch.setattr(model_cache, "_PACKAGE", package)
+        monkeypatch.setattr(model_cache, "assets_dir", lambda assets=assets: assets)
+        assert model_cache.fingerprint("tap", (urdf,)) == key, root
+        (package / "notes.txt").write_text("not code")  # what a checkout may hold beside the code
+        assert model_cache.fingerprint("tap", (urdf,)) == key, root
+
+
+def _entries(cache, sizes: dict[str, int]) -> list:
+    """Fake cached models of the given sizes, the first the oldest."""
+    cache.mkdir(exist_ok=True)
+    paths = []
+    for i, (name, size) in enumerate(sizes.items()):
+        path = cache / f"model-{name}.mjb"
+        path.write_bytes(b"m" * size)
+        os.utime(path, (1e9 + i, 1e9 + i))
+        paths.append(path)
+    return paths
+
+
+def test_the_cache_is_bounded_in_size_and_per_variant_least_recently_used_first(cache, monkeypatch):
+    monkeypatch.setattr(model_cache, "MAX_BYTES", 350)
+    monkeypatch.setattr(model_cache, "KEEP", 2)
+    old_tap, grasp, two_arms, tap, newer_tap, two_arms_left = _entries(cache, {
+        "tap-a": 100, "grasp-a": 100, "two_arms-a": 100, "tap-b": 50, "tap-c": 50, "two_arms_left-a": 100})
+    removed = model_cache.evict(cache)
+    # newest first: two_arms_left (100), tap-c (50), tap-b (50; two taps now), two_arms (100): 300 bytes; grasp
+    # would make 400; tap-a is a third tap.
+    assert sorted(removed) == sorted([grasp, old_tap])
+    assert {p.name for p in cache.glob("*.mjb")} == {p.name for p in (two_arms, tap, newer_tap, two_arms_left)}
+    assert sum(p.stat().st_size for p in cache.glob("*.mjb")) <= model_cache.MAX_BYTES
+    monkeypatch.setattr(model_cache, "MAX_BYTES", 10)  # the model just written stays, whatever its size and age
+    model_cache.evict(cache, keep=tap)
+    assert [p.name for p in cache.glob("*.mjb")] == [tap.name]
+
+
+def test_a_new_model_evicts_the_least_recently_used_and_a_read_counts_as_use(cache, monkeypatch):
+    def tiny(name):
+        return lambda: mujoco.MjModel.from_xml_string(f'<mujoco model="{name}"><worldbody/></mujoco>')
+
+    def never():
+        raise AssertionError("compiled instead of read from the cache")
+
+    model_cache.cached_model("tap", ("<robot name='a'/>",), tiny("a"))
+    model_cache.cached_model("grasp", ("<robot name='b'/>",), tiny("b"))
+    (a,), (b,) = cache.glob("model-tap-*.mjb"), cache.glob("model-grasp-*.mjb")
+    os.utime(a, (1e9, 1e9))  # a is the older, then read: used last
+    os.utime(b, (1e9 + 1, 1e9 + 1))
+    model_cache.cached_model("tap", ("<robot name='a'/>",), never)
+    assert a.stat().st_mtime > b.stat().st_mtime
+    monkeypatch.setattr(model_cache, "MAX_BYTES", a.stat().st_size + b.stat().st_size + 10)
+    model_cache.cached_model("two_arms", ("<robot name='c'/>",), tiny("c"))  # room for two of the three
+    assert a.exists() and not b.exists() and len(list(cache.glob("*.mjb"))) == 2

@@ -104,18 +104,18 @@ def _constant_mover(dx: float, n: int = 300, seed: int = 0) -> ActionEffectModel
 
 
 def test_toward_searches_over_two_interactions_where_the_nearest_first_step_is_a_dead_end():
-    # jump moves 5 cm, slide 7 cm; the target is 10 cm away, the tolerance 1.5 cm. Sliding ends nearest (3 cm)
-    # but no second interaction finishes from there; two jumps do.
-    planner = Planner({"jump": _constant_mover(0.05), "slide": _constant_mover(0.07, seed=1)}, n_candidates=8)
-    features, start, target = np.array([0.0, 0.0]), (0.0, 0.0), (0.10, 0.0)
+    # tap moves 5 cm, push 7 cm; the target is 10 cm away, the tolerance 1.5 cm. Pushing ends nearest (3 cm)
+    # but no second interaction finishes from there; two taps do.
+    planner = Planner({"tap": _constant_mover(0.05), "push": _constant_mover(0.07, seed=1)}, n_candidates=8)
+    features, start, target = np.array([0.0, 0.0]), (-0.5, 0.0), (-0.4, 0.0)
     greedy = planner.toward(features, start, target, 0.015, steps_left=1)
-    assert greedy.behavior == "slide" and greedy.probability == 0.0
+    assert greedy.behavior == "push" and greedy.probability == 0.0
     ahead = planner.toward(features, start, target, 0.015, steps_left=2)
-    assert ahead.behavior == "jump" and ahead.value > 0.9 and ahead.probability == 0.0
-    # Where jump cannot act after the first interaction, the sequence is worth nothing: the nearest again.
+    assert ahead.behavior == "tap" and ahead.value > 0.9 and ahead.probability == 0.0
+    # Where tap cannot act after the first interaction, the sequence is worth nothing: the nearest again.
     blocked = planner.toward(features, start, target, 0.015, steps_left=2,
-                             reachable=lambda name, xy: np.full(len(xy), name != "jump"))
-    assert blocked.behavior == "slide" and blocked.value == 0.0
+                             reachable=lambda name, xy: np.full(len(xy), name != "tap"))
+    assert blocked.behavior == "push" and blocked.value == 0.0
     with pytest.raises(ValueError, match="steps_left"):
         planner.toward(features, start, target, 0.015, steps_left=0)
 

@@ -1,0 +1,139 @@
+"""Wrong input to the API is refused before any work, with a message that names the value and what is expected; and
+what the API returns is what its documentation says."""
+
+from __future__ import annotations
+
+import warnings
+
+import gymnasium as gym
+import numpy as np
+import pandas as pd
+import pytest
+from gymnasium.utils.passive_env_checker import data_shares_objects
+
+import affordance_env  # noqa: F401 (registers the envs)
+from affordance_env.features import FEATURE_NAMES
+from affordance_env.physics import TapPhysics
+from affordance_env.scene import build_model
+from affordance_env.tap_env import TapAffordanceEnv
+from affordance_learning import predict_effect
+from affordance_learning.behaviors import BEHAVIORS
+from affordance_learning.effect_model import ActionEffectModel
+from affordance_learning.goals import Place, Roll
+from affordance_learning.planner import Planner, table_extent
+
+N = len(FEATURE_NAMES)
+
+
+@pytest.fixture(scope="module")
+def model() -> ActionEffectModel:
+    """An effect model of the real inputs: the 49 features and the 3 parameters; objects move dx = 0.1 a0."""
+    rng = np.random.default_rng(0)
+    X = np.column_stack([rng.normal(size=(200, N)), rng.uniform(-1, 1, (200, 3))])
+    zeros = np.zeros(200)
+    Y = pd.DataFrame({"dx": 0.1 * X[:, N], "dy": zeros, "rolled": (X[:, N] > 0).astype(float), "off_table": zeros,
+                      "lifted": zeros})
+    return ActionEffectModel(n_estimators=10, random_state=0).fit(X, Y)
+
+
+@pytest.fixture(scope="module")
+def planner(model) -> Planner:
+    return Planner({"push": model}, n_candidates=8)
+
+
+# --- the planner ------------------------------------------------------------------------------------------------
+def test_a_model_of_an_unknown_behaviour_is_refused_naming_the_known_ones(model):
+    with pytest.raises(ValueError, match="'kick'") as error:
+        Planner({"kick": model})
+    assert all(name in str(error.value) for name in BEHAVIORS)
+    with pytest.raises(TypeError, match="fitted ActionEffectModel, got str"):
+        Planner({"push": "model.joblib"})
+
+
+def test_features_of_the_wrong_length_are_refused_naming_the_length(planner):
+    for features in (np.zeros(N + 2), np.zeros(N - 1), np.zeros((2, N))):
+        with pytest.raises(ValueError, match=rf"49 feature values \(affordance_env.FEATURE_NAMES\).*{features.shape}"):
+            planner.choose(features, Roll())
+        with pytest.raises(ValueError, match="49 feature values"):
+            planner.toward(features, (-0.3, 0.0), (-0.25, 0.0), 0.03)
+    assert planner.choose(np.zeros((1, N)), Roll()).behavior == "push"  # one row is one vector
+
+
+def test_a_place_goal_needs_where_the_object_is(planner):
+    with pytest.raises(ValueError, match="a Place goal needs start_xy.*got None"):
+        planner.choose(np.zeros(N), Place((-0.3, 0.0)))
+    with pytest.raises(ValueError, match=r"start_xy must be .*\(x, y\).*got \(0.1, nan\)"):
+        planner.choose(np.zeros(N), Place((-0.3, 0.0)), (0.1, float("nan")))
+    assert planner.choose(np.zeros(N), Place((-0.3, 0.0)), (-0.35, 0.0)).behavior == "push"
+
+
+def test_a_goal_of_another_type_is_a_type_error_naming_the_goal_types(planner):
+    for goal in ("roll", {"kind": "roll"}, None):
+        with pytest.raises(TypeError, match="goal must be one of Roll, Lift, Move, Place, Percept") as error:
+            planner.choose(np.zeros(N), goal)
+        assert repr(goal) in str(error.value)
+    with pytest.raises(TypeError, match="goal_from_dict"):
+        planner.scores(np.zeros(N), {"kind": "roll"})
+
+
+def test_toward_refuses_a_target_off_the_table(planner):
+    (x0, y0), (x1, y1) = table_extent()
+    for target in ((x1 + 0.01, 0.0), (x0 - 0.01, 0.0), (-0.3, y1 + 0.01), (-0.3, y0 - 0.01)):
+        with pytest.raises(ValueError, match=rf"target_xy must be .* on the table top, x in \[{x0:.2f}, {x1:.2f}\]"):
+            planner.toward(np.zeros(N), (-0.3, 0.0), target, 0.03)
+    assert planner.toward(np.zeros(N), (-0.3, 0.0), (x1, y1), 0.03).behavior == "push"  # the edge is on it
+
+
+def test_the_planners_table_is_the_environments():
+    low, high = TapPhysics(build_model("tap")).table_extent()
+    np.testing.assert_allclose(table_extent(), (low, high))
+
+
+# --- snapshots of the world ---------------------------------------------------------------------------------------
+def test_a_state_restores_only_into_an_env_of_the_same_robot_model():
+    grasp = TapAffordanceEnv(behavior="grasp", camera_width=32, camera_height=24)
+    tap = TapAffordanceEnv(behavior="tap", camera_width=32, camera_height=24)
+    push = TapAffordanceEnv(behavior="push", camera_width=32, camera_height=24)
+    with pytest.raises(ValueError, match="behavior 'grasp' with the 'grasp' robot model.*behavior 'tap'.*'tap' robot"):
+        tap.set_state(grasp.get_state())
+    with pytest.raises(ValueError, match="'tap' robot model.*behavior 'grasp'.*'grasp' robot model"):
+        grasp.set_state(tap.get_state())
+    push.set_state(tap.get_state())  # the same model: the push arm takes over the tap's world
+    for env in (grasp, tap, push):
+        env.close()
+
+
+def test_steps_from_a_restored_state_return_infos_of_their_own():
+    # The README's get_state / set_state example, stepped again from the restored state, under gym.make's checker.
+    env = gym.make("TapAffordance-v1", camera_width=32, camera_height=24)
+    obs, reset_info = env.reset(seed=3)
+    kept = reset_info["object"]["pose"].copy()
+    state = env.unwrapped.get_state()
+    with warnings.catch_warnings():
+        warnings.filterwarnings("error", message=".*share an object")
+        first = env.step(np.zeros(3))[4]
+        env.unwrapped.set_state(state)
+        second = env.step(np.zeros(3))[4]
+    assert not data_shares_objects(first, second)
+    first["object"]["initial_pose"][:] = 0.0  # a user's changes to one step's info stay in it ...
+    first["initial_features"][:] = 0.0
+    env.unwrapped.set_state(state)
+    third = env.step(np.zeros(3))[4]
+    np.testing.assert_array_equal(third["object"]["initial_pose"], second["object"]["initial_pose"])
+    np.testing.assert_array_equal(third["initial_features"], second["initial_features"])
+    reset_info["object"]["pose"][:] = 0.0  # ... and to the reset's info too
+    env.unwrapped.set_state(state)
+    np.testing.assert_array_equal(env.step(np.zeros(3))[4]["object"]["initial_pose"], kept)
+    env.close()
+
+
+# --- predict_effect -----------------------------------------------------------------------------------------------
+def test_predict_effect_gives_one_result_for_one_vector_and_a_batch_for_a_batch():
+    features = np.random.default_rng(0).normal(size=(3, N))
+    batch = predict_effect(features)
+    assert batch.category.shape == (3,) and batch.effect.shape == (3, N)
+    one = predict_effect(features[1])
+    assert isinstance(one.category, int) and one.category == batch.category[1]
+    np.testing.assert_array_equal(one.effect, batch.effect[1])
+    row = predict_effect(features[1:2])  # a batch of one stays a batch
+    assert row.category.shape == (1,) and row.effect.shape == (1, N)
