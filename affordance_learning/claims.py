@@ -1,9 +1,11 @@
 """The paper's statements as claims with numeric rules, and their verdicts on our numbers.
 
 Each statement of Akgun et al. 2009 (section V) becomes a :class:`Claim` with a stated, numeric rule. The
-verdict is "agrees" or "disagrees" by that rule, or "not computable" when the results lack what the rule
-needs (for example k = 4 was not run). The rules are judgement calls written in the report beside each
-verdict, so a reader can disagree with a rule without having to trust prose.
+verdict is "agrees" or "disagrees" by that rule, "too few" when the rule was applied to less data than
+:data:`MIN_TRIALS` and :data:`MIN_INTERACTIONS` ask for, or "not computable" when the results lack what the rule
+needs (for example k = 4 was not run). Every verdict carries its n: the trials and interactions (or, for a map of
+the first trial, the interactions in it) it was judged on. The rules are judgement calls written in the report
+beside each verdict, so a reader can disagree with a rule without having to trust prose.
 
 The paper reports two behaviours, and the claims are chosen by the behaviour of the results
 (``results["config"]["behavior"]``, see :func:`claims_for`):
@@ -26,7 +28,20 @@ from affordance_learning.results import current_results
 
 AGREES = "agrees"
 DISAGREES = "disagrees"
+TOO_FEW = "too few"
 NOT_COMPUTABLE = "not computable"
+#: Every verdict, in the order the reports count them.
+VERDICTS = (AGREES, DISAGREES, TOO_FEW, NOT_COMPUTABLE)
+
+# The least data a verdict is given on; below it the verdict is "too few".
+#: A claim on means over trials needs at least this many trials: the standard error of a mean over n trials is the
+#: standard deviation between trials over sqrt(n), under a third of it from 10 trials on (the shipped grasp's
+#: uniformity at one k has a standard deviation of up to 32 points between trials).
+MIN_TRIALS = 10
+#: Every claim needs at least this many interactions (those of a run, or of the map of the first trial the claim
+#: reads): a share of them is then known within +-7 points (Wilson 95 % interval at 50 %), finer than the rules'
+#: margins of 20 to 25 %.
+MIN_INTERACTIONS = 200
 
 _ROLLING = ("sphere", "horizontal_cylinder")
 _RESTING = ("box", "vertical_cylinder")
@@ -61,7 +76,11 @@ class Claim:
         paper: What the paper says.
         rule: The numeric rule our verdict follows.
         ours: Our numbers, as text.
-        verdict: "agrees", "disagrees" or "not computable".
+        verdict: "agrees", "disagrees", "too few" or "not computable".
+        n: How many trials (a claim on means over trials) or interactions (a claim on one map, or on sizes) the
+            verdict was judged on; None when the results do not say.
+        judged_on: What the verdict was judged on, as text ("20 trials of 1000 interactions").
+        needed: The least data a verdict is given on, as text ("10 trials of 200 interactions").
     """
 
     topic: str
@@ -69,6 +88,21 @@ class Claim:
     rule: str
     ours: str
     verdict: str
+    n: int | None = None
+    judged_on: str = "unknown"
+    needed: str = ""
+
+    @property
+    def n_text(self) -> str:
+        """The verdict's n as text: "n=20 trials of 1000 interactions", with what is needed when it is too few."""
+        needed = f"; at least {self.needed} needed" if self.verdict == TOO_FEW else ""
+        return ("n unknown" if self.n is None else f"n={self.judged_on}") + needed
+
+    @property
+    def verdict_text(self) -> str:
+        """The verdict with its n: "agrees (n=20 trials of 1000 interactions)", "too few (n=3 trials of 240
+        interactions; at least 10 trials of 200 interactions needed)"."""
+        return f"{self.verdict} ({self.n_text})"
 
 
 class _Missing(Exception):
@@ -317,8 +351,13 @@ GRASP_UNIFORMITY = (70.0, TAP_UNIFORMITY)
 #: A 1 x 3 category straddles the critical size when at least this share of its objects lies on each side
 #: of it, and at least this share of its members has its less common outcome.
 STRADDLE_SHARE = 0.2
-#: ... and it is a category, not a handful of outliers: it holds at least this share of all interactions.
+#: ... and it is a category, not a handful of outliers: it holds at least this share of all interactions; so does
+#: each of the other categories, the two it steals from.
 STRADDLE_MIN_SIZE = 0.1
+#: ... and it is a minority: it holds less than this share of all interactions. The paper's category "falls near
+#: this region, stealing from both" a success and a fail category; one that holds most interactions is the bulk of
+#: the map, from which the others split off a few, and any size boundary runs through it.
+STRADDLE_MAX_SIZE = 0.5
 #: The critical size decides the grasp when successes are this much more common below it than above it.
 CRITICAL_SIZE_CONTRAST = 0.5
 
@@ -363,61 +402,117 @@ def _straddling_cluster(results: Mapping[str, Any]) -> tuple[str, bool]:
         raise _Missing("no critical size: success does not depend on size, or the fit of success on size does not "
                        "cross 50 % within the sizes seen")
     success_label, fail_label = _outcome_words(results)
-    parts, straddling = [], []
     clusters = _case(results, 3)
-    total = sum(c["success"] + c["fail"] for c in clusters)
+    total = max(sum(c["success"] + c["fail"] for c in clusters), 1)
+    parts, straddling, why_not = [], [], []
     for c in clusters:
         sizes = np.asarray(c["sizes"], dtype=float)
+        share = (c["success"] + c["fail"]) / total
         if sizes.size == 0:
             parts.append(f"cluster {c['cluster']}: empty")
             continue
-        n = c["success"] + c["fail"]
         below = float(np.mean(sizes < critical))
-        minority = min(c["success"], c["fail"]) / max(n, 1)
-        if (min(below, 1.0 - below) >= STRADDLE_SHARE and minority >= STRADDLE_SHARE
-                and n >= STRADDLE_MIN_SIZE * total):
-            straddling.append(str(c["cluster"]))
-        parts.append(f"cluster {c['cluster']} ({100 * n / max(total, 1):.0f} % of the interactions): "
+        minority = min(c["success"], c["fail"]) / (c["success"] + c["fail"])
+        parts.append(f"cluster {c['cluster']} ({c['success'] + c['fail']} interactions, {100 * share:.1f} %): "
                      f"{100 * sizes.min():.1f}-{100 * sizes.max():.1f} cm, {100 * below:.0f} % below; "
                      f"{c['success']} {success_label} / {c['fail']} {fail_label}")
+        if min(below, 1.0 - below) < STRADDLE_SHARE or minority < STRADDLE_SHARE:
+            continue  # neither its objects nor its outcomes lie on both sides
+        others = [o for o in clusters if o is not c]
+        sides = {(o["success"] > o["fail"]) - (o["fail"] > o["success"]) for o in others}  # 1: mostly successes
+        if not STRADDLE_MIN_SIZE <= share < STRADDLE_MAX_SIZE:
+            why_not.append(f"cluster {c['cluster']} lies on both sides but holds {100 * share:.0f} % of the "
+                           f"interactions: a straddling category holds >= {100 * STRADDLE_MIN_SIZE:.0f} % and < "
+                           f"{100 * STRADDLE_MAX_SIZE:.0f} %")
+        elif not {1, -1} <= sides or any(o["success"] + o["fail"] < STRADDLE_MIN_SIZE * total for o in others):
+            why_not.append(f"cluster {c['cluster']} lies on both sides but the others are not a success and a fail "
+                           f"category of >= {100 * STRADDLE_MIN_SIZE:.0f} % each")
+        else:
+            straddling.append(str(c["cluster"]))
     text = (f"critical size {100 * critical:.1f} cm; " + "; ".join(parts)
-            + f" -> straddling: {', '.join(straddling) or 'none'}")
+            + f" -> straddling: {', '.join(straddling) or 'none'}"
+            + ("" if straddling or not why_not else f" ({'; '.join(why_not)})"))
     return text, bool(straddling)
 
 
+@dataclass(frozen=True)
+class _Basis:
+    """What a verdict is judged on: ``n`` (None when the results do not say), as text, and whether it is enough."""
+
+    n: int | None
+    text: str
+    needed: str
+    enough: bool
+
+
+def _over_trials(results: Mapping[str, Any]) -> _Basis:
+    """A claim on means over trials: n is the trials, each over all the run's interactions."""
+    config = results.get("config", {})
+    trials, rows = config.get("n_trials"), config.get("n_rows")
+    needed = f"{MIN_TRIALS} trials of {MIN_INTERACTIONS} interactions"
+    if trials is None or rows is None:
+        return _Basis(None, "unknown", needed, False)
+    return _Basis(int(trials), f"{trials} trials of {rows} interactions", needed,
+                  trials >= MIN_TRIALS and rows >= MIN_INTERACTIONS)
+
+
+def _in_map(k: int) -> Callable[[Mapping[str, Any]], _Basis]:
+    """A claim on the 1 x k map of the first trial: n is the interactions in it."""
+    def basis(results: Mapping[str, Any]) -> _Basis:
+        clusters = results.get("case_studies", {}).get(str(k)) or []
+        n = sum(c["success"] + c["fail"] for c in clusters)
+        return _Basis(n if clusters else None, f"{n} interactions in the 1 x {k} map of the first trial",
+                      f"{MIN_INTERACTIONS} interactions", n >= MIN_INTERACTIONS)
+    return basis
+
+
+def _over_sizes(results: Mapping[str, Any]) -> _Basis:
+    """A claim on success by object size: n is the interactions binned by size."""
+    bins = (results.get("size_success") or {}).get("bins")
+    n = sum(b["n"] for b in bins or ())
+    return _Basis(n if bins else None, f"{n} interactions", f"{MIN_INTERACTIONS} interactions",
+                  n >= MIN_INTERACTIONS)
+
+
 _Judge = Callable[[Mapping[str, Any]], tuple[str, bool]]
-#: A claim before it is judged: topic, the paper's statement, the rule, and the function that applies it.
-_Spec = tuple[str, str, str, _Judge]
+#: A claim before it is judged: topic, the paper's statement, the rule, the function that applies it, and the
+#: function that says what the verdict is judged on (its n).
+_Spec = tuple[str, str, str, _Judge, Callable[[Mapping[str, Any]], _Basis]]
 
 _UNIFORMITY_RISES: _Spec = (
     "Uniformity rises with k",
     "Uniformity of clusters increases with the number of clusters.",
     f"Spearman rank correlation of k and mean uniformity >= {TREND_RHO}",
     _uniformity_rises,
+    _over_trials,
 )
 _UNIFORMITY_PEAK: _Spec = (
     "Uniformity peak",
     "It can reach up to 95 %.",
     f"highest mean uniformity over k >= {UNIFORMITY_PEAK:.0f} %",
     _uniformity_peak,
+    _over_trials,
 )
 _FEWER_FEATURES: _Spec = (
     "Fewer features as r rises",
     "The number of selected features tends to be inversely proportional to r.",
     "for every k the mean number never grows with r, and is lower at the largest r than at the smallest",
     _count_falls_with_r,
+    _over_trials,
 )
 _NUMBER_CONSTANT: _Spec = (
     "Number constant in k",
     "The number of selected features remains the same above some number of clusters.",
     f"for every r, the coefficient of variation over k >= {CONSTANT_FROM_K} of the mean number <= {CONSTANT_CV}",
     _count_constant_in_k,
+    _over_trials,
 )
 _ACCURACY_FALLS: _Spec = (
     "SVM accuracy falls with k",
     "SVM prediction accuracy decreases as the number of effect categories grows.",
     f"for every r, Spearman rank correlation of k and mean accuracy <= {-TREND_RHO}",
     _accuracy_falls,
+    _over_trials,
 )
 
 #: The paper's statements on the method, which do not depend on the behaviour.
@@ -430,6 +525,7 @@ GRASP_CLAIMS: tuple[_Spec, ...] = (
         f"mean over k of the mean uniformity > {GRASP_UNIFORMITY[0]:.0f} % and <= {GRASP_UNIFORMITY[1]:.0f} % "
         "(the paper sets the grasp's average apart from the tap's 'above 80 %')",
         _grasp_uniformity_average,
+        _over_trials,
     ),
     _UNIFORMITY_RISES,
     _UNIFORMITY_PEAK,
@@ -438,6 +534,7 @@ GRASP_CLAIMS: tuple[_Spec, ...] = (
         "There is a fall in the general trend of increase in the grasp behaviour for the 3 cluster case.",
         "mean uniformity at k = 3 below both k = 2 and k = 4",
         _fall_at_three,
+        _over_trials,
     ),
     (
         "Critical size",
@@ -447,14 +544,19 @@ GRASP_CLAIMS: tuple[_Spec, ...] = (
         "success falls with size, and the share of successes below the critical size is at least "
         f"{100 * CRITICAL_SIZE_CONTRAST:.0f} points above that above it",
         _critical_size,
+        _over_sizes,
     ),
     (
         "1 x 3 map: a category straddles the critical size",
         "One of the clusters falls near this region, stealing from both and therefore decreasing uniformity.",
-        f"a cluster of the 1 x 3 map (first trial) with >= {100 * STRADDLE_MIN_SIZE:.0f} % of the interactions "
-        f"has >= {100 * STRADDLE_SHARE:.0f} % of its objects on each side of the critical size and "
-        f">= {100 * STRADDLE_SHARE:.0f} % of its members with its less common outcome",
+        f"a cluster of the 1 x 3 map (first trial) with >= {100 * STRADDLE_MIN_SIZE:.0f} % and < "
+        f"{100 * STRADDLE_MAX_SIZE:.0f} % of the interactions (a minority, not a handful) has "
+        f">= {100 * STRADDLE_SHARE:.0f} % of its objects on each side of the critical size and "
+        f">= {100 * STRADDLE_SHARE:.0f} % of its members with its less common outcome; each other cluster holds "
+        f">= {100 * STRADDLE_MIN_SIZE:.0f} % of the interactions, one mostly successes and one mostly failures "
+        "(the two it steals from)",
         _straddling_cluster,
+        _in_map(3),
     ),
     (
         "Size features dominate",
@@ -462,6 +564,7 @@ GRASP_CLAIMS: tuple[_Spec, ...] = (
         f"for every r > 0, the mean over k of the size share of the selected features > {DOMINANT_SHARE:.0f} % "
         "(18 of the 49 features are size features)",
         _size_dominates,
+        _over_trials,
     ),
     _FEWER_FEATURES,
     _NUMBER_CONSTANT,
@@ -474,6 +577,7 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
         "The average uniformity is above 80 % for tapping.",
         f"mean over k of the mean uniformity > {TAP_UNIFORMITY:.0f} %",
         _uniformity_average,
+        _over_trials,
     ),
     _UNIFORMITY_RISES,
     _UNIFORMITY_PEAK,
@@ -482,12 +586,14 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
         "Shape features dominate the selected features.",
         f"for every r > 0, the mean over k of the shape share of the selected features > {DOMINANT_SHARE:.0f} %",
         _shape_dominates,
+        _over_trials,
     ),
     (
         "Shape share and r",
         "When the relevancy threshold is decreased ... the percentage of shape features decreases.",
         "Spearman rank correlation of r and the mean shape share > 0",
         _shape_share_falls_with_lower_r,
+        _over_trials,
     ),
     _FEWER_FEATURES,
     _NUMBER_CONSTANT,
@@ -498,18 +604,21 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
         "spheres and lying cylinders share a majority cluster, boxes and standing cylinders the "
         f"other, each type with >= {100 * TYPE_SHARE:.0f} % of its objects there (first trial)",
         _two_cluster_types,
+        _in_map(2),
     ),
     (
         "1 x 2 map: sizes",
         "Both clusters have instances from the whole size range.",
         f"each of the 2 clusters spans >= {100 * SIZE_SPAN:.0f} % of the range of object sizes (first trial)",
         _two_cluster_sizes,
+        _in_map(2),
     ),
     (
         "1 x 4 map: success/fail",
         "Two of the four clusters are success clusters, the other two fail clusters.",
         "exactly 2 clusters with more successes (rolled) than failures and 2 with more failures (first trial)",
         _four_cluster_split,
+        _in_map(4),
     ),
     _ACCURACY_FALLS,
     (
@@ -517,18 +626,21 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
         "Accuracy increases at 4 clusters against the decreasing trend (four object types).",
         "mean accuracy at k = 4 above that at k = 3 for at least half of the r values",
         _bump_at_four,
+        _over_trials,
     ),
     (
         "r = 0, 0.2, 0.4 alike",
         "Accuracy is almost the same for relevancy values of 0 %, 20 % and 40 %.",
         f"mean accuracy over k of these r within {ALIKE_POINTS:g} percentage points",
         _low_r_alike,
+        _over_trials,
     ),
     (
         "r = 0.4 best",
         "40 % is the best relevancy: maximum accuracy with the highest perceptual economy.",
         f"the largest r whose mean accuracy over k is within {BEST_R_POINTS:g} point of the best r's is {BEST_R}",
         _best_r,
+        _over_trials,
     ),
 )
 
@@ -555,7 +667,7 @@ def claims_scope(behavior: str) -> str:
 
 
 def claims_for(behavior: str) -> tuple[_Spec, ...]:
-    """The claims (topic, the paper, rule, judge) checked for ``behavior``: its own set in
+    """The claims (topic, the paper, rule, judge, basis) checked for ``behavior``: its own set in
     :data:`CLAIM_SETS`, else :data:`METHOD_CLAIMS`."""
     return CLAIM_SETS.get(behavior, METHOD_CLAIMS)
 
@@ -563,17 +675,30 @@ def claims_for(behavior: str) -> tuple[_Spec, ...]:
 def evaluate_claims(results: Mapping[str, Any], behavior: str | None = None) -> list[Claim]:
     """The paper's claims on a behaviour with our numbers and a verdict computed from them.
 
+    A verdict is "agrees" or "disagrees" only on enough data (:data:`MIN_TRIALS` trials of
+    :data:`MIN_INTERACTIONS` interactions for a claim on means over trials, :data:`MIN_INTERACTIONS` interactions
+    for one on a map or on sizes), else "too few"; "not computable" when the results lack what the rule needs,
+    or do not say how much data they hold.
+
     Args:
         results: The dict of :func:`affordance_learning.protocol.run_protocol` (or its JSON), or part of it.
         behavior: Whose claims to check; by default the results' own (:func:`results_behavior`).
     """
     results = current_results(results)
     claims = []
-    for topic, paper, rule, judge in claims_for(results_behavior(results) if behavior is None else behavior):
+    for topic, paper, rule, judge, basis_of in claims_for(results_behavior(results) if behavior is None else behavior):
+        basis = basis_of(results)
         try:
             ours, ok = judge(results)
-            verdict = AGREES if ok else DISAGREES
         except _Missing as why:
             ours, verdict = f"({why})", NOT_COMPUTABLE
-        claims.append(Claim(topic=topic, paper=paper, rule=rule, ours=ours, verdict=verdict))
+        else:
+            if basis.n is None:
+                ours, verdict = f"{ours} (the results do not say how much data this is)", NOT_COMPUTABLE
+            elif not basis.enough:
+                verdict = TOO_FEW
+            else:
+                verdict = AGREES if ok else DISAGREES
+        claims.append(Claim(topic=topic, paper=paper, rule=rule, ours=ours, verdict=verdict, n=basis.n,
+                            judged_on=basis.text, needed=basis.needed))
     return claims

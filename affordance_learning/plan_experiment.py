@@ -339,13 +339,21 @@ def within_reach(start_xy, target_xy, reach: Mapping[str, float], tolerance: flo
 
 # --- statistics ------------------------------------------------------------------------------------------------
 def wilson(successes: int, n: int) -> tuple[float, float]:
-    """Wilson 95 % interval of a share."""
-    if n == 0:
-        return (0.0, 1.0)
-    from scipy.stats import binomtest
+    """Wilson 95 % interval of a share (:func:`~affordance_learning.metrics.wilson_interval`); (0, 1) for 0 of 0."""
+    from affordance_learning.metrics import wilson_interval
 
-    ci = binomtest(int(successes), int(n)).proportion_ci(0.95, method="wilson")
-    return float(ci.low), float(ci.high)
+    return wilson_interval(int(successes), int(n))
+
+
+def share_text(value: float | None, n: int, ci: Sequence[float] | None = None, unit: str = "",
+               digits: int = 0) -> str:
+    """A share as the console and the report show it: ``"80 % [62, 91] (n=35 feasible goals)"``, the Wilson 95 %
+    interval when given; "not measured (n=0)" for a share of nothing (0 of 0 is no rate, not 0 %)."""
+    count = f"n={n}" + (f" {unit}" if unit else "")
+    if value is None or n == 0:
+        return f"not measured ({count})"
+    interval = "" if ci is None else f" [{100 * ci[0]:.0f}, {100 * ci[1]:.0f}]"
+    return f"{100 * value:.{digits}f} %{interval} ({count})"
 
 
 def calibration(p: np.ndarray, y: np.ndarray, bins: int = 10) -> dict[str, Any]:
@@ -459,7 +467,9 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
     timings["single_step"] = time.perf_counter() - t
     single = summarize(records, POLICIES)
     say(f"[3/5] single step on {len(records)} held-out objects ({timings['single_step']:.0f} s): "
-        + ", ".join(f"{p} {100 * single[p]['success']:.0f} %" for p in POLICIES))
+        + ", ".join(f"{p} {share_text(single[p]['success'], single[p]['n'], single[p]['success_ci'])}"
+                    for p in POLICIES)
+        + f"; {single['oracle']['n_feasible']} goals feasible")
 
     t = time.perf_counter()
     loso: dict[str, Any] = {}
@@ -474,7 +484,8 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         loso[shape] = summarize(shape_records, ("planner", "best_fixed", "random", "oracle"))
     timings["leave_one_shape_out"] = time.perf_counter() - t
     say(f"[4/5] leaving each shape out ({timings['leave_one_shape_out']:.0f} s): "
-        + ", ".join(f"{s} {100 * (loso[s]['planner']['success_feasible'] or 0):.0f} %" for s in SHAPES))
+        + ", ".join(f"{s} " + share_text(loso[s]["planner"]["success_feasible"], loso[s]["planner"]["n_feasible"],
+                                         loso[s]["planner"]["success_feasible_ci"], "feasible") for s in SHAPES))
 
     t = time.perf_counter()
     multi_items = _items(seed, 9, settings.multi_episodes)
@@ -487,13 +498,14 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         n = len(episodes)
         k = sum(e["success"] for e in episodes)
         interactions = sum(e["steps"] for e in episodes)
-        multi[policy] = {"success": k / n, "success_ci": wilson(k, n), "n": n,
+        multi[policy] = {"success": k / n if n else None, "success_ci": wilson(k, n), "n": n,
                          "reach_failures": sum(e["reach_failures"] for e in episodes) / max(interactions, 1),
                          "interactions": interactions, "gave_up": sum(e["gave_up"] for e in episodes),
                          "median_final_distance_m": float(np.median([e["final_distance"] for e in episodes]))}
     timings["multi_step"] = time.perf_counter() - t
     say(f"[5/5] multi-step on {settings.multi_episodes} episodes ({timings['multi_step']:.0f} s): "
-        + ", ".join(f"{p} {100 * multi[p]['success']:.0f} %" for p in MULTI_POLICIES))
+        + ", ".join(f"{p} {share_text(multi[p]['success'], multi[p]['n'], multi[p]['success_ci'])}"
+                    for p in MULTI_POLICIES))
 
     multi["planner"]["by_type"] = {
         shape: {"n": len(eps), "success": sum(e["success"] for e in eps) / len(eps)}
@@ -525,6 +537,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         "leave_one_shape_out": loso,
         "multi_step": multi,
         "placement_error_median_m": float(np.median(placement)) if placement else None,
+        "placement_error_n": len(placement),  # the place goals the planner acted on: the median's n
         "calibration": calibration([p for p, _ in executed], [y for _, y in executed]),
         "timings_s": {**timings, "total": time.perf_counter() - start},
         "goals": [{k: r[k] for k in ("kind", "type", "goal", "planner", "planner_p", "planner_behavior", "oracle")}
@@ -563,4 +576,5 @@ def record_episode(out: str | os.PathLike, results: Mapping[str, Any], seed: int
         env.close()
 
 
-__all__ = ["PlanSettings", "run_plan", "record_episode", "measured_outcome", "reached", "calibration", "wilson"]
+__all__ = ["PlanSettings", "run_plan", "record_episode", "measured_outcome", "reached", "calibration", "wilson",
+           "share_text"]

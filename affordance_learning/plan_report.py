@@ -1,6 +1,8 @@
 """The report and figures of ``affordance plan``: its results set beside the targets, and why a target is missed.
 
-:data:`TARGETS` holds each target once; the check and the report's text both read it.
+:data:`TARGETS` holds each target once; the check and the report's text both read it. A target is judged "met" or
+"missed" only on enough data (:data:`MIN_N`); below that it is "too few (n=...)", and a share of nothing is "not
+measured", never 0 %.
 """
 
 from __future__ import annotations
@@ -8,11 +10,11 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
-from affordance_learning.plan_experiment import GOAL_KINDS, MULTI_POLICIES, POLICIES, SHAPES
+from affordance_learning.plan_experiment import GOAL_KINDS, MULTI_POLICIES, POLICIES, SHAPES, share_text, wilson
 
 #: The targets of the planner, each a (direction, value): ">=" or "<=".
 TARGETS: dict[str, tuple[str, float]] = {
@@ -26,35 +28,151 @@ TARGETS: dict[str, tuple[str, float]] = {
     "multi-step reach failures per interaction": ("<=", 0.02),
 }
 
+# The least data a verdict is given on; below it the verdict is "too few (n=...)". A share's Wilson 95 % interval
+# is shown beside it, so a verdict close to its bound can be read as the near thing it is.
+#: Feasible single-step goals: a share near the 92 % target is then known within +-4 points (Wilson 95 %).
+MIN_FEASIBLE_GOALS = 200
+#: Feasible goals of each left-out shape: from 30, one goal is at most 3 points of the share and the interval around
+#: 75 % is about +-15 points; with fewer, both grow fast (one goal met or missed the target before).
+MIN_FEASIBLE_PER_SHAPE = 30
+#: Place goals the planner acted on, for the median placement error: at 30 the median's 95 % interval already spans
+#: the 10th to the 21st of the sorted errors; with fewer it is set by a handful of goals.
+MIN_PLACEMENTS = 30
+#: Actions executed, for the calibration: the ECE over 10 bins is biased upwards by sampling alone (a perfectly
+#: calibrated model shows up to about 0.8 x sqrt(2.5 / n)); from 1000 actions that is 0.04, under the 0.05 bound.
+MIN_CALIBRATION_ACTIONS = 1000
+#: Multi-step episodes: a share near the 85 % target is then known within +-9 points. The reach failures per
+#: interaction are judged on the same episodes (the interactions of one episode are not independent).
+MIN_EPISODES = 60
+#: The minimum n of each target's verdict.
+MIN_N: dict[str, int] = {
+    "single-step success on feasible goals": MIN_FEASIBLE_GOALS,
+    "single-step success over the oracle's": MIN_FEASIBLE_GOALS,
+    "median placement error [m]": MIN_PLACEMENTS,
+    "each left-out shape, success on its feasible goals": MIN_FEASIBLE_PER_SHAPE,
+    "calibration ECE": MIN_CALIBRATION_ACTIONS,
+    "calibration AUROC": MIN_CALIBRATION_ACTIONS,
+    "multi-step targets reached": MIN_EPISODES,
+    "multi-step reach failures per interaction": MIN_EPISODES,
+}
 
-def _pct(value: float | None) -> str:
-    return "-" if value is None else f"{100 * value:.1f} %"
+MET, MISSED, TOO_FEW, NOT_MEASURED = "met", "missed", "too few", "not measured"
 
 
-def _ci(ci) -> str:
-    return f"[{100 * ci[0]:.0f}, {100 * ci[1]:.0f}]"
+class Measured(NamedTuple):
+    """A target's measured value and what it was measured on.
+
+    Attributes:
+        value: The value (a fraction, metres, the ECE or the AUROC); None when nothing was measured.
+        n: How many goals, place goals, actions or episodes it was measured on (:data:`MIN_N` applies to it).
+        unit: What ``n`` counts, for the report ("feasible goals", "episodes, 212 interactions").
+        ci: The Wilson 95 % interval of a share, or None.
+        detail: What the report shows instead of the value, or None (the shape target lists every shape).
+    """
+
+    value: float | None
+    n: int
+    unit: str
+    ci: tuple[float, float] | None = None
+    detail: str | None = None
 
 
-def measured_targets(results: Mapping[str, Any]) -> dict[str, float | None]:
-    """The value of every target in ``results`` (the worst left-out shape for the shape target)."""
-    shapes = [results["leave_one_shape_out"][s]["planner"]["success_feasible"] for s in results["leave_one_shape_out"]]
+def _share(entry: Mapping[str, Any], key: str = "success", n: str = "n", unit: str = "") -> str:
+    """A policy's share in the report: value, Wilson 95 % interval and n (:func:`share_text`)."""
+    return share_text(entry.get(key), entry.get(n, 0), entry.get(f"{key}_ci"), unit, digits=1)
+
+
+def _placements(results: Mapping[str, Any]) -> int:
+    """How many place goals the planner acted on (the n of the median placement error); counted from the goals
+    for results written before ``placement_error_n``."""
+    if "placement_error_n" in results:
+        return int(results["placement_error_n"])
+    return sum(g["kind"] == "place" and bool(g.get("planner_behavior")) for g in results.get("goals", []))
+
+
+def _worst_shape(results: Mapping[str, Any]) -> Measured:
+    """The shape target: the worst share among the shapes judged on enough feasible goals if one misses the
+    bound (one such shape misses the target, whatever the others); else the worst share measured, with the
+    smallest n of the shapes (every shape must be measured on enough goals for the target to be met)."""
+    loso = results["leave_one_shape_out"]
+    shapes = {s: Measured(r["planner"]["success_feasible"], int(r["planner"]["n_feasible"]),
+                          f"feasible goals of {s}", tuple(r["planner"]["success_feasible_ci"]))
+              for s, r in loso.items()}
+    name = "each left-out shape, success on its feasible goals"
+    _, bound = TARGETS[name]
+    detail = "; ".join(f"{s} {share_text(m.value, m.n, m.ci, digits=1)}" for s, m in shapes.items())
+    missing = [m for m in shapes.values() if m.n >= MIN_FEASIBLE_PER_SHAPE and m.value < bound]
+    if missing:
+        return min(missing, key=lambda m: m.value)._replace(detail=detail)
+    measured = [m for m in shapes.values() if m.value is not None]
+    if not measured:
+        return Measured(None, 0, "feasible goals of any shape", detail=detail)
+    worst, fewest = min(measured, key=lambda m: m.value), min(shapes.values(), key=lambda m: m.n)
+    return worst._replace(n=fewest.n, unit=fewest.unit, ci=None, detail=detail)
+
+
+def measured_targets(results: Mapping[str, Any]) -> dict[str, Measured]:
+    """The value of every target in ``results`` with its n (for the shape target see :func:`_worst_shape`)."""
+    single = results["single_step"]["planner"]
+    multi = results["multi_step"]["planner"]
+    failures = round(multi["reach_failures"] * multi["interactions"])
+    calibration = results["calibration"]
     return {
-        "single-step success on feasible goals": results["single_step"]["planner"]["success_feasible"],
-        "single-step success over the oracle's": results["planner_over_oracle"],
-        "median placement error [m]": results["placement_error_median_m"],
-        "each left-out shape, success on its feasible goals": min((s for s in shapes if s is not None), default=None),
-        "calibration ECE": results["calibration"]["ece"],
-        "calibration AUROC": results["calibration"]["auroc"],
-        "multi-step targets reached": results["multi_step"]["planner"]["success"],
-        "multi-step reach failures per interaction": results["multi_step"]["planner"]["reach_failures"],
+        "single-step success on feasible goals": Measured(single["success_feasible"], int(single["n_feasible"]),
+                                                          "feasible goals", tuple(single["success_feasible_ci"])),
+        "single-step success over the oracle's": Measured(results["planner_over_oracle"], int(single["n_feasible"]),
+                                                          "feasible goals"),
+        "median placement error [m]": Measured(results["placement_error_median_m"], _placements(results),
+                                               "place goals acted on"),
+        "each left-out shape, success on its feasible goals": _worst_shape(results),
+        "calibration ECE": Measured(calibration["ece"], int(calibration["n"]), "actions"),
+        "calibration AUROC": Measured(calibration["auroc"], int(calibration["n"]), "actions"),
+        "multi-step targets reached": Measured(multi["success"], int(multi["n"]), "episodes",
+                                               tuple(multi["success_ci"])),
+        "multi-step reach failures per interaction": Measured(
+            multi["reach_failures"] if multi["interactions"] else None, int(multi["n"]),
+            f"episodes, {multi['interactions']} interactions", wilson(failures, multi["interactions"])),
     }
 
 
-def target_met(name: str, value: float | None) -> bool | None:
-    if value is None:
-        return None
+def target_verdict(name: str, measured: Measured) -> str:
+    """"met" or "missed" by the target's bound when ``measured`` has at least :data:`MIN_N` of its n; "too few"
+    below; "not measured" when there is no value (0 of 0)."""
+    if measured.value is None:
+        return NOT_MEASURED
+    if measured.n < MIN_N[name]:
+        return TOO_FEW
     direction, bound = TARGETS[name]
-    return value >= bound if direction == ">=" else value <= bound
+    return MET if (measured.value >= bound if direction == ">=" else measured.value <= bound) else MISSED
+
+
+def target_met(name: str, measured: Measured | float | None) -> bool | None:
+    """True if the target is met, False if missed, None without a verdict (too few, not measured, or a bare value
+    without its n)."""
+    if not isinstance(measured, Measured):
+        return None
+    verdict = target_verdict(name, measured)
+    return True if verdict == MET else False if verdict == MISSED else None
+
+
+def verdict_text(name: str, measured: Measured) -> str:
+    """The verdict with its n, as the report shows it: "met (n=212 feasible goals)", "too few (n=12 feasible
+    goals; 200 needed)", "not measured (n=0 ...)"."""
+    verdict = target_verdict(name, measured)
+    needed = f"; {MIN_N[name]} needed" if verdict == TOO_FEW else ""
+    return f"{verdict} (n={measured.n} {measured.unit}{needed})"
+
+
+def _value_text(name: str, measured: Measured) -> str:
+    if measured.detail is not None:
+        return measured.detail
+    if measured.value is None:
+        return share_text(None, measured.n, unit=measured.unit)
+    if "[m]" in name:
+        return f"{100 * measured.value:.1f} cm (n={measured.n} {measured.unit})"
+    if name.startswith("calibration"):
+        return f"{measured.value:.3f} (n={measured.n} {measured.unit})"
+    return share_text(measured.value, measured.n, measured.ci, measured.unit, digits=1)
 
 
 def _why(name: str, results: Mapping[str, Any]) -> str:
@@ -63,17 +181,17 @@ def _why(name: str, results: Mapping[str, Any]) -> str:
     if name.startswith("single-step"):
         gaps = sorted(((single[k]["oracle"]["success"] or 0) - (single[k]["planner"]["success"] or 0), k)
                       for k in GOAL_KINDS if single.get(k))
-        worst = ", ".join(f"{k}: planner {_pct(single[k]['planner']['success'])} vs oracle "
-                          f"{_pct(single[k]['oracle']['success'])}" for _, k in reversed(gaps[-2:]))
+        worst = ", ".join(f"{k}: planner {_share(single[k]['planner'])} vs oracle {_share(single[k]['oracle'])}"
+                          for _, k in reversed(gaps[-2:]))
         return f"the gap to the oracle is largest for {worst}"
     if name.startswith("median placement"):
         place = single.get("place", {})
-        return (f"place goals are reached in {_pct(place.get('oracle', {}).get('success'))} of cases even by the "
-                "oracle: most targets 5-15 cm away are beyond what one interaction does to the object")
+        return (f"place goals are reached in {_share(place.get('oracle', {}))} of cases even by the oracle: most "
+                "targets 5-15 cm away are beyond what one interaction does to the object")
     if name.startswith("each left-out"):
         loso = results["leave_one_shape_out"]
-        parts = [f"{s}: {_pct(loso[s]['planner']['success_feasible'])} of {loso[s]['planner']['n_feasible']} "
-                 f"feasible (best fixed {_pct(loso[s]['best_fixed']['success_feasible'])})" for s in loso]
+        parts = [f"{s}: {_share(loso[s]['planner'], 'success_feasible', 'n_feasible', 'feasible')} (best fixed "
+                 f"{_share(loso[s]['best_fixed'], 'success_feasible', 'n_feasible', 'feasible')})" for s in loso]
         return "; ".join(parts)
     if name.startswith("calibration"):
         curve = results["calibration"]["curve"]
@@ -112,18 +230,19 @@ def multi_step_why(results: Mapping[str, Any]) -> str:
     missed = [e for e in multi.get("episodes", []) if not e["success"]]
     beyond = [e for e in missed if not e["within_reach"]]
     per_type = "; ".join(
-        f"{t}: {_pct(r['success'])} of {r['n']} (9 in 10 interactions move it at most "
+        f"{t}: {share_text(r['success'], r['n'], digits=1)} (9 in 10 interactions move it at most "
         + ", ".join(f"{100 * v:.1f}" for v in reach.get(t, {}).values()) + " cm along +x, -x, +y, -y)"
         for t, r in multi.get("by_type", {}).items())
     towards = sum(e["target_xy"][0] - e["start_xy"][0] > reach.get(e["type"], {}).get("+x", 0.0) * most
                   for e in beyond)
     inside = multi.get("within_reach", {})
     gave_up = sum(e["gave_up"] for e in missed)
-    return (f"{_pct(multi['success'])} of episodes reach the target (median final distance "
+    return (f"{_share(multi, unit='episodes')} reach the target (median final distance "
             f"{100 * multi['median_final_distance_m']:.1f} cm). By type: {per_type}. {len(beyond)} of the "
             f"{len(missed)} missed targets lay further along an axis than {most} such interactions take the object "
             f"({towards} of them towards the robot, where only rolling brings an object); on the "
-            f"{inside.get('n', 0)} targets within that reach the planner reached {_pct(inside.get('success'))}. In "
+            f"{inside.get('n', 0)} targets within that reach the planner reached "
+            f"{share_text(inside.get('success'), inside.get('n', 0), digits=1)}. In "
             f"{gave_up} missed episodes the object ended where no candidate action was reachable")
 
 
@@ -136,43 +255,47 @@ def write_plan_report(results: Mapping[str, Any], out: str | os.PathLike) -> Pat
               + ", ".join(f"{b} {n}" for b, n in results["training"].items())
               + f" (random actions from {s['episodes']} goal episodes, objects over the workspaces). "
               f"Total time {results['timings_s']['total'] / 60:.1f} min.", ""]
-    lines += ["## Targets", "", "| target | bound | measured | met | why not |", "|---|---|---|---|---|"]
-    for name, value in measured_targets(results).items():
+    lines += ["## Targets", "",
+              "A target is judged only on enough data, else it is *too few* (a share of nothing is *not measured*): "
+              f"at least {MIN_FEASIBLE_GOALS} feasible single-step goals, {MIN_FEASIBLE_PER_SHAPE} feasible goals "
+              f"of each left-out shape, {MIN_PLACEMENTS} place goals acted on, {MIN_CALIBRATION_ACTIONS} actions "
+              f"for the calibration and {MIN_EPISODES} multi-step episodes. Shares carry their Wilson 95 % interval "
+              "and n.", "",
+              "| target | bound | measured | verdict | why not |", "|---|---|---|---|---|"]
+    for name, measured in measured_targets(results).items():
         direction, bound = TARGETS[name]
-        met = target_met(name, value)
-        shown = ("-" if value is None else f"{100 * value:.1f} cm" if "[m]" in name
-                 else f"{value:.3f}" if name.startswith("calibration") else _pct(value))
+        verdict = target_verdict(name, measured)
         bound_text = f"{100 * bound:.0f} cm" if "[m]" in name else (f"{bound}" if name.startswith("calibration")
                                                                      else f"{100 * bound:.0f} %")
-        lines.append(f"| {name} | {direction} {bound_text} | {shown} | {'yes' if met else 'no'} | "
-                     f"{'' if met else _why(name, results)} |")
+        lines.append(f"| {name} | {direction} {bound_text} | {_value_text(name, measured)} | "
+                     f"**{verdict_text(name, measured)}** | {_why(name, results) if verdict == MISSED else ''} |")
     single = results["single_step"]
     lines += ["", f"## Single step ({single['planner']['n']} held-out objects, one goal each; "
               f"{single['oracle']['n_feasible']} feasible)", "",
               "| policy | success [95 % CI] | on feasible goals [95 % CI] |", "|---|---|---|"]
     for p in POLICIES:
         r = single[p]
-        lines.append(f"| {p} | {_pct(r['success'])} {_ci(r['success_ci'])} | {_pct(r['success_feasible'])} "
-                     f"{_ci(r['success_feasible_ci'])} |")
-    lines += ["", "Per goal kind (success):", "", "| goal | n | " + " | ".join(POLICIES) + " |",
-              "|---|---|" + "---|" * len(POLICIES)]
+        lines.append(f"| {p} | {_share(r)} | {_share(r, 'success_feasible', 'n_feasible')} |")
+    lines += ["", "Per goal kind (success [95 % CI]):", "", "| goal | " + " | ".join(POLICIES) + " |",
+              "|---|" + "---|" * len(POLICIES)]
     for kind, by in results["single_step_by_goal"].items():
-        lines.append(f"| {kind} | {by['planner']['n']} | " + " | ".join(_pct(by[p]["success"]) for p in POLICIES)
-                     + " |")
+        lines.append(f"| {kind} | " + " | ".join(_share(by[p]) for p in POLICIES) + " |")
     lines += ["", f"Best fixed behaviour per goal kind: {results['best_fixed_behavior']}.", ""]
     lines += ["## Leaving each shape out", "", "Models refitted without the shape, judged on goals for it only.", "",
-              "| shape | n (feasible) | planner on feasible | best fixed on feasible | random |",
-              "|---|---|---|---|---|"]
+              "| shape | planner on feasible [95 % CI] | best fixed on feasible [95 % CI] | random [95 % CI] |",
+              "|---|---|---|---|"]
     for shape, r in results["leave_one_shape_out"].items():
-        lines.append(f"| {shape} | {r['planner']['n']} ({r['planner']['n_feasible']}) | "
-                     f"{_pct(r['planner']['success_feasible'])} | {_pct(r['best_fixed']['success_feasible'])} | "
-                     f"{_pct(r['random']['success'])} |")
-    lines += ["", "## Multi-step", "", "| policy | targets reached [95 % CI] | reach failures per interaction | "
-              "median final distance |", "|---|---|---|---|"]
+        lines.append(f"| {shape} | {_share(r['planner'], 'success_feasible', 'n_feasible')} | "
+                     f"{_share(r['best_fixed'], 'success_feasible', 'n_feasible')} | {_share(r['random'])} |")
+    lines += ["", "## Multi-step", "", "| policy | targets reached [95 % CI] | reach failures per interaction "
+              "[95 % CI] | median final distance |", "|---|---|---|---|"]
     for p in MULTI_POLICIES:
         r = results["multi_step"][p]
-        lines.append(f"| {p} | {_pct(r['success'])} {_ci(r['success_ci'])} | {_pct(r['reach_failures'])} | "
-                     f"{100 * r['median_final_distance_m']:.1f} cm |")
+        failures = round(r["reach_failures"] * r["interactions"])
+        lines.append(f"| {p} | {_share(r, unit='episodes')} | "
+                     + share_text(r["reach_failures"], r["interactions"], wilson(failures, r["interactions"]),
+                                  "interactions", digits=1)
+                     + f" | {100 * r['median_final_distance_m']:.1f} cm (n={r['n']} episodes) |")
     cal = results["calibration"]
     auroc = "-" if cal["auroc"] is None else f"{cal['auroc']:.3f}"
     lines += ["", "## Calibration", "",
@@ -199,7 +322,7 @@ def write_plan_figures(results: Mapping[str, Any], out: str | os.PathLike,
     for j, p in enumerate(POLICIES):
         values = [results["single_step_by_goal"][k][p] for k in GOAL_KINDS]
         x = np.arange(len(GOAL_KINDS)) + (j - len(POLICIES) / 2 + 0.5) * width
-        y = np.array([v["success"] or 0.0 for v in values])
+        y = np.array([np.nan if v["success"] is None else v["success"] for v in values])  # nothing measured: no bar
         lo = y - np.array([v["success_ci"][0] for v in values])
         hi = np.array([v["success_ci"][1] for v in values]) - y
         ax.bar(x, 100 * y, width, yerr=100 * np.vstack([lo, hi]), capsize=2, label=p)
@@ -237,5 +360,5 @@ def write_plan_figures(results: Mapping[str, Any], out: str | os.PathLike,
     return written
 
 
-__all__ = ["TARGETS", "measured_targets", "target_met", "write_plan_report", "write_plan_figures", "SHAPES",
-           "MULTI_POLICIES"]
+__all__ = ["TARGETS", "MIN_N", "Measured", "measured_targets", "target_verdict", "target_met", "verdict_text",
+           "write_plan_report", "write_plan_figures", "SHAPES", "MULTI_POLICIES"]

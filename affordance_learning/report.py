@@ -15,7 +15,11 @@ import numpy as np
 from affordance_learning.claims import (  # noqa: F401  (AGREES ... Claim: re-exported, the report's vocabulary)
     AGREES,
     DISAGREES,
+    MIN_INTERACTIONS,
+    MIN_TRIALS,
     NOT_COMPUTABLE,
+    TOO_FEW,
+    VERDICTS,
     Claim,
     _outcome_words,
     claims_scope,
@@ -71,6 +75,23 @@ def _case_tables(results: Mapping[str, Any]) -> list[str]:
                          + (f" {c['left_view']} |" if left else ""))
         lines.append("")
     return lines
+
+
+def _tally(claims: Sequence[Claim]) -> str:
+    """How many claims got each verdict, and the least data a verdict is given on."""
+    tally = {v: sum(c.verdict == v for c in claims) for v in VERDICTS}
+    return (f"**{tally[AGREES]} of {len(claims)} claims agree**, {tally[DISAGREES]} disagree, {tally[TOO_FEW]} had too "
+            f"few data for a verdict, {tally[NOT_COMPUTABLE]} could not be computed. A verdict is given on at least "
+            f"{MIN_TRIALS} trials of {MIN_INTERACTIONS} interactions (a claim on means over trials) or "
+            f"{MIN_INTERACTIONS} interactions (a claim on one map of the first trial, or on sizes); each shows its "
+            "n.")
+
+
+def _claim_rows(claims: Sequence[Claim]) -> list[str]:
+    """The claims' table: each with the paper's statement, the rule, our numbers and the verdict with its n."""
+    rows = ["| claim | the paper | rule | ours | verdict |", "|---|---|---|---|---|"]
+    rows += [f"| {c.topic} | {c.paper} | {c.rule} | {c.ours} | **{c.verdict}** ({c.n_text}) |" for c in claims]
+    return rows
 
 
 def _pct(value: float | None) -> str:
@@ -156,7 +177,6 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
     """The Markdown text of the report (see :func:`write_report`)."""
     results = current_results(results)
     claims = evaluate_claims(results)
-    tally = {v: sum(c.verdict == v for c in claims) for v in (AGREES, DISAGREES, NOT_COMPUTABLE)}
     config = results.get("config", {})
     behavior = results_behavior(results)
     success_label, fail_label = _outcome_words(results)
@@ -172,15 +192,11 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
         f"{UNIFORMITY_DEFINITION} Shares are shown in percent here; `results.json` holds them as fractions "
         f"({UNITS}).",
         "",
-        f"**{tally[AGREES]} of {len(claims)} claims agree**, {tally[DISAGREES]} disagree, "
-        f"{tally[NOT_COMPUTABLE]} could not be computed. Each verdict follows the rule beside it, applied to "
-        f"the numbers below (means over trials). {claims_scope(behavior)}",
+        f"{_tally(claims)} Each verdict follows the rule beside it, applied to the numbers below (means over "
+        f"trials). {claims_scope(behavior)}",
         "",
-        "| claim | the paper | rule | ours | verdict |",
-        "|---|---|---|---|---|",
+        *_claim_rows(claims),
     ]
-    for c in claims:
-        lines.append(f"| {c.topic} | {c.paper} | {c.rule} | {c.ours} | **{c.verdict}** |")
     lines += [""] + _effects_section(results, figures) + _size_section(results)
     lines += ["## Effect clusters", ""]
     lines += _table_k(
@@ -283,20 +299,16 @@ def render_overview(runs: Mapping[str, Mapping[str, Any]],
     for behavior, results in runs.items():
         h = _headline(results)
         agree = sum(c.verdict == AGREES for c in claims[behavior])
+        few = sum(c.verdict == TOO_FEW for c in claims[behavior])
         lines.append(f"| [{behavior}]({behavior}/REPORT.md) | {h['interactions']} | {h['success']} | "
                      f"{h['uniformity']} | {h['peak']} | {h['accuracy']} | {h['critical']} | "
-                     f"{agree} of {len(claims[behavior])} |")
+                     f"{agree} of {len(claims[behavior])}" + (f" ({few} on too few data)" if few else "") + " |")
     lines.append("")
     for behavior, found in claims.items():
-        tally = {v: sum(c.verdict == v for c in found) for v in (AGREES, DISAGREES, NOT_COMPUTABLE)}
         shown = sorted(Path(f).name for f in figures.get(behavior, ()))
         lines += [f"## {behavior}", "", f"[Full report]({behavior}/REPORT.md)"
                   + (" · figures: " + ", ".join(f"[{Path(f).stem}]({behavior}/{f})" for f in shown) if shown else ""),
-                  "", f"**{tally[AGREES]} of {len(found)} claims agree**, {tally[DISAGREES]} disagree, "
-                  f"{tally[NOT_COMPUTABLE]} could not be computed. {claims_scope(behavior)}", "",
-                  "| claim | the paper | rule | ours | verdict |", "|---|---|---|---|---|"]
-        lines += [f"| {c.topic} | {c.paper} | {c.rule} | {c.ours} | **{c.verdict}** |" for c in found]
-        lines.append("")
+                  "", f"{_tally(found)} {claims_scope(behavior)}", "", *_claim_rows(found), ""]
     return "\n".join(lines)
 
 

@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 
 from affordance_learning import run_protocol, write_figures, write_report
-from affordance_learning.report import AGREES, DISAGREES, NOT_COMPUTABLE, evaluate_claims, write_overview
+from affordance_learning.report import AGREES, DISAGREES, NOT_COMPUTABLE, VERDICTS, evaluate_claims, write_overview
 from affordance_learning.schema import feature_groups, feature_names
 from affordance_learning.synthetic import make_synthetic_frame
 
@@ -224,7 +224,7 @@ def test_figures_and_report_are_written(results: dict, tmp_path: Path) -> None:
     assert "uniformity.png" in text and "| Uniformity on average |" in text
     assert "# Reproduction of Akgun et al. 2009, tap:" in text and "| cluster | rolled | did not roll |" in text
     assert "## Success by object size" in text and "![size_success](size_success.png)" in text
-    assert text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**") == 14
+    assert sum(text.count(f"**{v}**") for v in VERDICTS) == 14
     again = write_report(json.loads(json.dumps(results)), tmp_path / "again").read_text()
     assert again.split("## Configuration")[0] == text.split("## Figures")[0]  # same numbers from the JSON
 
@@ -232,6 +232,7 @@ def test_figures_and_report_are_written(results: dict, tmp_path: Path) -> None:
 def _paper_like(results: dict) -> dict:
     """The results edited to say what the paper says, claim by claim."""
     good = copy.deepcopy(results)
+    good["config"] = {**good["config"], "n_trials": 20, "n_rows": 1000}  # as many as the maps below hold
     ks = [str(k) for k in range(2, 11)]
     rs = ["0.0", "0.2", "0.4", "0.6", "0.8"]
     good["uniformity"] = {k: {"mean": 0.80 + 0.015 * i, "std": 0.01} for i, k in enumerate(ks)}
@@ -311,7 +312,7 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
         "Bump at k = 4",
     ):
         assert verdicts[topic] == DISAGREES, topic
-    partial = {"results_format": 2, "uniformity": good["uniformity"]}
+    partial = {"results_format": 2, "uniformity": good["uniformity"], "config": {"n_trials": 20, "n_rows": 1000}}
     verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
     assert verdicts["Uniformity on average"] == AGREES and verdicts["Bump at k = 4"] == NOT_COMPUTABLE
 
@@ -384,7 +385,8 @@ def test_grasp_claims_are_computed_from_the_numbers(results: dict) -> None:
     single = copy.deepcopy(none)
     single["size_success"]["logistic"] = None
     assert {c.topic: c.verdict for c in evaluate_claims(single)}["Critical size"] == DISAGREES
-    partial = {"results_format": 2, "uniformity": good["uniformity"], "config": {"behavior": "grasp"}}
+    partial = {"results_format": 2, "uniformity": good["uniformity"],
+               "config": {"behavior": "grasp", "n_trials": 20, "n_rows": 1000}}
     verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
     assert verdicts["Fall at k = 3"] == AGREES and verdicts["Critical size"] == NOT_COMPUTABLE
 
@@ -400,7 +402,7 @@ def test_each_behaviour_gets_its_own_claims(results: dict, tmp_path: Path) -> No
         "Uniformity rises with k", "Fewer features as r rises", "Number constant in k", "SVM accuracy falls with k"]
     text = write_report(push, tmp_path).read_text()
     assert "# Reproduction of Akgun et al. 2009, push:" in text and "tapping and grasping only" in text
-    assert text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**") == 4
+    assert sum(text.count(f"**{v}**") for v in VERDICTS) == 4
 
 
 def test_the_overview_sets_the_behaviours_side_by_side(results: dict, tmp_path: Path) -> None:
@@ -413,8 +415,7 @@ def test_the_overview_sets_the_behaviours_side_by_side(results: dict, tmp_path: 
     assert "6.0 cm (90 % below, 10 % above)" in text  # the grasp's critical size in the headline table
     assert "[uniformity](grasp/uniformity.png)" in text and "## tap" in text and "## grasp" in text
     assert "| Fall at k = 3 |" in text and "| 1 x 2 map: object types |" in text
-    verdicts = text.count("**agrees**") + text.count("**disagrees**") + text.count("**not computable**")
-    assert verdicts == 14 + 10
+    assert sum(text.count(f"**{v}**") for v in VERDICTS) == 14 + 10
     with pytest.raises(ValueError, match="runs must map each behaviour"):
         write_overview({}, tmp_path)
 

@@ -1,0 +1,266 @@
+"""Verdicts are given only on enough data and carry their n: the paper's claims and the planner's targets, on small
+synthetic results (no simulator)."""
+
+from __future__ import annotations
+
+import copy
+import re
+from pathlib import Path
+
+import pytest
+
+from affordance_learning.claims import (
+    AGREES,
+    DISAGREES,
+    MIN_INTERACTIONS,
+    MIN_TRIALS,
+    NOT_COMPUTABLE,
+    STRADDLE_MAX_SIZE,
+    STRADDLE_MIN_SIZE,
+    TOO_FEW,
+    evaluate_claims,
+)
+from affordance_learning.metrics import wilson_interval
+from affordance_learning.plan_experiment import MULTI_POLICIES, POLICIES, SHAPES, share_text, summarize
+from affordance_learning.plan_report import (
+    MET,
+    MIN_CALIBRATION_ACTIONS,
+    MIN_EPISODES,
+    MIN_FEASIBLE_GOALS,
+    MIN_FEASIBLE_PER_SHAPE,
+    MIN_PLACEMENTS,
+    MISSED,
+    NOT_MEASURED,
+    measured_targets,
+    target_met,
+    target_verdict,
+    write_plan_report,
+)
+from affordance_learning.plan_report import TOO_FEW as TARGET_TOO_FEW
+from affordance_learning.report import render_report
+
+STRADDLE = "1 x 3 map: a category straddles the critical size"
+SHAPE_TARGET = "each left-out shape, success on its feasible goals"
+SINGLE_TARGET = "single-step success on feasible goals"
+MULTI_TARGET = "multi-step targets reached"
+
+
+# --- the Wilson interval ---------------------------------------------------------------------------------------
+def test_wilson_interval_matches_the_formula_and_its_edges() -> None:
+    # 45 of 50: the Wilson score interval, by hand (z = 1.96)
+    low, high = wilson_interval(45, 50)
+    assert low == pytest.approx(0.786398, abs=1e-6) and high == pytest.approx(0.956524, abs=1e-6)
+    # it stays within [0, 1] and does not collapse at 0 of n or n of n, where p +- z sqrt(p (1 - p) / n) would
+    assert wilson_interval(0, 20)[0] == 0.0 and wilson_interval(0, 20)[1] == pytest.approx(0.161125, abs=1e-6)
+    assert wilson_interval(20, 20)[1] == 1.0 and wilson_interval(20, 20)[0] == pytest.approx(0.838875, abs=1e-6)
+    # symmetric in successes and failures, and nothing known of 0 of 0
+    for k in range(0, 31, 5):
+        low, high = wilson_interval(k, 30)
+        assert (1 - high, 1 - low) == pytest.approx(wilson_interval(30 - k, 30))
+        assert low <= k / 30 <= high
+    assert wilson_interval(0, 0) == (0.0, 1.0)
+    with pytest.raises(ValueError, match="successes <= n"):
+        wilson_interval(3, 2)
+
+
+def test_wilson_interval_agrees_with_scipy() -> None:
+    from scipy.stats import binomtest
+
+    for n in (1, 7, 30, 200):
+        for k in range(0, n + 1, max(1, n // 6)):
+            ci = binomtest(k, n).proportion_ci(0.95, method="wilson")
+            assert wilson_interval(k, n) == pytest.approx((ci.low, ci.high), abs=1e-12)
+
+
+def test_a_share_of_nothing_is_not_measured_and_every_share_shows_its_n() -> None:
+    assert share_text(None, 0) == "not measured (n=0)"
+    assert share_text(0.0, 0, unit="feasible") == "not measured (n=0 feasible)"  # 0 of 0, never "0 %"
+    assert share_text(0.0, 12) == "0 % (n=12)"  # 0 of 12 is a rate
+    assert share_text(0.8, 35, (0.62, 0.91), "feasible goals", digits=1) == "80.0 % [62, 91] (n=35 feasible goals)"
+
+
+# --- the planner's targets -------------------------------------------------------------------------------------
+def _records(n: int, feasible: int, reached: int, policies=POLICIES) -> list[dict]:
+    """``n`` goals of which ``feasible`` are feasible (the oracle reached them); every policy but the oracle reaches
+    the first ``reached`` feasible ones."""
+    out = []
+    for i in range(n):
+        row = {p: i < reached for p in policies}
+        row["oracle"] = i < feasible
+        out.append(row)
+    return out
+
+
+def _plan_results(shape_goals: dict[str, tuple[int, int, int]] | None = None, single: tuple[int, int, int] = (
+        300, 250, 240), episodes: tuple[int, int] = (80, 75)) -> dict:
+    """Plan results: ``single`` = (goals, feasible, reached by the planner), ``shape_goals`` per left-out shape,
+    ``episodes`` = (multi-step episodes, reached)."""
+    shape_goals = shape_goals or {s: (60, 50, 45) for s in SHAPES}
+    records = _records(*single)
+    n, k = episodes
+    multi = {p: {"success": k / n if n else None, "success_ci": wilson_interval(k, n), "n": n,
+                 "reach_failures": 0.01, "interactions": 3 * n, "gave_up": 0, "median_final_distance_m": 0.02}
+             for p in MULTI_POLICIES}
+    multi["planner"].update(by_type={"sphere": {"n": n, "success": k / n if n else None}}, episodes=[],
+                            within_reach={"n": 0, "success": None})
+    return {
+        "seed": 0, "settings": {"episodes": 1000}, "training": {"tap": 1000}, "timings_s": {"total": 60.0},
+        "single_step": summarize(records, POLICIES),
+        "single_step_by_goal": {"roll": summarize(records, POLICIES), "lift": summarize([], POLICIES)},
+        "best_fixed_behavior": {"roll": "tap"},
+        "planner_over_oracle": single[2] / single[1],
+        "leave_one_shape_out": {s: summarize(_records(*g), ("planner", "best_fixed", "random", "oracle"))
+                                for s, g in shape_goals.items()},
+        "multi_step": {**multi, "step_reach_p90_m": {}, "max_interactions": 5, "tolerance_m": 0.03},
+        "placement_error_median_m": 0.015, "placement_error_n": 40,
+        "calibration": {"ece": 0.03, "auroc": 0.97, "n": 2000, "curve": []},
+        "goals": [],
+    }
+
+
+def test_a_left_out_shape_judged_on_one_goal_is_too_few_not_met() -> None:
+    results = _plan_results({**{s: (60, 50, 45) for s in SHAPES}, "box": (3, 1, 1)})  # box: 1 of 1 feasible
+    measured = measured_targets(results)[SHAPE_TARGET]
+    assert target_verdict(SHAPE_TARGET, measured) == TARGET_TOO_FEW and target_met(SHAPE_TARGET, measured) is None
+    assert measured.n == 1 and "box" in measured.unit
+    # with enough feasible goals of every shape the same shares are met
+    enough = _plan_results({**{s: (60, 50, 45) for s in SHAPES}, "box": (40, MIN_FEASIBLE_PER_SHAPE, 30)})
+    assert target_verdict(SHAPE_TARGET, measured_targets(enough)[SHAPE_TARGET]) == MET
+
+
+def test_a_left_out_shape_missed_on_enough_goals_misses_whatever_the_others() -> None:
+    results = _plan_results({"sphere": (60, 50, 20), "box": (3, 0, 0), "horizontal_cylinder": (60, 50, 45),
+                             "vertical_cylinder": (60, 50, 45)})
+    measured = measured_targets(results)[SHAPE_TARGET]
+    assert target_verdict(SHAPE_TARGET, measured) == MISSED and measured.value == pytest.approx(0.4)
+    assert measured.n == 50 and "sphere" in measured.unit
+
+
+def test_single_step_and_multi_step_need_their_minimum_n() -> None:
+    few = _plan_results(single=(200, MIN_FEASIBLE_GOALS - 1, MIN_FEASIBLE_GOALS - 1),
+                        episodes=(MIN_EPISODES - 1, MIN_EPISODES - 1))
+    targets = measured_targets(few)
+    assert target_verdict(SINGLE_TARGET, targets[SINGLE_TARGET]) == TARGET_TOO_FEW  # 100 % of 199
+    assert target_verdict(MULTI_TARGET, targets[MULTI_TARGET]) == TARGET_TOO_FEW  # 100 % of 59
+    enough = measured_targets(_plan_results(single=(300, MIN_FEASIBLE_GOALS, 150),
+                                            episodes=(MIN_EPISODES, MIN_EPISODES)))
+    assert target_verdict(SINGLE_TARGET, enough[SINGLE_TARGET]) == MISSED  # 75 % of 200
+    assert target_verdict(MULTI_TARGET, enough[MULTI_TARGET]) == MET
+    # nothing measured is no verdict, and a bare value without its n gets none either
+    none = measured_targets(_plan_results(episodes=(0, 0)))
+    assert target_verdict(MULTI_TARGET, none[MULTI_TARGET]) == NOT_MEASURED
+    assert target_met(SINGLE_TARGET, 0.99) is None
+
+
+def test_placement_and_calibration_need_their_minimum_n() -> None:
+    placement, ece = "median placement error [m]", "calibration ECE"
+    results = _plan_results()
+    results["placement_error_n"], results["calibration"]["n"] = MIN_PLACEMENTS - 1, MIN_CALIBRATION_ACTIONS - 1
+    targets = measured_targets(results)
+    assert target_verdict(placement, targets[placement]) == TARGET_TOO_FEW
+    assert target_verdict(ece, targets[ece]) == TARGET_TOO_FEW
+    results["placement_error_n"], results["calibration"]["n"] = MIN_PLACEMENTS, MIN_CALIBRATION_ACTIONS
+    targets = measured_targets(results)
+    assert target_verdict(placement, targets[placement]) == target_verdict(ece, targets[ece]) == MET
+    # results written before placement_error_n: the place goals the planner acted on, counted from the goals
+    del results["placement_error_n"]
+    results["goals"] = [{"kind": "place", "planner_behavior": "push"}] * 12 + [{"kind": "place",
+                                                                             "planner_behavior": None}] * 30
+    assert measured_targets(results)[placement].n == 12
+
+
+def test_the_plan_report_shows_n_beside_every_rate_and_no_zero_for_nothing(tmp_path: Path) -> None:
+    results = _plan_results({**{s: (60, 50, 45) for s in SHAPES}, "box": (4, 0, 0)})
+    text = write_plan_report(results, tmp_path).read_text()
+    box = next(line for line in text.splitlines() if line.startswith("| box |"))
+    assert box == "| box | not measured (n=0) | not measured (n=0) | 0.0 % [0, 49] (n=4) |"  # 0 of 0, but 0 of 4
+    assert f"**{TARGET_TOO_FEW} (n=0 feasible goals of box; {MIN_FEASIBLE_PER_SHAPE} needed)**" in text
+    assert "| lift | not measured (n=0) |" in text  # a goal kind without goals
+    rows = [line for line in text.splitlines() if line.startswith("| ")]
+    assert len(rows) > 20
+    for cell in (cell for line in rows for cell in line.split("|")):
+        rates = re.findall(r"\d\.\d %", cell)  # a measured rate (the bounds are whole percents)
+        assert cell.count("n=") >= len(rates), cell
+
+
+# --- the paper's claims ----------------------------------------------------------------------------------------
+def _grasp_results(straddle: list[tuple[int, int, list[float]]], trials: int = 20, rows: int = 1000) -> dict:
+    """Grasp results with a critical size of 6 cm, a 1 x 3 map of (successes, failures, sizes) and a uniformity
+    curve, as ``trials`` trials of ``rows`` interactions."""
+    u = {2: 0.66, 3: 0.60, 4: 0.70, 5: 0.72, 6: 0.75, 7: 0.78, 8: 0.80, 9: 0.84, 10: 0.90}
+    return {
+        "results_format": 2,
+        "config": {"behavior": "grasp", "n_trials": trials, "n_rows": rows},
+        "uniformity": {str(k): {"mean": v, "std": 0.05} for k, v in u.items()},
+        "size_success": {"bins": [{"low": 0.03, "high": 0.06, "n": rows // 2, "success": 0.9},
+                                  {"low": 0.06, "high": 0.09, "n": rows - rows // 2, "success": 0.1}],
+                         "logistic": {"intercept": 18.0, "slope": -300.0}, "critical_size": 0.06,
+                         "below": {"n": rows // 2, "success": 0.9}, "above": {"n": rows - rows // 2, "success": 0.1}},
+        "case_studies": {"3": [{"cluster": c, "success": s, "fail": f, "types": {}, "sizes": sizes}
+                               for c, (s, f, sizes) in enumerate(straddle)]},
+    }
+
+
+SMALL, BOTH, LARGE = [0.03, 0.04, 0.05], [0.05, 0.055, 0.062, 0.068], [0.07, 0.08, 0.09]
+
+
+def _verdict(results: dict, topic: str) -> str:
+    return next(c.verdict for c in evaluate_claims(results) if c.topic == topic)
+
+
+def test_a_straddling_category_must_be_a_minority() -> None:
+    # the paper's picture: a success and a fail category, and a minority between them, with some of each
+    good = _grasp_results([(400, 20, SMALL), (120, 80, BOTH), (20, 460, LARGE)])
+    assert _verdict(good, STRADDLE) == AGREES
+    # what the shipped grasp shows: the category with objects and outcomes on both sides holds 97 % of everything
+    bulk = _grasp_results([(553, 414, [0.04, 0.07, 0.1]), (0, 29, [0.071, 0.093]), (0, 4, [0.083, 0.085])])
+    assert _verdict(bulk, STRADDLE) == DISAGREES
+    claim = next(c for c in evaluate_claims(bulk) if c.topic == STRADDLE)
+    assert "holds 97 % of the interactions" in claim.ours and f"{100 * STRADDLE_MAX_SIZE:.0f} %" in claim.rule
+    # a majority, with two fair categories beside it, is still the bulk of the map
+    majority = _grasp_results([(200, 20, SMALL), (330, 270, BOTH), (20, 160, LARGE)])
+    assert _verdict(majority, STRADDLE) == DISAGREES
+
+
+def test_the_categories_a_straddling_one_steals_from_hold_enough_of_both_outcomes() -> None:
+    # a category of 5 % beside the straddling one: not one of the two it steals from
+    handful = _grasp_results([(630, 20, SMALL), (180, 120, BOTH), (5, 45, LARGE)])
+    assert 50 / 1000 < STRADDLE_MIN_SIZE and _verdict(handful, STRADDLE) == DISAGREES
+    # two success categories beside it: there is no fail category to steal from
+    no_fail = _grasp_results([(400, 20, SMALL), (120, 80, BOTH), (300, 80, LARGE)])
+    assert _verdict(no_fail, STRADDLE) == DISAGREES
+
+
+def test_claims_judged_on_too_few_data_say_so_with_their_n() -> None:
+    straddle = [(400, 20, SMALL), (120, 80, BOTH), (20, 460, LARGE)]
+    few_trials = _grasp_results(straddle, trials=MIN_TRIALS - 1)
+    claims = {c.topic: c for c in evaluate_claims(few_trials)}
+    assert claims["Fall at k = 3"].verdict == TOO_FEW and claims["Fall at k = 3"].n == MIN_TRIALS - 1
+    assert claims["Fall at k = 3"].verdict_text.startswith(f"too few (n={MIN_TRIALS - 1} trials of 1000 interactions")
+    assert claims[STRADDLE].verdict == AGREES  # a map of the first trial does not depend on the trials
+    assert _verdict(_grasp_results(straddle, trials=MIN_TRIALS), "Fall at k = 3") == AGREES
+    few_rows = _grasp_results(straddle, rows=MIN_INTERACTIONS - 1)
+    assert _verdict(few_rows, "Fall at k = 3") == TOO_FEW and _verdict(few_rows, "Critical size") == TOO_FEW
+    small_map = _grasp_results([(80, 4, SMALL), (24, 16, BOTH), (4, 70, LARGE)])  # 198 interactions
+    claim = next(c for c in evaluate_claims(small_map) if c.topic == STRADDLE)
+    assert claim.verdict == TOO_FEW and claim.n == 198 and "198 interactions in the 1 x 3 map" in claim.verdict_text
+    # results that do not say how many trials they hold get no verdict
+    unknown = copy.deepcopy(few_trials)
+    del unknown["config"]["n_trials"]
+    fall = next(c for c in evaluate_claims(unknown) if c.topic == "Fall at k = 3")
+    assert fall.verdict == NOT_COMPUTABLE and fall.verdict_text == "not computable (n unknown)"
+
+
+def test_every_claim_carries_its_n_in_the_report() -> None:
+    results = _grasp_results([(400, 20, SMALL), (120, 80, BOTH), (20, 460, LARGE)])
+    claims = evaluate_claims(results)
+    for c in claims:
+        assert re.search(r"\(n=\d+ ", c.verdict_text) or c.verdict == NOT_COMPUTABLE, c
+    text = render_report(results)
+    rows = [line for line in text.splitlines() if any(line.startswith(f"| {c.topic} |") for c in claims)]
+    assert len(rows) == len(claims)
+    for row, c in zip(rows, claims, strict=True):
+        assert row.endswith(f"**{c.verdict}** ({c.n_text}) |")
+    assert "had too few data for a verdict" in text and f"at least {MIN_TRIALS} trials of {MIN_INTERACTIONS}" in text
+    few = render_report({**results, "config": {**results["config"], "n_trials": 3}})
+    assert "**too few** (n=3 trials of 1000 interactions; at least" in few
