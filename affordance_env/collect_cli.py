@@ -3,13 +3,59 @@
 from __future__ import annotations
 
 import argparse
+import math
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 #: Command-line flags that are env options, and the env keyword each one sets.
 _ENV_FLAGS = ("behavior", "object_types", "size_range", "camera_width", "camera_height", "camera_fovy",
               "roll_threshold", "settle_timeout", "range_noise", "position_range")
+
+
+# --- argparse types: a value that cannot be used is refused as the command line is parsed --------------------
+def int_at_least(low: int) -> Callable[[str], int]:
+    """An argparse ``type``: an integer >= ``low``; any other value is an error that names it and the bound."""
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or value < low:
+            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {text!r}")
+        return value
+
+    parse.__name__ = f"integer >= {low}"
+    return parse
+
+
+#: Counts of something (interactions, trials, workers, ...) and seeds.
+positive_int, non_negative_int = int_at_least(1), int_at_least(0)
+
+
+def real_within(low: float, high: float = math.inf, *, open_low: bool = False,
+                expected: str | None = None) -> Callable[[str], float]:
+    """An argparse ``type``: a finite number in ``[low, high]`` (``(low, high]`` with ``open_low``); any other value
+    is an error that names it and ``expected`` (by default the interval)."""
+    if expected is None:
+        expected = f"a number in {'(' if open_low else '['}{low:g}, {high:g}]"
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not (math.isfinite(value) and (value > low if open_low else value >= low) and value <= high):
+            raise argparse.ArgumentTypeError(f"expected {expected}, got {text!r}")
+        return value
+
+    parse.__name__ = expected
+    return parse
+
+
+#: A share, as of failed interactions: 0 to 1.
+share = real_within(0.0, 1.0, expected="a share in [0, 1]")
 
 
 def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -21,10 +67,10 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
                     "the same command resumes an interrupted collection, or extends it with a larger "
                     "--episodes; other settings on an existing dataset are refused.",
     )
-    parser.add_argument("--episodes", type=int, required=True, help="number of interactions")
+    parser.add_argument("--episodes", type=positive_int, required=True, help="number of interactions")
     parser.add_argument("--out", type=Path, required=True, help="dataset directory (resumed if it exists)")
-    parser.add_argument("--seed", type=int, default=0, help="dataset seed (default 0)")
-    parser.add_argument("--workers", type=int, default=1,
+    parser.add_argument("--seed", type=non_negative_int, default=0, help="dataset seed (default 0)")
+    parser.add_argument("--workers", type=positive_int, default=1,
                         help="worker processes, or workers of the local Dask cluster (default 1)")
     parser.add_argument("--env", default="TapAffordance-v1", choices=("TapAffordance-v1", "TapAffordanceGoal-v0"),
                         dest="env_id",
@@ -36,10 +82,10 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
                              "(default canonical)")
     parser.add_argument("--save-images", action="store_true",
                         help="also store range images (float16) and object masks (bit-packed), compressed")
-    parser.add_argument("--max-failure-share", type=float, default=0.2, metavar="SHARE",
+    parser.add_argument("--max-failure-share", type=share, default=0.2, metavar="SHARE",
                         help="stop once more than this share of the interactions failed (the environment's "
                              "failure reasons are listed); 1 accepts any (default 0.2)")
-    parser.add_argument("--chunk-size", type=int, default=50,
+    parser.add_argument("--chunk-size", type=positive_int, default=50,
                         help="interactions per file, the most a crash loses per worker (default 50)")
     parser.add_argument("--scheduler", choices=("joblib", "dask"), default=None,
                         help="joblib: processes on this machine (default); dask: Dask distributed, a local "
@@ -47,19 +93,27 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     parser.add_argument("--dask-address", default=None, metavar="ADDRESS",
                         help="Dask scheduler to run on (e.g. tcp://host:8786); implies --scheduler dask. Its "
                              "workers must see --out and have the same tap-affordance version")
+    from affordance_env.objects import SIZE_LIMITS
+
+    low, high = SIZE_LIMITS
     env = parser.add_argument_group("environment options (default: the environment's own)")
     env.add_argument("--behavior", default=None, help="tap | tap_back | push | grasp")
     env.add_argument("--object-types", nargs="+", default=None, metavar="TYPE",
                      help="object types to sample from: sphere box horizontal_cylinder vertical_cylinder")
-    env.add_argument("--size-range", nargs=2, type=float, default=None, metavar=("LOW", "HIGH"),
-                     help="object size range [m]")
-    env.add_argument("--camera-width", type=int, default=None, help="range image width [pixels]")
-    env.add_argument("--camera-height", type=int, default=None, help="range image height [pixels]")
-    env.add_argument("--camera-fovy", type=float, default=None, help="vertical field of view [deg]")
-    env.add_argument("--roll-threshold", type=float, default=None,
+    env.add_argument("--size-range", nargs=2, default=None, metavar=("LOW", "HIGH"),
+                     type=real_within(low, high, expected=f"a size in metres in [{low:g}, {high:g}] (what the "
+                                      "hand can tap)"),
+                     help=f"object size range [m], LOW <= HIGH, both within {low:g}-{high:g}")
+    env.add_argument("--camera-width", type=int_at_least(2), default=None, help="range image width [pixels]")
+    env.add_argument("--camera-height", type=int_at_least(2), default=None, help="range image height [pixels]")
+    env.add_argument("--camera-fovy", type=real_within(1.0, 170.0, expected="a field of view in [1, 170] degrees"),
+                     default=None, help="vertical field of view [deg]")
+    env.add_argument("--roll-threshold", default=None,
+                     type=real_within(0.0, open_low=True, expected="a positive distance in metres"),
                      help="rolling distance above which an interaction is 'rolled' [m]; for push, the "
                           "displacement above which it is a 'success'")
-    env.add_argument("--settle-timeout", type=float, default=None,
+    env.add_argument("--settle-timeout", default=None,
+                     type=real_within(0.0, open_low=True, expected="a positive duration in seconds"),
                      help="longest simulated wait for the outcome after the first touch [s]")
     env.add_argument("--range-noise", default=None, choices=("kinect_v1",),
                      help="depth noise of the range camera (default: none)")
@@ -79,12 +133,45 @@ def env_options_from_args(args: argparse.Namespace) -> dict[str, Any]:
     return options
 
 
-def run_collect(args: argparse.Namespace) -> int:
-    """Run ``affordance collect``; bad options or a dataset made with other settings raise ValueError."""
-    from affordance_env.dataset import MANIFEST, collect, failure_summary, read_manifest
+def check_collect_args(args: argparse.Namespace) -> None:
+    """What the options of ``affordance collect`` say together, and its ``--out``, checked without the simulator
+    and before anything is built or written: ValueError naming the options. (Each value alone is checked as it is
+    parsed.)"""
+    from affordance_env.options import EnvOptions
+    from affordance_env.registration import GOAL_ENV_ID
 
     if args.scheduler == "joblib" and args.dask_address is not None:
         raise ValueError("--dask-address runs on Dask: drop --scheduler joblib (or use --scheduler dask).")
+    if args.size_range is not None and args.size_range[0] > args.size_range[1]:
+        low, high = args.size_range
+        raise ValueError(f"--size-range {low:g} {high:g}: expected LOW <= HIGH (equal for a single size).")
+    if args.env_id == GOAL_ENV_ID and args.behavior is not None:
+        raise ValueError(f"--env {GOAL_ENV_ID} chooses among all four behaviours at every step: drop --behavior "
+                         f"{args.behavior}.")
+    try:
+        EnvOptions.checked(**env_options_from_args(args))
+    except ValueError as exc:
+        flags = {name: "--" + name.replace("_", "-") for name in _ENV_FLAGS}
+        message = str(exc)
+        for name, flag in flags.items():  # name the options as they were given
+            message = message.replace(f"{name} must", f"{flag} must")
+        raise ValueError(message) from None
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out} is a file, not a dataset directory.")
+    if out.is_dir():
+        from affordance_env.dataset.format import MANIFEST
+
+        if not (out / MANIFEST).exists() and any(p.name != ".lock" for p in out.iterdir()):
+            raise ValueError(f"--out {out} exists and is not a TapAffordance dataset (no {MANIFEST}): choose an "
+                             "empty or new directory, or a dataset to resume or extend.")
+
+
+def run_collect(args: argparse.Namespace) -> int:
+    """Run ``affordance collect``; bad options or a dataset made with other settings raise ValueError."""
+    check_collect_args(args)
+    from affordance_env.dataset import MANIFEST, collect, failure_summary, read_manifest
+
     scheduler = args.scheduler or ("dask" if args.dask_address else "joblib")
     start = time.perf_counter()
     out = collect(args.out, args.episodes, seed=args.seed, workers=args.workers, action=args.action,
@@ -129,7 +216,10 @@ def add_export_parser(subparsers: argparse._SubParsersAction) -> argparse.Argume
 
 
 def run_export(args: argparse.Namespace) -> int:
-    """Run ``affordance export``."""
+    """Run ``affordance export``; a malformed id is refused first, before Minari is imported."""
+    from affordance_env.dataset.minari_export import check_dataset_id_form
+
+    check_dataset_id_form(args.minari)
     from affordance_env.dataset import read_manifest
     from affordance_env.dataset.minari_export import export_minari, left_out
 

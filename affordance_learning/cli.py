@@ -1,19 +1,57 @@
-"""The ``affordance`` command line."""
+"""The ``affordance`` command line.
+
+The arguments are parsed and checked before anything heavy (the simulator, the learning models) is imported, so
+that a command-line mistake is a one-line error at once, before any work starts and before anything is written.
+"""
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import sys
 import time
 import warnings
 from pathlib import Path
+from typing import NoReturn
 
-import numpy as np
+from affordance_env.collect_cli import (
+    add_collect_parser,
+    add_export_parser,
+    int_at_least,
+    non_negative_int,
+    positive_int,
+)
+
+#: The sizes of ``affordance plan`` (:class:`~affordance_learning.plan_experiment.PlanSettings`' defaults), for its
+#: help; an option not given keeps PlanSettings' own default.
+PLAN_DEFAULTS = {"episodes": 1000, "goals": 160, "multi_episodes": 40}
+#: What ``affordance plan`` writes into its ``--out``: its goal episodes in this directory, and its results
+#: (of this format), report and figures beside it.
+PLAN_DATASET, PLAN_RESULTS_FORMAT = "dataset", "tap-affordance-plan-results"
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line: what is wrong with which argument, and where the options are
+    listed."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {' '.join(message.split())} (see {self.prog} --help)\n")
+
+
+def _check_demo(args: argparse.Namespace) -> None:
+    from affordance_env.behaviors import get_behavior
+    from affordance_env.objects import check_object_type
+
+    get_behavior(args.behavior)
+    if args.object:
+        check_object_type(args.object)
 
 
 def _demo(args: argparse.Namespace) -> int:
+    _check_demo(args)
     import gymnasium as gym
+    import numpy as np
 
     import affordance_env  # noqa: F401  (registers the environment)
 
@@ -69,11 +107,12 @@ def _reproduce(args: argparse.Namespace) -> int:
 
 
 def _train_default(args: argparse.Namespace) -> int:
-    from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
     from affordance_learning.behaviors import check_behavior, check_env_offers
-    from affordance_learning.default_model import train_default_model, user_model_path
 
     behavior = check_behavior(args.behavior)
+    from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
+    from affordance_learning.default_model import train_default_model, user_model_path
+
     dataset = args.dataset or Path("default-taps" if behavior == "tap" else f"default-{behavior}")
     if (dataset / MANIFEST).exists():  # say so plainly, before the collection refuses its other settings
         found = read_manifest(dataset)["settings"]["env_options"].get("behavior", "tap")
@@ -105,11 +144,102 @@ def _fingerprint(args: argparse.Namespace) -> int:
     return 1 if drifted else 0
 
 
+def _compare(args: argparse.Namespace) -> int:
+    from affordance_learning.agreement import compare_results
+
+    found = [_results_of(where) for where in (args.reference, args.found)]
+    comparisons = compare_results(*found)
+    outside = [c for c in comparisons if not c.ok]
+    print(f"{args.found} against {args.reference}: {len(comparisons) - len(outside)} of {len(comparisons)} numbers "
+          "within their tolerances")
+    for comparison in comparisons:
+        print(f"  {comparison}")
+    return 1 if outside else 0
+
+
+def _results_of(where: Path) -> dict:
+    results = _read_json(where / "results.json" if where.is_dir() else where)
+    if not isinstance(results, dict) or "config" not in results:
+        raise ValueError(f"{where} holds no results.json of `affordance reproduce`.")
+    return results
+
+
+def _read_json(path: Path) -> object:
+    """The JSON value in ``path``; None if it cannot be read as JSON."""
+    try:
+        return json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, ValueError):
+        return None
+
+
+def _dataset_kind(manifest: object) -> str:
+    """What a dataset's manifest says the dataset holds, for a person."""
+    from affordance_env.dataset.format import FORMAT, MANIFEST
+
+    if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
+        return f"a {MANIFEST} that is not a TapAffordance dataset's"
+    settings = manifest.get("settings") if isinstance(manifest.get("settings"), dict) else {}
+    env_id = settings.get("env_id", "TapAffordance-v1")
+    options = settings.get("env_options") if isinstance(settings.get("env_options"), dict) else {}
+    what = f"{options.get('behavior', 'tap')} interactions" if env_id == "TapAffordance-v1" else "episodes"
+    return (f"a {env_id} dataset of {manifest.get('episodes', '?')} {what} with {settings.get('action', '?')} "
+            f"actions, seed {settings.get('seed', '?')}")
+
+
+def _check_plan_out(out: Path, seed: int) -> None:
+    """Refuse an ``--out`` of ``affordance plan`` that holds anything but an earlier plan's output (its dataset is
+    resumed, its results rewritten), before anything is written."""
+    if not out.exists():
+        return
+    if not out.is_dir():
+        raise ValueError(f"--out {out} is a file, not a directory.")
+    from affordance_env.dataset.format import GOAL_ENV_ID, MANIFEST
+
+    hint = (f"affordance plan writes its goal episodes into OUT/{PLAN_DATASET} and results.json, REPORT.md and "
+            "figures beside it: give a new or empty directory, or an earlier plan's to resume it")
+    if (out / MANIFEST).exists():
+        raise ValueError(f"--out {out} is a dataset directory ({_dataset_kind(_read_json(out / MANIFEST))}), not a "
+                         f"plan's: {hint}.")
+    own = False
+    dataset = out / PLAN_DATASET
+    if dataset.exists() and not dataset.is_dir():
+        raise ValueError(f"--out {out} holds a file {PLAN_DATASET}, not the plan's dataset directory: {hint}.")
+    if (dataset / MANIFEST).exists():
+        manifest = _read_json(dataset / MANIFEST)
+        settings = manifest.get("settings") if isinstance(manifest, dict) else None
+        if not (isinstance(settings, dict) and settings.get("env_id") == GOAL_ENV_ID
+                and settings.get("action") == "random"):
+            raise ValueError(f"{dataset} holds {_dataset_kind(manifest)}, not the plan's {GOAL_ENV_ID} episodes "
+                             f"with random actions: {hint}.")
+        if settings.get("seed") != seed:
+            raise ValueError(f"{dataset} holds the plan's episodes of seed {settings.get('seed')!r}, not of --seed "
+                             f"{seed}: give --seed {settings.get('seed')!r} to resume that plan, or another --out.")
+        own = True
+    elif dataset.is_dir() and any(p.name != ".lock" for p in dataset.iterdir()):
+        raise ValueError(f"{dataset} holds files but no {MANIFEST}, so it is not a dataset the plan can resume: "
+                         f"{hint}.")
+    results = out / "results.json"
+    if results.exists():
+        found = _read_json(results)
+        if not (isinstance(found, dict) and found.get("format") == PLAN_RESULTS_FORMAT):
+            what = f"of format {found.get('format')!r}" if isinstance(found, dict) else "that is not a plan's"
+            raise ValueError(f"--out {out} holds a results.json {what}, not a plan's ({PLAN_RESULTS_FORMAT}): "
+                             f"{hint}.")
+        own = True
+    others = sorted(p.name for p in out.iterdir() if not p.name.startswith(".") and p.name != PLAN_DATASET)
+    if others and not own:
+        listed = ", ".join(others[:3]) + (", ..." if len(others) > 3 else "")
+        raise ValueError(f"--out {out} is not empty ({listed}) and holds no earlier plan's results or dataset: "
+                         f"{hint}.")
+
+
 def _plan(args: argparse.Namespace) -> int:
+    _check_plan_out(args.out, args.seed)
     from affordance_learning.plan_experiment import PlanSettings, record_episode, run_plan
     from affordance_learning.plan_report import measured_targets, target_met, write_plan_figures, write_plan_report
 
-    settings = PlanSettings(episodes=args.episodes, goals=args.goals, multi_episodes=args.multi_episodes)
+    settings = PlanSettings(**{name: getattr(args, name) for name in PLAN_DEFAULTS
+                               if getattr(args, name) is not None})
     results = run_plan(args.out, seed=args.seed, workers=args.workers, settings=settings)
     frames = record_episode(args.out, results, seed=args.seed)
     write_plan_figures(results, args.out, frames)
@@ -121,15 +251,15 @@ def _plan(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from affordance_env.collect_cli import add_collect_parser, add_export_parser
+    """The parser of every subcommand; each value is checked as it is parsed (counts, seeds, shares, sizes)."""
     from affordance_learning import __version__
 
-    parser = argparse.ArgumentParser(prog="affordance", description=__doc__)
+    parser = _Parser(prog="affordance", description=__doc__)
     parser.add_argument("--version", action="version", version=f"%(prog)s (tap-affordance) {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     demo = sub.add_parser("demo", help="tap a few objects with the canonical tap and print what happened")
-    demo.add_argument("--episodes", type=int, default=8, help="number of interactions (default 8)")
-    demo.add_argument("--seed", type=int, default=0, help="seed of the first interaction (default 0)")
+    demo.add_argument("--episodes", type=positive_int, default=8, help="number of interactions (default 8)")
+    demo.add_argument("--seed", type=non_negative_int, default=0, help="seed of the first interaction (default 0)")
     demo.add_argument("--behavior", default="tap", help="tap | tap_back | push | grasp (default tap)")
     demo.add_argument("--object", default=None, help="only this object type (default: all four)")
     demo.set_defaults(func=_demo)
@@ -146,11 +276,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     reproduce.add_argument("--behavior", action="append", default=None, metavar="NAME",
                            help="run this behaviour; repeat for several (default: tap and grasp, the paper's)")
-    reproduce.add_argument("--episodes", type=int, default=1000,
-                           help="interactions per behaviour (default 1000)")
-    reproduce.add_argument("--trials", type=int, default=20, help="learning trials per setting (default 20)")
-    reproduce.add_argument("--seed", type=int, default=0, help="seed of the dataset and the trials (default 0)")
-    reproduce.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
+    reproduce.add_argument("--episodes", type=int_at_least(20), default=1000,
+                           help="interactions per behaviour, at least 20 for the protocol's splits (default 1000)")
+    reproduce.add_argument("--trials", type=positive_int, default=20, help="learning trials per setting (default 20)")
+    reproduce.add_argument("--seed", type=non_negative_int, default=0,
+                           help="seed of the dataset and the trials (default 0)")
+    reproduce.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
     reproduce.add_argument("--dataset", action="append", default=[], metavar="[BEHAVIOR=]PATH",
                            help="a behaviour's dataset directory, collected there or reused (default "
                            "OUT/BEHAVIOR/dataset); repeatable; a bare PATH when one behaviour runs")
@@ -166,16 +297,27 @@ def build_parser() -> argparse.ArgumentParser:
         description="For each reproduction directory (one behaviour's, holding results.json, e.g. "
         "docs/reproduction/tap), collect again the first 30 interactions that `affordance reproduce` collects for "
         "it (its behaviour, seed and range noise) and write their fingerprint.json (a SHA-256 per part of each "
-        "row), or with --check compare them with it bit for bit (exit status 1 if they differ). Rewrite the "
-        "fingerprints whenever the results are regenerated: affordance fingerprint docs/reproduction/*/",
+        "row, and the versions and CPU it was made with), or with --check compare them with it (exit status 1 if "
+        "they differ): bit for bit where the versions and the CPU are those it records, by the interactions' "
+        "outcome labels elsewhere; the first line says which check was made. Rewrite the fingerprints whenever "
+        "the results are regenerated: affordance fingerprint docs/reproduction/*/",
     )
     fingerprint.add_argument("reproduction", nargs="+", type=Path, metavar="DIR",
                              help="a behaviour's reproduction directory, e.g. docs/reproduction/tap")
     fingerprint.add_argument("--check", action="store_true", help="compare instead of writing")
-    fingerprint.add_argument("--workers", type=int, default=1, help="worker processes (default 1)")
+    fingerprint.add_argument("--workers", type=positive_int, default=1, help="worker processes (default 1)")
     fingerprint.set_defaults(func=_fingerprint)
 
-    from affordance_learning.plan_experiment import PlanSettings
+    compare = sub.add_parser(
+        "compare", help="set a reproduction's numbers beside a reference's, with the tolerances they must keep",
+        description="Compare two reproductions of one behaviour (directories holding results.json of `affordance "
+        "reproduce` with the same settings, e.g. docs/reproduction/tap and reproduction/tap): every uniformity, "
+        "SVM accuracy and the share of successes, each with the tolerance a reproduction keeps across machines and "
+        "versions (README, Reproducibility). Exit status 1 if a number lies outside its tolerance.",
+    )
+    compare.add_argument("reference", type=Path, metavar="REFERENCE", help="the reference, e.g. docs/reproduction/tap")
+    compare.add_argument("found", type=Path, metavar="DIR", help="the reproduction to check, e.g. reproduction/tap")
+    compare.set_defaults(func=_compare)
 
     plan = sub.add_parser(
         "plan", help="learn what each behaviour does to objects, then choose behaviours to reach goals, against "
@@ -185,15 +327,17 @@ def build_parser() -> argparse.ArgumentParser:
         "leaving each shape out, multi-step episodes) against random, fixed, canonical, the paper's categories and "
         "an oracle that tries actions in simulation. Writes OUT/results.json, OUT/REPORT.md and figures.",
     )
-    plan.add_argument("--out", type=Path, required=True, help="output directory (its dataset is resumed)")
-    plan.add_argument("--seed", type=int, default=0, help="seed of the data and of the evaluation (default 0)")
-    plan.add_argument("--workers", type=int, default=2, help="worker processes (default 2)")
-    plan.add_argument("--episodes", type=int, default=PlanSettings.episodes,
-                      help=f"goal episodes collected for training (default {PlanSettings.episodes})")
-    plan.add_argument("--goals", type=int, default=PlanSettings.goals,
-                      help=f"held-out objects of the single-step evaluation (default {PlanSettings.goals})")
-    plan.add_argument("--multi-episodes", type=int, default=PlanSettings.multi_episodes,
-                      help=f"multi-step episodes per policy (default {PlanSettings.multi_episodes})")
+    plan.add_argument("--out", type=Path, required=True,
+                      help="output directory: new, empty or an earlier plan's (whose dataset is resumed)")
+    plan.add_argument("--seed", type=non_negative_int, default=0,
+                      help="seed of the data and of the evaluation (default 0)")
+    plan.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
+    plan.add_argument("--episodes", type=positive_int, default=None,
+                      help=f"goal episodes collected for training (default {PLAN_DEFAULTS['episodes']})")
+    plan.add_argument("--goals", type=positive_int, default=None,
+                      help=f"held-out objects of the single-step evaluation (default {PLAN_DEFAULTS['goals']})")
+    plan.add_argument("--multi-episodes", type=positive_int, default=None,
+                      help=f"multi-step episodes per policy (default {PLAN_DEFAULTS['multi_episodes']})")
     plan.set_defaults(func=_plan)
 
     train = sub.add_parser("train-default", help="rebuild a behaviour's default model behind predict_effect")
@@ -202,7 +346,7 @@ def build_parser() -> argparse.ArgumentParser:
     train.add_argument("--dataset", type=Path, default=None,
                        help="where the behaviour's 1000 canonical interactions (seed 0) are collected, or reused "
                        "(default ./default-taps for the tap, ./default-BEHAVIOR otherwise)")
-    train.add_argument("--workers", type=int, default=2)
+    train.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
     train.add_argument("--out", type=Path, default=None,
                        help="model file (default: BEHAVIOR_model.joblib in the user's data directory, "
                        "$TAP_AFFORDANCE_DATA or ~/.local/share/tap-affordance, where predict_effect finds it)")
@@ -225,9 +369,11 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``affordance`` console script.
 
     A user error (a bad option, a path that cannot be used or written, a dataset that cannot be read or
-    extended, a missing optional package) is one line on stderr and exit status 2; Ctrl-C is one line and
-    status 130, and what was finished is kept (a dataset's chunks: the same command resumes it). Anything else
-    is a bug and keeps its traceback.
+    extended, a missing optional package) is one line on stderr and exit status 2; a command-line mistake is
+    found before any work starts (a value that cannot be used at all raises SystemExit(2) as it is parsed, the
+    others are checked before the subcommand imports what it runs). Ctrl-C is one line and status 130, and what
+    was finished is kept (a dataset's chunks: the same command resumes it). Anything else is a bug and keeps its
+    traceback.
     """
     args = build_parser().parse_args(argv)
     # joblib's resource tracker, a process of its own that inherits this environment, lists on Ctrl-C the

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+import re
 import shutil
 import tempfile
 import warnings
@@ -45,7 +46,14 @@ from affordance_env.features import FEATURE_NAMES
 #: Data formats Minari writes.
 DATA_FORMATS = ("arrow", "hdf5")
 #: The form of a Minari dataset id that this export accepts (Minari's own, with the version required).
-ID_FORM = "(namespace/)name-v(version), e.g. tap-affordance/canonical-taps-v0"
+ID_FORM = ("(namespace/)name-v(version), e.g. tap-affordance/canonical-taps-v0: an optional namespace of at least "
+           "2 characters, then a name, each of letters, digits, '_' and '-' (a namespace may have '/' between its "
+           "parts), then -v and the version's digits")
+#: Minari's rules for the parts of an id (``minari.dataset.minari_dataset.DATASET_ID_RE``): the namespace, before
+#: the last "/", at least 2 characters, neither first nor last a "/"; the name; the version, "-v" and digits.
+_NAMESPACE_RE = re.compile(r"[-_\w][-_\w/]*[-_\w]+")
+_PART_CHARACTER_RE = re.compile(r"[-_\w]")
+_VERSIONED_RE = re.compile(r"(?P<name>.*)-v(?P<version>\d+)", re.DOTALL)
 
 
 def _minari():
@@ -59,14 +67,64 @@ def _minari():
     return minari, EpisodeBuffer
 
 
+def _not_allowed(part: str, also: str = "") -> str:
+    """The characters of ``part`` that Minari does not allow in it (besides those of ``also``), quoted."""
+    found = dict.fromkeys(c for c in part if c not in also and not _PART_CHARACTER_RE.fullmatch(c))
+    return ", ".join(repr(c) for c in found)
+
+
+def dataset_id_problem(dataset_id: object) -> str | None:
+    """What makes ``dataset_id`` other than a Minari dataset id with a version, naming the part it is in, for a
+    person; None for an id of that form (Minari's rule, which this follows part by part, is the authority:
+    :func:`check_dataset_id`)."""
+    if not isinstance(dataset_id, str):
+        return f"it is a {type(dataset_id).__name__}, not a string"
+    if not dataset_id:
+        return "it is empty"
+    namespace, slash, rest = dataset_id.rpartition("/")
+    if slash:
+        if not namespace:
+            return "it starts with '/', with no namespace before it"
+        if bad := _not_allowed(namespace, also="/"):
+            return f"its namespace {namespace!r} has {bad}, which it may not"
+        if namespace.startswith("/"):
+            return f"its namespace {namespace!r} starts with '/'"
+        if namespace.endswith("/"):
+            return "'//' before the name: a single '/' separates the namespace from the name"
+        if not _NAMESPACE_RE.fullmatch(namespace):  # what remains: a single character
+            return f"its namespace {namespace!r} is a single character, Minari's have at least 2"
+    if not rest:
+        return "nothing follows the last '/': the name and the version are missing"
+    versioned = _VERSIONED_RE.fullmatch(rest)
+    if versioned is None:
+        return f"{rest!r} does not end in a version, -v and digits (e.g. -v0)"
+    name = versioned["name"]
+    if not name:
+        return f"it has no name before -v{versioned['version']}"
+    if bad := _not_allowed(name):
+        return f"its name {name!r} has {bad}, which it may not"
+    return None
+
+
+def check_dataset_id_form(dataset_id: str) -> None:
+    """ValueError naming ``dataset_id``, the form expected and what breaks it, unless it is a Minari dataset id
+    with a version; Minari need not be installed."""
+    problem = dataset_id_problem(dataset_id)
+    if problem is not None:
+        raise ValueError(f"Minari dataset id {dataset_id!r} is malformed: expected {ID_FORM}; {problem}.")
+
+
 def check_dataset_id(dataset_id: str) -> tuple[str | None, str, int]:
-    """``(namespace, name, version)`` of a Minari dataset id; ValueError naming it and the expected form when it
-    is malformed or has no version (Minari itself would fail midway, after creating directories)."""
+    """``(namespace, name, version)`` of a Minari dataset id; ValueError naming it, the expected form and what
+    breaks it when it is malformed or has no version (Minari itself would fail midway, after creating
+    directories)."""
     from minari.dataset.minari_dataset import DATASET_ID_RE, parse_dataset_id
 
-    match = DATASET_ID_RE.fullmatch(dataset_id) if isinstance(dataset_id, str) else None
-    if match is None or match.group("version") is None:
-        raise ValueError(f"Minari dataset id {dataset_id!r} is malformed: expected {ID_FORM}.")
+    check_dataset_id_form(dataset_id)
+    match = DATASET_ID_RE.fullmatch(dataset_id)
+    if match is None or match.group("version") is None:  # the installed Minari has rules of its own
+        raise ValueError(f"Minari dataset id {dataset_id!r} is malformed: expected {ID_FORM}; the installed "
+                         "Minari refuses it.")
     return parse_dataset_id(dataset_id)
 
 
