@@ -14,6 +14,7 @@
   :class:`Planner` (``affordance plan`` measures them against baselines, :mod:`.plan_experiment`).
 """
 
+import importlib
 import importlib.metadata as _metadata
 
 try:  # the version has one source, the package's metadata (pyproject.toml)
@@ -21,23 +22,24 @@ try:  # the version has one source, the package's metadata (pyproject.toml)
 except _metadata.PackageNotFoundError:  # a source tree that was never installed
     __version__ = "0+unknown"
 
-from affordance_learning.default_model import (  # noqa: E402 (after __version__, which it reads)
-    DefaultModelError,
-    DefaultModelMissingError,
-    load_default_model,
-    predict_effect,
-    train_default_model,
-)
-from affordance_learning.effect_model import ActionEffectModel
-from affordance_learning.goals import Lift, Move, Percept, Place, Roll, goal_from_dict
-from affordance_learning.metrics import adjusted_rand, cluster_purity, svm_cv_accuracy, uniformity
-from affordance_learning.model import AffordanceModel, EffectPrediction, select_features
-from affordance_learning.planner import Planner
-from affordance_learning.relieff import ReliefF, ReliefFScorer, relieff_weights
-from affordance_learning.som import SOMClustering
 
-#: Names loaded on first use, so that ``import affordance_learning`` stays light (no matplotlib).
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})
+
+#: The public names, each loaded from its module on first use: ``import affordance_learning`` (and so the
+#: ``affordance`` command, which checks its arguments before any work) stays light, with no scikit-learn, SciPy,
+#: pandas or matplotlib until a name is used.
 _LAZY = {
+    **dict.fromkeys(("DefaultModelError", "DefaultModelMissingError", "load_default_model", "predict_effect",
+                     "train_default_model"), "affordance_learning.default_model"),
+    "ActionEffectModel": "affordance_learning.effect_model",
+    **dict.fromkeys(("Lift", "Move", "Percept", "Place", "Roll", "goal_from_dict"), "affordance_learning.goals"),
+    **dict.fromkeys(("adjusted_rand", "cluster_purity", "svm_cv_accuracy", "uniformity"),
+                    "affordance_learning.metrics"),
+    **dict.fromkeys(("AffordanceModel", "EffectPrediction", "select_features"), "affordance_learning.model"),
+    "Planner": "affordance_learning.planner",
+    **dict.fromkeys(("ReliefF", "ReliefFScorer", "relieff_weights"), "affordance_learning.relieff"),
+    "SOMClustering": "affordance_learning.som",
     "make_synthetic_frame": "affordance_learning.synthetic",
     "run_protocol": "affordance_learning.protocol",
     "write_figures": "affordance_learning.figures",
@@ -47,9 +49,9 @@ _LAZY = {
 
 def __getattr__(name: str) -> object:
     if name in _LAZY:
-        import importlib
-
-        return getattr(importlib.import_module(_LAZY[name]), name)
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value  # found directly from now on
+        return value
     raise AttributeError(f"module 'affordance_learning' has no attribute {name!r}")
 
 

@@ -182,3 +182,20 @@ def test_only_reproductions_of_the_same_experiment_are_compared():
     other["config"]["seed"] = 1
     with pytest.raises(ValueError, match="seed 1 \\(reference 0\\)"):
         compare_results(_results(), other)
+
+
+def test_compare_command_sets_numbers_beside_the_reference(tmp_path, capsys):
+    from affordance_learning.cli import main
+
+    reference = ROOT / "docs" / "reproduction" / "tap"
+    assert main(["compare", str(reference), str(reference)]) == 0
+    out = capsys.readouterr().out
+    assert "55 of 55 numbers within their tolerances" in out and "uniformity at k = 8" in out
+    moved = json.loads((reference / "results.json").read_text())
+    moved["uniformity"]["8"]["mean"] -= 0.2
+    (tmp_path / "results.json").write_text(json.dumps(moved))
+    assert main(["compare", str(reference), str(tmp_path)]) == 1
+    assert "uniformity at k = 8" in capsys.readouterr().out.split("outside")[0].splitlines()[-1]
+    assert main(["compare", str(reference), str(tmp_path / "nothing")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "holds no results.json" in err
