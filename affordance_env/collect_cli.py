@@ -67,7 +67,9 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
                     "the same command resumes an interrupted collection, or extends it with a larger "
                     "--episodes; other settings on an existing dataset are refused.",
     )
-    parser.add_argument("--episodes", type=positive_int, required=True, help="number of interactions")
+    parser.add_argument("--episodes", type=positive_int, required=True,
+                        help="how many to collect: interactions of TapAffordance-v1, episodes (of several "
+                        "interactions each) of TapAffordanceGoal-v0")
     parser.add_argument("--out", type=Path, required=True, help="dataset directory (resumed if it exists)")
     parser.add_argument("--seed", type=non_negative_int, default=0, help="dataset seed (default 0)")
     parser.add_argument("--workers", type=positive_int, default=1,
