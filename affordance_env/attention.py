@@ -22,8 +22,11 @@ GAZE_JOINTS = ("neck_pitch", "neck_yaw")
 #: Where the head looks for an object it does not see: (pitch, yaw) offsets [rad] from its current gaze, nearest
 #: first, each clipped to the neck's range. The eye camera sees +-37 degrees across and +-29 up and down (57.4
 #: degrees vertical field of view at 4:3), so yaw steps of 0.5 rad (29 degrees) and a pitch step of 0.15 rad
-#: overlap the view they leave and cover the table beside and in front of the robot.
-SEARCH_GAZES = ((0.0, 0.5), (0.0, -0.5), (-0.15, 0.5), (-0.15, -0.5), (-0.15, 0.0), (0.0, 0.9), (0.0, -0.9))
+#: overlap the view they leave and cover the table beside and in front of the robot; the last three look up
+#: (positive pitch), over the far part of the table, where an object pushed away from a gaze that looks down at
+#: the near part lies above the view of every other gaze.
+SEARCH_GAZES = ((0.0, 0.5), (0.0, -0.5), (-0.15, 0.5), (-0.15, -0.5), (-0.15, 0.0), (0.0, 0.9), (0.0, -0.9),
+                (0.3, 0.0), (0.3, 0.5), (0.3, -0.5))
 
 
 def _gaze_indices(physics: TapPhysics) -> np.ndarray:

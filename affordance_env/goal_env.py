@@ -87,7 +87,10 @@ class TapAffordanceGoalEnv(gym.Env):
     After ``reset``: ``object``, ``visible``, ``attention``, ``still`` as TapAffordance-v1, and ``distance``.
     After ``step``: every key of TapAffordance-v1's step info for the interaction (``effect``, ``object`` with
     ``initial_pose`` and ``final_pose``, ``displacement``, ``success``, ``failure``, ...), and ``behavior``,
-    ``distance`` [m] to the goal and ``is_success``.
+    ``distance`` [m] to the goal and ``is_success``; ``attention`` (the head turning to the object again, as after
+    ``reset``; None when the episode ended without looking) and ``observation_visible``: whether the returned
+    observation sees the object, as ``visible`` after ``reset``. Where it does not (the object lies hidden behind an
+    arm, or out of every view of the head), the next interaction would fail with ``"perception: ..."``.
 
     ## Arguments
     ``object_types``, ``size_range``, ``camera_width``, ``camera_height``, ``camera_fovy``, ``roll_threshold``,
@@ -277,13 +280,15 @@ class TapAffordanceGoalEnv(gym.Env):
         inner_obs, _, _, _, info = arm.step(params)
         fault = info["outcome"] == "fault"
         off_table = info["outcome"] == "off_table"
+        seen = {"visible": False, "attention": None}
         if fault or off_table:  # nothing more to see: the episode ends on the interaction's final observation
             obs = self._observation(inner_obs, False)
         else:  # the head turns to the object where it rests, for the next interaction
             inner_obs, seen = arm.observe()
             obs = self._observation(inner_obs, seen["visible"])
         distance = float(goal_distance(obs["achieved_goal"], self._goal))
-        info.update(behavior=name, distance=distance, is_success=bool(distance <= self.goal_tolerance))
+        info.update(behavior=name, distance=distance, is_success=bool(distance <= self.goal_tolerance),
+                    observation_visible=bool(seen["visible"]), attention=seen["attention"])
         reward = self.compute_reward(obs["achieved_goal"], self._goal, info)
         terminated = bool(info["is_success"] or off_table or fault)
         self._obs = None if terminated else obs

@@ -7,7 +7,7 @@ import pytest
 
 from affordance_env import load_dataset
 from affordance_env.dataset import collect, read_manifest
-from affordance_env.dataset.format import GOAL_COLUMNS, collect_command
+from affordance_env.dataset.format import GOAL_COLUMNS, chunk_metadata, collect_command
 from affordance_env.goal_env import BEHAVIORS
 from affordance_env.workspace import in_any_workspace
 
@@ -32,18 +32,25 @@ def test_goal_episodes_are_rows_of_interactions_with_episode_step_and_goal(goal_
     assert "--env TapAffordanceGoal-v0" in command and "--position-range workspace" in command
     assert {"step", *GOAL_COLUMNS} <= set(frame.columns)
     assert set(frame["behavior"]) <= set(BEHAVIORS) and frame["behavior"].nunique() >= 3
+    truncated = {k: v for chunk in sorted(goal_dir.glob("chunk-*.parquet"))
+                 for k, v in chunk_metadata(chunk)[0]["chunk"]["truncated"].items()}
+    assert all(reason.startswith(("infeasible:", "lost:")) for reason in truncated.values())
+    assert not set(truncated) & {str(e) for e in frame.attrs["failures"]}  # cut short is not failed
     for episode, rows in frame.groupby("episode"):
         steps = rows["step"].to_numpy()
         np.testing.assert_array_equal(steps, np.arange(len(steps)))  # from 0, none missing
         assert rows[["goal_x", "goal_y"]].nunique().max() == 1  # one goal per episode
         # the object stays: each interaction starts where the one before it left the object, at rest (the head
-        # turning to it again moves it by less than a micrometre)
+        # turning to it again moves it by less than 0.1 mm: the contacts of an object at rest still creep by
+        # micrometres)
         for axis in ("x", "y"):
             np.testing.assert_allclose(rows[f"true_initial_{axis}"].to_numpy()[1:],
-                                       rows[f"true_final_{axis}"].to_numpy()[:-1], atol=1e-6)
+                                       rows[f"true_final_{axis}"].to_numpy()[:-1], atol=1e-4)
         ended = rows.iloc[-1]
         failed = episode in frame.attrs["failures"]
-        assert failed or len(rows) == 5 or ended["goal_reached"] or ended["outcome"] == "off_table"
+        cut_short = str(episode) in truncated  # no feasible action drawn, or the object not seen
+        assert failed or cut_short or len(rows) == 5 or ended["goal_reached"] or ended["outcome"] == "off_table"
+        assert rows["visible_initial"].all()  # an interaction starts only from an observation that sees the object
     first = frame[frame["step"] == 0]
     assert np.all(in_any_workspace(first[["true_initial_x", "true_initial_y"]].to_numpy()))
     np.testing.assert_allclose(frame["goal_distance"], np.hypot(frame["achieved_x"] - frame["goal_x"],

@@ -8,7 +8,9 @@ crash or ``kill -9`` leaves only whole chunks, and the same command collects jus
 An interaction that the environment marks as failed (``info["failure"]``: an unreachable stroke, a missed tap,
 a physics fault) is not written; its episode and reason go to the chunk's metadata and the manifest. Anything
 else that goes wrong (an exception from ``reset`` or ``step``, a record with non-finite numbers) is a bug: it
-stops the collection with its traceback, and the chunks already written stay. When more than
+stops the collection with its traceback, and the chunks already written stay. A goal episode never runs an action
+that ``feasible`` refuses: where no feasible action is drawn, or the head does not see the object, the episode
+ends there, truncated (its reason in the chunk's metadata), and is no failure. When more than
 ``max_failure_share`` of the interactions collected so far have failed, the collection stops with
 :class:`FailureShareError`, which lists the reasons: rerun with a larger share to accept them.
 """
@@ -17,6 +19,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import itertools
 import json
 import os
 import signal
@@ -76,7 +79,12 @@ def interaction_action(seed: int, episode: int, action: str) -> np.ndarray:
 
 
 #: A goal episode's action is drawn again, up to this many times, until the arm can reach it (``feasible``).
-GOAL_ACTION_DRAWS = 20
+GOAL_ACTION_DRAWS = 50
+#: How goal episodes are collected, recorded in the settings of every goal dataset (a dataset collected otherwise
+#: is not resumed with it): only feasible actions are run; an episode ends where none is drawn or the head does
+#: not see the object.
+GOAL_EPISODE_RULE = (f"feasible actions only, {GOAL_ACTION_DRAWS} draws per step; truncated where none is or the "
+                     "object is not seen")
 
 
 def goal_episode_actions(seed: int, episode: int, action: str) -> Iterator[dict[str, Any]]:
@@ -111,30 +119,38 @@ def _worker_env(options_json: str, env_id: str = ENV_IDS[0]):
     return envs[key]
 
 
-def _goal_episode_rows(env, settings: dict, episode: int) -> tuple[list[dict], str | None]:
-    """The rows of goal episode ``episode`` (one per interaction, until the episode ends or its first failed
-    interaction) and the reason of that failure, or None."""
+def _goal_episode_rows(env, settings: dict, episode: int) -> tuple[list[dict], str | None, str | None]:
+    """The rows of goal episode ``episode`` (one per interaction, until the episode ends), the reason of its failed
+    interaction (the last one run, left out), or None, and why the episode was cut short (truncated), or None.
+
+    Only actions that ``env.feasible`` accepts are run: at each step up to ``GOAL_ACTION_DRAWS`` are drawn, the
+    first feasible one is run, and an episode where none is ends before that step (``"infeasible: ..."``). An
+    episode whose object the head does not see ends there too (``"lost: ..."``): its next interaction would fail."""
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
 
     env_seed = interaction_seed(settings["seed"], episode)
     before = env.reset(seed=env_seed)
-    rows = []
+    rows: list[dict] = []
     actions = goal_episode_actions(settings["seed"], episode, settings["action"])
     for step in range(GOAL_MAX_EPISODE_STEPS):
-        for _ in range(GOAL_ACTION_DRAWS):  # an action the arm can reach, if one of these draws is
-            action = next(actions)
-            if env.feasible(action["behavior"], action["params"]):
-                break
+        if not before[1]["visible"]:  # hidden behind an arm, or out of every view of the head
+            return rows, None, f"lost: the head did not find the object for step {step}"
+        action = next((a for a in itertools.islice(actions, GOAL_ACTION_DRAWS)
+                       if env.feasible(a["behavior"], a["params"])), None)
+        if action is None:
+            return rows, None, (f"infeasible: none of {GOAL_ACTION_DRAWS} actions drawn for step {step} is "
+                                "feasible")
         after = env.step(action)
         row = interaction_row(episode, env_seed, action["params"], before, after, settings["save_images"],
                               goal_step=step)
         if isinstance(row, str):
-            return rows, f"{row} (at step {step})"
+            return rows, f"{row} (at step {step})", None
         rows.append(row)
         if after[2]:  # terminated: the goal reached, or the object left the table
             break
-        before = (after[0], after[4])
-    return rows, None
+        # the next interaction starts from the observation the head took after this one
+        before = (after[0], {**after[4], "visible": after[4]["observation_visible"]})
+    return rows, None, None
 
 
 def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict
@@ -152,13 +168,16 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict
     schema = arrow_schema(settings["save_images"], goal=goal)
     columns: dict[str, list] = {name: [] for name in schema.names}
     failures: dict[str, str] = {}
+    truncated: dict[str, str] = {}  # goal episodes cut short, and why
     for episode in range(start, stop):
         # an env that cannot be built stops the run: not a failed interaction
         env = _worker_env(options_json, settings.get("env_id", ENV_IDS[0]))
         if goal:
-            rows, failure = _goal_episode_rows(env, settings, episode)
+            rows, failure, truncation = _goal_episode_rows(env, settings, episode)
             if failure is not None:
                 failures[str(episode)] = failure
+            if truncation is not None:
+                truncated[str(episode)] = truncation
             for row in rows:
                 for name in schema.names:
                     columns[name].append(row[name])
@@ -176,8 +195,10 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict
         for name in schema.names:
             columns[name].append(row[name])
     n_rows = len(columns["episode"])
-    meta = {**header, "chunk": {"index": index, "start": start, "stop": stop, "failures": failures,
-                                "rows": n_rows}}
+    chunk = {"index": index, "start": start, "stop": stop, "failures": failures, "rows": n_rows}
+    if goal:
+        chunk["truncated"] = truncated
+    meta = {**header, "chunk": chunk}
     table = pa.Table.from_pydict(columns, schema=schema.with_metadata({METADATA_KEY: json.dumps(meta)}))
     # zstd for the images (small); snappy for the numbers: zstd saves little there and reads twice as slowly
     codecs = {name: "zstd" if name in IMAGE_COLUMNS else "snappy" for name in schema.names}
@@ -266,8 +287,14 @@ def collect(
         env_id: ``"TapAffordance-v1"`` (one interaction per episode, a row each) or ``"TapAffordanceGoal-v0"``:
             goal episodes of up to 5 interactions (``GOAL_MAX_EPISODE_STEPS``), each a behaviour drawn uniformly
             with its parameters by ``action``, drawn again (up to ``GOAL_ACTION_DRAWS`` times) until the arm can
-            reach it (``feasible``), one row per interaction with its ``step`` and the goal columns;
-            an episode is recorded up to its first failed interaction (left out; the episode counts as failed).
+            reach it (``feasible``), one row per interaction with its ``step`` and the goal columns. An action that
+            ``feasible`` refuses is never run: a step for which none of the draws is feasible ends the episode
+            before it, as does an object the head does not see (hidden behind an arm, or out of every view of the
+            head), whose interaction would fail. Such an episode keeps its rows and counts as truncated, not failed:
+            the chunk's metadata records why (``"truncated"``: episode -> ``"infeasible: ..."`` or ``"lost: ..."``).
+            An episode is recorded up to its first failed interaction (left out; the episode counts as failed).
+            The rule is part of the dataset's settings (``goal_episodes``): a dataset collected otherwise is not
+            resumed with it.
 
     Returns:
         The dataset directory.
@@ -292,6 +319,8 @@ def collect(
     if scheduler == "joblib" and workers == 1:
         _worker_env(options_json, env_id)  # this process collects: build its env now, before any work
     header = dataset_header(seed, action, chunk_size, options, save_images, env_id)
+    if env_id == GOAL_ENV_ID:
+        header["settings"]["goal_episodes"] = GOAL_EPISODE_RULE
     out, episodes = Path(out), int(episodes)
 
     stored: dict = {}
