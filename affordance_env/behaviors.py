@@ -57,6 +57,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import matmul
 from affordance_env.objects import ObjectGeometry
 from affordance_env.robot_model import HAND_OPEN
@@ -133,7 +134,7 @@ class Behavior:
 
     def __post_init__(self) -> None:
         if self.success_rule not in SUCCESS_RULES:
-            raise ValueError(f"success_rule must be one of {SUCCESS_RULES}, got {self.success_rule!r}.")
+            raise InvalidValueError(f"success_rule must be one of {SUCCESS_RULES}, got {self.success_rule!r}.")
 
 
 @dataclass(frozen=True)
@@ -213,14 +214,14 @@ def is_success(rule: str, rolled: bool | np.ndarray, displacement: float | np.nd
     elif rule == "moved":
         label = np.asarray(displacement, dtype=np.float64) > threshold
     else:
-        raise ValueError(f"rule must be one of {SUCCESS_RULES}, got {rule!r}.")
+        raise InvalidValueError(f"rule must be one of {SUCCESS_RULES}, got {rule!r}.")
     return bool(label) if label.ndim == 0 else label
 
 
 def get_behavior(name: str) -> Behavior | GraspBehavior:
     """The behaviour called ``name``; raises ValueError listing the valid names."""
     if name not in BEHAVIORS:
-        raise ValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
+        raise InvalidValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
     return BEHAVIORS[name]
 
 
@@ -254,11 +255,11 @@ def check_action(action: np.ndarray) -> np.ndarray:
     """Return ``action`` as a float64 (3,) array, or raise ValueError naming the problem."""
     a = np.asarray(action, dtype=np.float64)
     if a.shape != (ACTION_DIM,):
-        raise ValueError(f"action must have shape ({ACTION_DIM},), got shape {a.shape}: {action!r}.")
+        raise InvalidValueError(f"action must have shape ({ACTION_DIM},), got shape {a.shape}: {action!r}.")
     if not np.all(np.isfinite(a)):
-        raise ValueError(f"action must be finite, got {action!r}.")
+        raise InvalidValueError(f"action must be finite, got {action!r}.")
     if np.any(np.abs(a) > 1.0 + 1e-6):
-        raise ValueError(f"action must lie in [-1, 1] in every dimension, got {action!r}.")
+        raise InvalidValueError(f"action must lie in [-1, 1] in every dimension, got {action!r}.")
     return np.clip(a, -1.0, 1.0)
 
 
@@ -411,7 +412,7 @@ def plan_grasp(
     R = grasp_orientation(yaw)
     top = float(p_world_object[2]) + geometry.half_height
     if top <= table_top:
-        raise ValueError(f"the object's top ({top:.3f} m) must be above the table top ({table_top:.3f} m).")
+        raise InvalidValueError(f"the object's top ({top:.3f} m) must be above the table top ({table_top:.3f} m).")
     centre_hand = np.array([GRASP_CENTRE_HAND[0], GRASP_CENTRE_HAND[1] + a[1] * GRASP_LATERAL_RANGE, 0.0])
     p_grasp = np.array([p_world_object[0], p_world_object[1], 0.0]) - matmul(R, centre_hand)
     p_grasp[2] = top + GRASP_GAP + a[0] * GRASP_HEIGHT_RANGE

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import matmul, norm
 from affordance_env.pinhole import Intrinsics
 
@@ -125,16 +126,16 @@ class RangeCamera:
         camera_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
         if camera_id < 0:
             names = [model.camera(i).name for i in range(model.ncam)]
-            raise ValueError(f"Camera {camera!r} does not exist in the model. Available cameras: {names}")
+            raise InvalidValueError(f"Camera {camera!r} does not exist in the model. Available cameras: {names}")
         if not max_range > 0:
-            raise ValueError(f"max_range must be positive [m], got {max_range!r}.")
+            raise InvalidValueError(f"max_range must be positive [m], got {max_range!r}.")
         self.model = model
         self.camera_id = camera_id
         fovy = model.cam_fovy[camera_id] if fovy_deg is None else fovy_deg
         self.intrinsics = Intrinsics.from_fovy(width, height, fovy)
         self.max_range = float(max_range)
         if any(g not in range(6) for g in geom_groups):
-            raise ValueError(f"geom_groups must be within 0..5, got {geom_groups!r}.")
+            raise InvalidValueError(f"geom_groups must be within 0..5, got {geom_groups!r}.")
         self._world_group = np.array([g == 0 and g in geom_groups for g in range(6)], dtype=np.uint8)
         self._bounded_group = np.array([g != 0 and g in geom_groups for g in range(6)], dtype=np.uint8)
         #: Geoms of the bounded pass (read once: set_object changes only the object's geoms, in group 0 or 3).
@@ -156,20 +157,22 @@ class RangeCamera:
         model = self.model
         geom = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, name)
         if geom < 0:
-            raise ValueError(f"support: the model has no geom named {name!r}.")
+            raise InvalidValueError(f"support: the model has no geom named {name!r}.")
         data = mujoco.MjData(model)
         mujoco.mj_kinematics(model, data)
         R = data.geom_xmat[geom].reshape(3, 3)
         if (model.geom_type[geom] != mujoco.mjtGeom.mjGEOM_BOX or model.geom_group[geom] != 0
                 or model.body_weldid[model.geom_bodyid[geom]] != 0 or not np.allclose(R, np.eye(3), atol=1e-12)):
-            raise ValueError(f"support: geom {name!r} must be a box of group 0, fixed to the world and aligned with "
+            raise InvalidValueError(
+                f"support: geom {name!r} must be a box of group 0, fixed to the world and aligned with "
                              "its axes.")
         centre, half = data.geom_xpos[geom], model.geom_size[geom]
         top = float(centre[2] + half[2])
         planes = np.flatnonzero((model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE) & (model.geom_group == 0))
         for plane in planes:  # a plane of the world may never end a ray before the face does
             if data.geom_xpos[plane, 2] >= top or not np.allclose(data.geom_xmat[plane, 8], 1.0):
-                raise ValueError(f"support: the plane {model.geom(plane).name!r} is not below the face of {name!r}.")
+                raise InvalidValueError(
+                    f"support: the plane {model.geom(plane).name!r} is not below the face of {name!r}.")
         return int(geom), top, centre[:2] - half[:2], centre[:2] + half[:2]
 
     def _cast(self, data: mujoco.MjData, p_world_camera: np.ndarray, d_world: np.ndarray, rays: np.ndarray,
@@ -309,7 +312,7 @@ class RangeCamera:
         self._geom_ids[:] = -1
         if window:
             if occluded is None:
-                raise ValueError("window=True casts only where the occluded geoms may be seen: give occluded.")
+                raise InvalidValueError("window=True casts only where the occluded geoms may be seen: give occluded.")
             rays = self._rays_near(np.atleast_1d(occluded), data, p_world_camera, R_world_camera)
             if rays.size and self._world_group.any():
                 ray_normal = np.empty(3 * rays.size) if normals else None

@@ -9,6 +9,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from affordance_env.exceptions import InvalidValueError
+
 #: Command-line flags that are env options, and the env keyword each one sets.
 _ENV_FLAGS = ("behavior", "object_types", "size_range", "camera_width", "camera_height", "camera_fovy",
               "roll_threshold", "settle_timeout", "range_noise", "position_range")
@@ -143,12 +145,12 @@ def check_collect_args(args: argparse.Namespace) -> None:
     from affordance_env.registration import GOAL_ENV_ID
 
     if args.scheduler == "joblib" and args.dask_address is not None:
-        raise ValueError("--dask-address runs on Dask: drop --scheduler joblib (or use --scheduler dask).")
+        raise InvalidValueError("--dask-address runs on Dask: drop --scheduler joblib (or use --scheduler dask).")
     if args.size_range is not None and args.size_range[0] > args.size_range[1]:
         low, high = args.size_range
-        raise ValueError(f"--size-range {low:g} {high:g}: expected LOW <= HIGH (equal for a single size).")
+        raise InvalidValueError(f"--size-range {low:g} {high:g}: expected LOW <= HIGH (equal for a single size).")
     if args.env_id == GOAL_ENV_ID and args.behavior is not None:
-        raise ValueError(f"--env {GOAL_ENV_ID} chooses among all four behaviours at every step: drop --behavior "
+        raise InvalidValueError(f"--env {GOAL_ENV_ID} chooses among all four behaviours at every step: drop --behavior "
                          f"{args.behavior}.")
     try:
         EnvOptions.checked(**env_options_from_args(args))
@@ -157,15 +159,15 @@ def check_collect_args(args: argparse.Namespace) -> None:
         message = str(exc)
         for name, flag in flags.items():  # name the options as they were given
             message = message.replace(f"{name} must", f"{flag} must")
-        raise ValueError(message) from None
+        raise InvalidValueError(message) from None
     out = Path(args.out)
     if out.exists() and not out.is_dir():
-        raise ValueError(f"--out {out} is a file, not a dataset directory.")
+        raise InvalidValueError(f"--out {out} is a file, not a dataset directory.")
     if out.is_dir():
         from affordance_env.dataset.format import MANIFEST
 
         if not (out / MANIFEST).exists() and any(p.name != ".lock" for p in out.iterdir()):
-            raise ValueError(f"--out {out} exists and is not a TapAffordance dataset (no {MANIFEST}): choose an "
+            raise InvalidValueError(f"--out {out} exists and is not a TapAffordance dataset (no {MANIFEST}): choose an "
                              "empty or new directory, or a dataset to resume or extend.")
 
 

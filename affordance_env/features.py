@@ -43,6 +43,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import matmul
 
 N_FEATURES = 49
@@ -147,7 +148,7 @@ class Features:
 
     def __post_init__(self) -> None:
         if self.values.shape != (N_FEATURES,) or self.values.dtype != np.float32:
-            raise ValueError(
+            raise InvalidValueError(
                 f"Features.values must be a ({N_FEATURES},) float32 array, "
                 f"got shape {self.values.shape} and dtype {self.values.dtype}."
             )
@@ -238,7 +239,7 @@ def effect_features(initial: np.ndarray, final: np.ndarray) -> np.ndarray:
     initial = np.asarray(initial, dtype=np.float64)
     final = np.asarray(final, dtype=np.float64)
     if initial.shape != final.shape or initial.shape[-1:] != (N_FEATURES,):
-        raise ValueError(f"initial and final must both be (..., {N_FEATURES}) feature arrays, got shapes "
+        raise InvalidValueError(f"initial and final must both be (..., {N_FEATURES}) feature arrays, got shapes "
                          f"{initial.shape} and {final.shape}.")
     effect = final - initial
     effect[..., ORIENTATION_INDEX] = wrap_axis_angle(effect[..., ORIENTATION_INDEX])
@@ -360,18 +361,18 @@ def _validated(
     """The arguments of :func:`compute_features` as arrays, after checking shapes, dtypes and finiteness."""
     points = _real_array("p_world_points", p_world_points)
     if points.ndim != 3 or points.shape[2] != 3:
-        raise ValueError(f"p_world_points must have shape (H, W, 3), got shape {points.shape}.")
+        raise InvalidValueError(f"p_world_points must have shape (H, W, 3), got shape {points.shape}.")
     grid = points.shape[:2]
     ranges_arr = _real_array("ranges", ranges)
     if ranges_arr.shape != grid:
-        raise ValueError(
+        raise InvalidValueError(
             f"ranges must have shape (H, W) = {grid} like p_world_points, got shape {ranges_arr.shape}."
         )
     mask_arr = np.asarray(mask)
     if mask_arr.dtype != np.bool_:
-        raise ValueError(f"mask must be a boolean array (dtype bool), got dtype {mask_arr.dtype}.")
+        raise InvalidValueError(f"mask must be a boolean array (dtype bool), got dtype {mask_arr.dtype}.")
     if mask_arr.shape != grid:
-        raise ValueError(
+        raise InvalidValueError(
             f"mask must have shape (H, W) = {grid} like p_world_points, got shape {mask_arr.shape}."
         )
     camera = _finite_vector("p_world_camera", p_world_camera, 3, MAX_ABS_METRES, "m")
@@ -385,7 +386,7 @@ def _real_array(name: str, value: np.ndarray) -> np.ndarray:
     arr = np.asarray(value)
     real = np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)
     if arr.dtype == np.bool_ or not real:
-        raise ValueError(f"{name} must have a real floating or integer dtype, got dtype {arr.dtype}.")
+        raise InvalidValueError(f"{name} must have a real floating or integer dtype, got dtype {arr.dtype}.")
     return arr
 
 
@@ -393,9 +394,9 @@ def _finite_vector(name: str, value: np.ndarray, size: int, max_abs: float, unit
     """``value`` as a float (size,) vector with entries finite and within +-``max_abs``, else ValueError."""
     vec = _real_array(name, value).astype(np.float64)
     if vec.shape != (size,):
-        raise ValueError(f"{name} must have shape ({size},), got shape {vec.shape}.")
+        raise InvalidValueError(f"{name} must have shape ({size},), got shape {vec.shape}.")
     if not np.all(np.abs(vec) <= max_abs):
-        raise ValueError(f"{name} must be finite and within +-{max_abs:g} {unit}, got {vec.tolist()}.")
+        raise InvalidValueError(f"{name} must be finite and within +-{max_abs:g} {unit}, got {vec.tolist()}.")
     return vec
 
 
@@ -403,14 +404,14 @@ def _check_on_mask(p_world_obj: np.ndarray, range_obj: np.ndarray) -> None:
     """Raise ValueError unless object points (3, k) and ranges (k,) [m] are finite, bounded, ranges >= 0."""
     bad_points = ~(np.abs(p_world_obj) <= MAX_ABS_METRES).all(axis=0)
     if bad_points.any():
-        raise ValueError(
+        raise InvalidValueError(
             f"p_world_points must be finite and within +-{MAX_ABS_METRES:g} m wherever mask is True, got "
             f"{int(bad_points.sum())} object pixels that are not, "
             f"e.g. {p_world_obj[:, np.argmax(bad_points)].tolist()}."
         )
     bad_ranges = ~((range_obj >= 0.0) & (range_obj <= MAX_ABS_METRES))
     if bad_ranges.any():
-        raise ValueError(
+        raise InvalidValueError(
             f"ranges must be finite and within [0, {MAX_ABS_METRES:g}] m wherever mask is True, got "
             f"{int(bad_ranges.sum())} object pixels that are not, e.g. {range_obj[bad_ranges][0]!r}."
         )

@@ -10,6 +10,7 @@ import numpy as np
 from gymnasium import spaces
 
 from affordance_env.behaviors import ACTION_DIM, check_action
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.options import EnvOptions
 from affordance_env.tap_env import RESET_OPTIONS, TapAffordanceEnv
 from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
@@ -131,11 +132,11 @@ class TapAffordanceGoalEnv(gym.Env):
         render_height: int = 360,
     ) -> None:
         if not (isinstance(goal_tolerance, (int, float)) and np.isfinite(goal_tolerance) and goal_tolerance > 0):
-            raise ValueError(f"goal_tolerance must be a positive distance [m], got {goal_tolerance!r}.")
+            raise InvalidValueError(f"goal_tolerance must be a positive distance [m], got {goal_tolerance!r}.")
         if reward_type not in ("sparse", "dense"):
-            raise ValueError(f"reward_type must be 'sparse' or 'dense', got {reward_type!r}.")
+            raise InvalidValueError(f"reward_type must be 'sparse' or 'dense', got {reward_type!r}.")
         if render_mode not in (None, *self.metadata["render_modes"]):
-            raise ValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got "
+            raise InvalidValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got "
                              f"{render_mode!r}.")
         EnvOptions(position_range=position_range)  # checked
         #: Where objects are placed: ``"canonical"`` as in TapAffordance-v1, or ``"workspace"``: uniform over the
@@ -184,7 +185,8 @@ class TapAffordanceGoalEnv(gym.Env):
             xy = np.full(1, np.nan)
         low, high = self._arm.physics.table_extent()
         if xy.shape != (2,) or not np.all(np.isfinite(xy)) or np.any(xy < low) or np.any(xy > high):
-            raise ValueError(f"goal must be (x, y) on the table top, x in [{low[0]:.2f}, {high[0]:.2f}] and y in "
+            raise InvalidValueError(
+                f"goal must be (x, y) on the table top, x in [{low[0]:.2f}, {high[0]:.2f}] and y in "
                              f"[{low[1]:.2f}, {high[1]:.2f}] m, got {goal!r}.")
         return xy
 
@@ -214,11 +216,12 @@ class TapAffordanceGoalEnv(gym.Env):
         """Place an object, attend to it, draw the goal (or take ``options["goal"]``) and observe."""
         super().reset(seed=seed)
         if options is not None and not isinstance(options, Mapping):
-            raise ValueError(f"options must be a dict with keys among {GOAL_RESET_OPTIONS}, got {options!r}.")
+            raise InvalidValueError(f"options must be a dict with keys among {GOAL_RESET_OPTIONS}, got {options!r}.")
         options = dict(options or {})
         unknown = sorted(set(options) - set(GOAL_RESET_OPTIONS))
         if unknown:
-            raise ValueError(f"Unknown reset option(s) {unknown}. Valid options: {', '.join(GOAL_RESET_OPTIONS)}.")
+            raise InvalidValueError(
+                f"Unknown reset option(s) {unknown}. Valid options: {', '.join(GOAL_RESET_OPTIONS)}.")
         goal = options.pop("goal", None)
         goal = None if goal is None else self._check_goal(goal)
         for arm in self.arms.values():
@@ -237,17 +240,17 @@ class TapAffordanceGoalEnv(gym.Env):
 
     def _check_action(self, action: Any) -> tuple[str, np.ndarray]:
         if not isinstance(action, Mapping) or set(action) != {"behavior", "params"}:
-            raise ValueError(f"action must be a dict with keys 'behavior' (an index into {list(BEHAVIORS)} or a "
+            raise InvalidValueError(f"action must be a dict with keys 'behavior' (an index into {list(BEHAVIORS)} or a "
                              f"name) and 'params' (3 values in [-1, 1]), got {action!r}.")
         behavior = action["behavior"]
         if isinstance(behavior, str):
             name = behavior
             if name not in BEHAVIORS:
-                raise ValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
+                raise InvalidValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
         else:
             index = int(behavior) if np.ndim(behavior) == 0 and float(behavior) == int(behavior) else -1
             if not 0 <= index < len(BEHAVIORS):
-                raise ValueError(f"action 'behavior' must be an index in 0..{len(BEHAVIORS) - 1} "
+                raise InvalidValueError(f"action 'behavior' must be an index in 0..{len(BEHAVIORS) - 1} "
                                  f"({', '.join(BEHAVIORS)}), got {behavior!r}.")
             name = BEHAVIORS[index]
         return name, check_action(action["params"])
@@ -335,7 +338,7 @@ class FlatActionWrapper(gym.ActionWrapper):
     def action(self, action: Any) -> dict[str, Any]:
         a = np.asarray(action, dtype=np.float64)
         if a.shape != self.action_space.shape or not np.all(np.isfinite(a)):
-            raise ValueError(f"action must be {self.action_space.shape[0]} finite values (4 behaviour scores, 3 "
+            raise InvalidValueError(f"action must be {self.action_space.shape[0]} finite values (4 behaviour scores, 3 "
                              f"parameters in [-1, 1]), got {action!r}.")
         return {"behavior": int(np.argmax(a[: len(BEHAVIORS)])), "params": a[len(BEHAVIORS):].astype(np.float32)}
 

@@ -32,6 +32,7 @@ from affordance_env.behaviors import (
     plan_grasp,
     plan_stroke,
 )
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.grasping import GraspOutcome, grasp_reachable, run_grasp
 from affordance_env.motion import MotionExecutor, ReachOutcome
 from affordance_env.objects import ObjectGeometry, object_geometry
@@ -190,5 +191,5 @@ INTERACTIONS: Mapping[str, Interaction] = {name: _interaction(b) for name, b in 
 def get_interaction(name: str) -> Interaction:
     """The interaction of the behaviour called ``name``; raises ValueError listing the valid names."""
     if name not in INTERACTIONS:
-        raise ValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(INTERACTIONS)}.")
+        raise InvalidValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(INTERACTIONS)}.")
     return INTERACTIONS[name]

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import pinocchio as pin
 
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import matmul, norm, solve_spd
 from affordance_env.robot_model import (
     HAND_MOUNT_FRAME,
@@ -90,7 +91,7 @@ class Kinematics:
         for frame in (hand_frame, head_frame):
             if not self.model.existFrame(frame):
                 available = sorted({f.name for f in self.model.frames})
-                raise ValueError(f"Frame {frame!r} does not exist in the model. Available frames: {available}")
+                raise InvalidValueError(f"Frame {frame!r} does not exist in the model. Available frames: {available}")
         self.hand_frame_id = self.model.getFrameId(hand_frame)
         self.head_frame_id = self.model.getFrameId(head_frame)
         #: Joint limits [rad] in active-joint order.
@@ -109,7 +110,7 @@ class Kinematics:
     def _check_q(self, q: np.ndarray) -> np.ndarray:
         q = np.asarray(q, dtype=float)
         if q.shape != (self.nq,) or not np.all(np.isfinite(q)):
-            raise ValueError(f"q must be {self.nq} finite joint angles in the {self.variant.name!r} variant's "
+            raise InvalidValueError(f"q must be {self.nq} finite joint angles in the {self.variant.name!r} variant's "
                              f"active-joint order, got {q!r}.")
         return q
 
@@ -142,11 +143,11 @@ class Kinematics:
         reach = self.variant.reach_joints
         for name, (low, high) in joint_ranges.items():
             if name not in reach:
-                raise ValueError(f"joint_ranges: {name!r} is not a joint the IK moves; those are {reach}.")
+                raise InvalidValueError(f"joint_ranges: {name!r} is not a joint the IK moves; those are {reach}.")
             j = self.joint_names.index(name)
             lower[j], upper[j] = max(lower[j], float(low)), min(upper[j], float(high))
             if not lower[j] <= upper[j]:
-                raise ValueError(f"joint_ranges: {name!r} range ({low}, {high}) misses the joint's limits "
+                raise InvalidValueError(f"joint_ranges: {name!r} range ({low}, {high}) misses the joint's limits "
                                  f"({self.lower[j]:.3f}, {self.upper[j]:.3f}) rad.")
         return lower, upper
 
@@ -183,14 +184,14 @@ class Kinematics:
         """
         p_target = np.asarray(p_world_target, dtype=float)
         if p_target.shape != (3,) or not np.all(np.isfinite(p_target)):
-            raise ValueError(f"p_world_target must be 3 finite coordinates [m], got {p_world_target!r}.")
+            raise InvalidValueError(f"p_world_target must be 3 finite coordinates [m], got {p_world_target!r}.")
         if R_world_target is not None:
             R_world_target = np.asarray(R_world_target, dtype=float)
             # a stroke asks for one orientation many times: the last one checked need not be checked again
             if not (R_world_target.shape == (3, 3) and np.array_equal(R_world_target, self._last_rotation)):
                 if (R_world_target.shape != (3, 3)
                         or np.abs(matmul(R_world_target, R_world_target.T) - np.eye(3)).max() > 1e-6):
-                    raise ValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
+                    raise InvalidValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
                 self._last_rotation = R_world_target.copy()
         lower, upper = self.joint_limits(joint_ranges)
         lower, upper = lower[self._to_pin], upper[self._to_pin]  # in Pinocchio's order from here on

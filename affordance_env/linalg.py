@@ -23,6 +23,8 @@ import math
 import eigenpy
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
+
 _SUBSCRIPTS = {(1, 1): "i,i->", (1, 2): "i,ij->j", (2, 1): "...ij,j->...i", (2, 2): "...ij,jk->...ik"}
 
 
@@ -32,7 +34,8 @@ def matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
     key = (min(a.ndim, 2), b.ndim)
     if key not in _SUBSCRIPTS or a.ndim == 0:
-        raise ValueError(f"matmul takes a vector or (a stack of) matrices times a vector or a matrix, got shapes "
+        raise InvalidValueError(
+            f"matmul takes a vector or (a stack of) matrices times a vector or a matrix, got shapes "
                          f"{a.shape} and {b.shape}.")
     return np.einsum(_SUBSCRIPTS[key], a, b)
 
@@ -53,7 +56,7 @@ def solve_spd(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     A = np.asarray(A, dtype=np.float64)
     decomposition = eigenpy.LLT(A)
     if decomposition.info() != eigenpy.ComputationInfo.Success:
-        raise ValueError(f"solve_spd needs a symmetric positive definite matrix, got {A!r}.")
+        raise InvalidValueError(f"solve_spd needs a symmetric positive definite matrix, got {A!r}.")
     return np.asarray(decomposition.solve(np.asarray(b, dtype=np.float64)), dtype=np.float64)
 
 

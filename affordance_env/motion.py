@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from affordance_env.behaviors import GraspPlan, StrokePlan
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.kinematics import IKResult, Kinematics
 from affordance_env.linalg import dot, norm
 from affordance_env.motor_limits import velocity_limits
@@ -247,7 +248,7 @@ class MotionExecutor:
         """Simulate at ``timestep`` [s], a divisor of CONTROL_DT, inside the block; at the model's own after it."""
         steps = round(CONTROL_DT / timestep)
         if not (timestep > 0 and abs(steps * timestep - CONTROL_DT) < 1e-12):
-            raise ValueError(f"timestep must divide the control period {CONTROL_DT} s, got {timestep!r}.")
+            raise InvalidValueError(f"timestep must divide the control period {CONTROL_DT} s, got {timestep!r}.")
         opt = self.physics.model.opt
         saved, opt.timestep = opt.timestep, timestep
         try:

@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.robot_model import HAND_COUPLINGS, HAND_DRIVEN_JOINTS, coupled_slope_max
 
 _DEG = np.pi / 180.0
@@ -83,5 +84,5 @@ def torque_limits(joints: Sequence[str]) -> np.ndarray:
 def _lookup(table: dict[str, float], name: str, what: str) -> float:
     key = name if name in table else _side_free(name)
     if key not in table:
-        raise ValueError(f"No {what} limit for joint {name!r}. Joints with one: {', '.join(sorted(table))}.")
+        raise InvalidValueError(f"No {what} limit for joint {name!r}. Joints with one: {', '.join(sorted(table))}.")
     return table[key]

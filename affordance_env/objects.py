@@ -10,6 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import norm
 
 #: Object types, as named in the paper.
@@ -32,7 +33,7 @@ SIZE_LIMITS = (0.02, 0.15)
 def check_object_type(object_type: str) -> str:
     """Return ``object_type`` if it is one of :data:`OBJECT_TYPES`, else raise a ValueError listing them."""
     if object_type not in OBJECT_TYPES:
-        raise ValueError(f"Unknown object type {object_type!r}. Valid types: {', '.join(OBJECT_TYPES)}.")
+        raise InvalidValueError(f"Unknown object type {object_type!r}. Valid types: {', '.join(OBJECT_TYPES)}.")
     return object_type
 
 
@@ -43,9 +44,9 @@ def check_size(size: float) -> float:
     except (TypeError, ValueError):
         size_f = float("nan")
     if isinstance(size, bool | str) or not np.isfinite(size_f) or size_f <= 0:
-        raise ValueError(f"Object size must be a positive length in metres, got {size!r}.")
+        raise InvalidValueError(f"Object size must be a positive length in metres, got {size!r}.")
     if not SIZE_LIMITS[0] <= size_f <= SIZE_LIMITS[1]:
-        raise ValueError(
+        raise InvalidValueError(
             f"Object size {size_f} m is outside the range the hand can tap, {SIZE_LIMITS[0]}-{SIZE_LIMITS[1]} m."
         )
     return size_f
@@ -122,7 +123,7 @@ def as_resting(geometry: ObjectGeometry, quat: np.ndarray) -> tuple[ObjectGeomet
     they are wide, boxes cubes); what changes is the extent across a stroke and the hand's turn over a grasp."""
     q = np.asarray(quat, dtype=float)
     if q.shape != (4,) or not np.all(np.isfinite(q)) or norm(q) == 0.0:
-        raise ValueError(f"quat must be a finite, non-zero quaternion (w, x, y, z), got {quat!r}.")
+        raise InvalidValueError(f"quat must be a finite, non-zero quaternion (w, x, y, z), got {quat!r}.")
     w, x, y, z = q / norm(q)
     R = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
                   [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],

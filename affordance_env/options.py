@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from affordance_env.behaviors import ROLL_THRESHOLD, get_behavior
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size
 from affordance_env.pinhole import Intrinsics
 from affordance_env.range_noise import check_range_noise
@@ -47,33 +48,34 @@ class EnvOptions:
         get_behavior(self.behavior)
         types = self.object_types
         if isinstance(types, str) or not isinstance(types, Sequence) or len(types) == 0:
-            raise ValueError(f"object_types must be a non-empty sequence of {OBJECT_TYPES}, got {types!r}.")
+            raise InvalidValueError(f"object_types must be a non-empty sequence of {OBJECT_TYPES}, got {types!r}.")
         normalised: dict[str, Any] = {"object_types": tuple(check_object_type(t) for t in types)}
         size_range = self.size_range
         if isinstance(size_range, str) or not isinstance(size_range, Sequence) or len(size_range) != 2:
-            raise ValueError(f"size_range must be (low, high) in metres, got {size_range!r}.")
+            raise InvalidValueError(f"size_range must be (low, high) in metres, got {size_range!r}.")
         try:
             low, high = (check_size(s) for s in size_range)
         except ValueError as exc:
-            raise ValueError(f"size_range must be (low, high) in metres, got {size_range!r}: {exc}") from None
+            raise InvalidValueError(f"size_range must be (low, high) in metres, got {size_range!r}: {exc}") from None
         if low > high:
-            raise ValueError(f"size_range must be (low, high) with low <= high, got {size_range!r}.")
+            raise InvalidValueError(f"size_range must be (low, high) with low <= high, got {size_range!r}.")
         normalised["size_range"] = (low, high)
         if isinstance(self.camera_fovy, bool) or not isinstance(self.camera_fovy, numbers.Real):
-            raise ValueError(f"camera_fovy must be a vertical field of view in degrees, got {self.camera_fovy!r}.")
+            raise InvalidValueError(
+                f"camera_fovy must be a vertical field of view in degrees, got {self.camera_fovy!r}.")
         Intrinsics.from_fovy(self.camera_width, self.camera_height, self.camera_fovy)
         for name in ("roll_threshold", "settle_timeout"):
             value = getattr(self, name)
             real = isinstance(value, numbers.Real) and not isinstance(value, bool)
             if not (real and math.isfinite(value) and value > 0):
                 unit = "distance [m]" if name == "roll_threshold" else "duration [s]"
-                raise ValueError(f"{name} must be a positive {unit}, got {value!r}.")
+                raise InvalidValueError(f"{name} must be a positive {unit}, got {value!r}.")
             normalised[name] = float(value)
         normalised["camera_width"], normalised["camera_height"] = int(self.camera_width), int(self.camera_height)
         normalised["camera_fovy"] = float(self.camera_fovy)
         check_range_noise(self.range_noise)
         if self.position_range not in POSITION_RANGES:
-            raise ValueError(f"position_range must be one of {POSITION_RANGES}, got {self.position_range!r}.")
+            raise InvalidValueError(f"position_range must be one of {POSITION_RANGES}, got {self.position_range!r}.")
         for name, value in normalised.items():
             object.__setattr__(self, name, value)
 
@@ -83,6 +85,7 @@ class EnvOptions:
         known = [f.name for f in dataclasses.fields(cls)]
         unknown = sorted(set(options) - set(known))
         if unknown:
-            raise ValueError(f"unknown or unsupported env options {unknown}; the data options of TapAffordance-v1 "
+            raise InvalidValueError(
+                f"unknown or unsupported env options {unknown}; the data options of TapAffordance-v1 "
                              f"(what a dataset records) are {known}.")
         return cls(**options)

@@ -13,6 +13,7 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import norm
 from affordance_env.objects import PRIMITIVES, ObjectGeometry
 from affordance_env.outcome import ObjectMonitor
@@ -31,7 +32,7 @@ OBJECT_CONTYPE, OBJECT_CONAFFINITY = 1, 3
 def _id(model: mujoco.MjModel, kind: mujoco.mjtObj, name: str) -> int:
     index = mujoco.mj_name2id(model, kind, name)
     if index < 0:
-        raise ValueError(f"The model has no {kind.name.removeprefix('mjOBJ_').lower()} named {name!r}.")
+        raise InvalidValueError(f"The model has no {kind.name.removeprefix('mjOBJ_').lower()} named {name!r}.")
     return index
 
 

@@ -10,6 +10,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
+
 
 @dataclass(frozen=True)
 class Intrinsics:
@@ -28,9 +30,9 @@ class Intrinsics:
         if not (isinstance(width, int | np.integer) and isinstance(height, int | np.integer)) or min(
             width, height
         ) < 2:
-            raise ValueError(f"camera resolution must be integers >= 2, got width={width!r}, height={height!r}.")
+            raise InvalidValueError(f"camera resolution must be integers >= 2, got width={width!r}, height={height!r}.")
         if not 1.0 <= float(fovy_deg) <= 170.0:
-            raise ValueError(f"fovy_deg must be within [1, 170] degrees, got {fovy_deg!r}.")
+            raise InvalidValueError(f"fovy_deg must be within [1, 170] degrees, got {fovy_deg!r}.")
         f = 0.5 * height / np.tan(np.deg2rad(fovy_deg) / 2.0)
         return cls(int(width), int(height), float(f), float(f), (width - 1) / 2.0, (height - 1) / 2.0)
 

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import matmul
 
 if TYPE_CHECKING:  # only for annotations: importing the camera would import MuJoCo
@@ -34,7 +35,8 @@ MAX_INCIDENCE = np.deg2rad(80.0)
 def check_range_noise(name: str | None) -> str | None:
     """Return ``name`` if it is None or one of :data:`RANGE_NOISE_MODELS`, else raise ValueError listing them."""
     if name is not None and name not in RANGE_NOISE_MODELS:
-        raise ValueError(f"Unknown range_noise {name!r}. Valid: None (no noise), {', '.join(RANGE_NOISE_MODELS)}.")
+        raise InvalidValueError(
+            f"Unknown range_noise {name!r}. Valid: None (no noise), {', '.join(RANGE_NOISE_MODELS)}.")
     return name
 
 
@@ -58,7 +60,7 @@ def add_kinect_noise(image: RangeImage, rng: np.random.Generator) -> RangeImage:
     depth ``z + N(0, sigma_z)`` moves the point along the same ray. Pixels that hit nothing stay so.
     """
     if image.normals is None:
-        raise ValueError("add_kinect_noise needs surface normals: capture the image with normals=True.")
+        raise InvalidValueError("add_kinect_noise needs surface normals: capture the image with normals=True.")
     hit = np.isfinite(image.ranges)
     ranges = image.ranges.astype(np.float64)
     r = ranges[hit]

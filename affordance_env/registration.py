@@ -6,6 +6,8 @@ from typing import Any
 
 import gymnasium as gym
 
+from affordance_env.exceptions import InvalidValueError
+
 ENV_ID = "TapAffordance-v1"
 GOAL_ENV_ID = "TapAffordanceGoal-v0"
 #: Interactions per episode of the goal env, after which it is truncated.
@@ -31,7 +33,7 @@ def make_tap_vector_env(num_envs: int = 1, **kwargs: Any) -> gym.vector.VectorEn
     second step of a one-interaction episode would be a reset with reward 0. ``vectorization_mode="async"``
     with ``vector_kwargs={"autoreset_mode": gym.vector.AutoresetMode.SAME_STEP}`` gives worker processes."""
     if isinstance(num_envs, bool) or not isinstance(num_envs, int) or num_envs < 1:
-        raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}.")
+        raise InvalidValueError(f"num_envs must be an integer >= 1, got {num_envs!r}.")
     kwargs.pop("max_episode_steps", None)  # one interaction per episode: the env terminates it
     return gym.vector.SyncVectorEnv([lambda: make_tap_env(**kwargs) for _ in range(num_envs)],
                                     autoreset_mode=gym.vector.AutoresetMode.SAME_STEP)
@@ -52,7 +54,7 @@ def make_goal_vector_env(num_envs: int = 1, max_episode_steps: int = GOAL_MAX_EP
     (``AutoresetMode.SAME_STEP``, declared in the env's metadata; the episode's last observation and info are in
     ``infos["final_obs"]`` and ``infos["final_info"]``), so that every vector step is an interaction."""
     if isinstance(num_envs, bool) or not isinstance(num_envs, int) or num_envs < 1:
-        raise ValueError(f"num_envs must be an integer >= 1, got {num_envs!r}.")
+        raise InvalidValueError(f"num_envs must be an integer >= 1, got {num_envs!r}.")
 
     def make() -> gym.Env:
         return gym.wrappers.TimeLimit(make_goal_env(**kwargs), max_episode_steps)

@@ -18,6 +18,8 @@ import os
 import mujoco
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
+
 #: Headless backends tried in this order when the user named none, with the library each needs.
 HEADLESS_BACKENDS = {"egl": "EGL", "osmesa": "OSMesa"}
 _GLFW_NAMES = ("glfw", "enable", "enabled", "on", "true", "1")
@@ -48,7 +50,7 @@ def _gl_context_class(backend: str):
     elif backend in _GLFW_NAMES:
         from mujoco.glfw import GLContext
     else:
-        raise ValueError(f"unknown OpenGL backend MUJOCO_GL={backend!r}; expected egl, osmesa or glfw.")
+        raise InvalidValueError(f"unknown OpenGL backend MUJOCO_GL={backend!r}; expected egl, osmesa or glfw.")
     return GLContext
 
 
@@ -70,10 +72,11 @@ class SceneRenderer:
         camera_id = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_CAMERA, camera)
         if camera_id < 0:
             names = [model.camera(i).name for i in range(model.ncam)]
-            raise ValueError(f"Camera {camera!r} does not exist in the model. Available cameras: {names}")
+            raise InvalidValueError(f"Camera {camera!r} does not exist in the model. Available cameras: {names}")
         limit = (model.vis.global_.offwidth, model.vis.global_.offheight)
         if not (0 < width <= limit[0] and 0 < height <= limit[1]):
-            raise ValueError(f"picture size {width} x {height} must be positive and within the model's offscreen "
+            raise InvalidValueError(
+                f"picture size {width} x {height} must be positive and within the model's offscreen "
                              f"buffer, {limit[0]} x {limit[1]} pixels.")
         backend = backend or choose_gl_backend()
         self.backend = backend

@@ -29,6 +29,8 @@ from pathlib import Path
 import icub_models
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
+
 #: The URDF model of ``icub-models`` we use: iCub 2.5 as simulated in Gazebo (fixed base at ``root_link``).
 ICUB_MODEL = "iCubGazeboV2_5"
 
@@ -136,7 +138,7 @@ HAND_MOUNT_POS: tuple[float, float, float] = (0.0185, -0.0017, 0.0023)
 def coupled_position(distal: str, q_proximal: float | np.ndarray) -> float | np.ndarray:
     """Angle [rad] of the coupled ``distal`` joint when its proximal joint is at ``q_proximal`` [rad]."""
     if distal not in HAND_COUPLINGS:
-        raise ValueError(f"{distal!r} is not a coupled joint. Coupled joints: {', '.join(HAND_COUPLINGS)}.")
+        raise InvalidValueError(f"{distal!r} is not a coupled joint. Coupled joints: {', '.join(HAND_COUPLINGS)}.")
     q = q_proximal if isinstance(q_proximal, np.ndarray) else float(q_proximal)  # a scalar as a float: fast
     angle = 0.0
     for c in reversed(HAND_COUPLINGS[distal][1]):  # Horner's scheme
@@ -148,7 +150,7 @@ def coupled_slope_max(distal: str) -> float:
     """Largest rate of the coupled ``distal`` joint per unit rate of its proximal joint, over the proximal joint's
     range (0 to 95 degrees): how much faster than its motor's joint the linkage can turn it."""
     if distal not in HAND_COUPLINGS:
-        raise ValueError(f"{distal!r} is not a coupled joint. Coupled joints: {', '.join(HAND_COUPLINGS)}.")
+        raise InvalidValueError(f"{distal!r} is not a coupled joint. Coupled joints: {', '.join(HAND_COUPLINGS)}.")
     c = HAND_COUPLINGS[distal][1]
     q = np.linspace(0.0, np.radians(95.0), 200)
     return float(np.max(np.abs(sum(i * c[i] * q ** (i - 1) for i in range(1, len(c))))))
@@ -248,7 +250,7 @@ VARIANTS["two_arms_left"] = dataclasses.replace(
 def get_variant(name: str) -> RobotVariant:
     """The robot variant called ``name``; raises ValueError listing the valid names."""
     if name not in VARIANTS:
-        raise ValueError(f"Unknown robot variant {name!r}. Valid variants: {', '.join(VARIANTS)}.")
+        raise InvalidValueError(f"Unknown robot variant {name!r}. Valid variants: {', '.join(VARIANTS)}.")
     return VARIANTS[name]
 
 

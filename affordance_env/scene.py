@@ -14,6 +14,7 @@ import mujoco
 import numpy as np
 
 from affordance_env.assets_path import assets_dir
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import matmul
 from affordance_env.model_cache import cached_model
 from affordance_env.motor_limits import torque_limits
@@ -240,7 +241,7 @@ def phalanx_capsules() -> dict[str, tuple[tuple[float, float, float], float, flo
         low, high = p_link_vertices.min(axis=0), p_link_vertices.max(axis=0)
         extent = high - low
         if np.argmax(extent) != 0:
-            raise ValueError(f"{link} is expected to be longest along its x axis; its mesh extends {extent} m.")
+            raise InvalidValueError(f"{link} is expected to be longest along its x axis; its mesh extends {extent} m.")
         radius = float(extent[2] / 2)
         capsules[link] = (tuple(float(c) for c in (low + high) / 2), float(extent[0] / 2 - radius), radius)
     return capsules
@@ -344,7 +345,8 @@ def _lock_joints(spec: mujoco.MjSpec, active: tuple[str, ...], held: Mapping[str
         angle = held.get(joint.name, 0.0)
         if angle:
             if np.any(joint.pos):
-                raise ValueError(f"joint {joint.name!r} is not at its body's origin; it cannot be held at an angle.")
+                raise InvalidValueError(
+                    f"joint {joint.name!r} is not at its body's origin; it cannot be held at an angle.")
             body = joint.parent
             turn = np.empty(4)
             mujoco.mju_axisAngle2Quat(turn, np.asarray(joint.axis, dtype=float), angle)

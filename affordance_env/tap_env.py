@@ -15,6 +15,7 @@ from gymnasium import spaces
 from affordance_env.attention import attend
 from affordance_env.behaviors import ACTION_DIM, BEHAVIORS, check_action
 from affordance_env.camera import RangeCamera
+from affordance_env.exceptions import IncompatibleStateError, InvalidValueError
 from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
 from affordance_env.interactions import Interaction, get_interaction
 from affordance_env.kinematics import Kinematics
@@ -352,7 +353,7 @@ class TapAffordanceEnv(gym.Env):
     @classmethod
     def _check_render_mode(cls, render_mode: str | None) -> None:
         if render_mode not in (None, *cls.metadata["render_modes"]):
-            raise ValueError(f"render_mode must be None or one of {cls.metadata['render_modes']}, got "
+            raise InvalidValueError(f"render_mode must be None or one of {cls.metadata['render_modes']}, got "
                              f"{render_mode!r}.")
 
     def _blank_observation(self) -> dict[str, np.ndarray]:
@@ -401,35 +402,37 @@ class TapAffordanceEnv(gym.Env):
         if self.position_range == "workspace":
             xy = sample_in_workspace(self.behavior.name, rng)
         if options is not None and not isinstance(options, Mapping):
-            raise ValueError(f"options must be a dict with keys among {RESET_OPTIONS}, got {options!r}.")
+            raise InvalidValueError(f"options must be a dict with keys among {RESET_OPTIONS}, got {options!r}.")
         options = dict(options or {})
         unknown = sorted(set(options) - set(RESET_OPTIONS))
         if unknown:
-            raise ValueError(f"Unknown reset option(s) {unknown}. Valid options: {', '.join(RESET_OPTIONS)}.")
+            raise InvalidValueError(f"Unknown reset option(s) {unknown}. Valid options: {', '.join(RESET_OPTIONS)}.")
         if "object_type" in options:
             object_type = check_object_type(options["object_type"])
         if "size" in options:
             try:
                 size = check_size(options["size"])
             except ValueError as exc:
-                raise ValueError(f"reset option 'size': {exc}") from None
+                raise InvalidValueError(f"reset option 'size': {exc}") from None
         if object_type in ("sphere", "vertical_cylinder"):
             yaw = 0.0
         if "position" in options:
             xy = np.asarray(options["position"], dtype=np.float64)
             low, high = self.physics.table_extent()
             if xy.shape != (2,) or not np.all(np.isfinite(xy)) or np.any(xy < low) or np.any(xy > high):
-                raise ValueError(f"position must be (x, y) on the table top, x in [{low[0]:.2f}, {high[0]:.2f}] and "
+                raise InvalidValueError(
+                    f"position must be (x, y) on the table top, x in [{low[0]:.2f}, {high[0]:.2f}] and "
                                  f"y in [{low[1]:.2f}, {high[1]:.2f}] m, got {options['position']!r}.")
         if "yaw" in options:
             real = isinstance(options["yaw"], numbers.Real) and not isinstance(options["yaw"], bool)
             yaw = float(options["yaw"]) if real else float("nan")
             if not np.isfinite(yaw):
-                raise ValueError(f"yaw must be a finite angle [rad], got {options['yaw']!r}.")
+                raise InvalidValueError(f"yaw must be a finite angle [rad], got {options['yaw']!r}.")
         pose = None
         if "object_pose" in options:
             if "position" in options or "yaw" in options:
-                raise ValueError("reset options 'object_pose' and 'position' or 'yaw' exclude each other: the pose "
+                raise InvalidValueError(
+                    "reset options 'object_pose' and 'position' or 'yaw' exclude each other: the pose "
                                  "gives both.")
             pose = self._check_pose(options["object_pose"], object_geometry(object_type, size))
         return object_type, size, xy, yaw, pose
@@ -447,7 +450,8 @@ class TapAffordanceEnv(gym.Env):
                   and top + 0.5 * geometry.half_height <= pose[2] <= top + 3.0 * geometry.rbound
                   and norm(pose[3:]) > 1e-6)
         if not ok:
-            raise ValueError(f"object_pose must be (x, y, z, qw, qx, qy, qz): x in [{low[0]:.2f}, {high[0]:.2f}] and "
+            raise InvalidValueError(
+                f"object_pose must be (x, y, z, qw, qx, qy, qz): x in [{low[0]:.2f}, {high[0]:.2f}] and "
                              f"y in [{low[1]:.2f}, {high[1]:.2f}] m on the table, z [m] the object's centre above the "
                              f"table top ({top:.3f} m) by {0.5 * geometry.half_height:.3f} to "
                              f"{3.0 * geometry.rbound:.3f} m, and a non-zero quaternion; got {value!r}.")
@@ -502,7 +506,8 @@ class TapAffordanceEnv(gym.Env):
         for name in names:
             interaction = get_interaction(name)
             if interaction.behavior.robot != self.behavior.robot:
-                raise ValueError(f"behavior {name!r} needs the {interaction.behavior.robot!r} arm; this env has the "
+                raise InvalidValueError(
+                    f"behavior {name!r} needs the {interaction.behavior.robot!r} arm; this env has the "
                                  f"{self.behavior.robot!r} arm.")
             if name not in self._postures:
                 self.motion.approach_posture = None
@@ -513,7 +518,8 @@ class TapAffordanceEnv(gym.Env):
     def use_behavior(self, name: str) -> None:
         """Run the behaviour ``name`` (prepared by :meth:`prepare_behaviors`) from the next ``step`` on."""
         if name not in self._postures:
-            raise ValueError(f"behavior {name!r} is not prepared in this env; prepared: {', '.join(self._postures)}.")
+            raise InvalidValueError(
+                f"behavior {name!r} is not prepared in this env; prepared: {', '.join(self._postures)}.")
         self.interaction = get_interaction(name)
         self.behavior = self.interaction.behavior
         self.motion.approach_posture = self._postures[name]
@@ -546,7 +552,8 @@ class TapAffordanceEnv(gym.Env):
         a = check_action(params)
         name = self.behavior.name if behavior is None else behavior
         if name not in self._postures:
-            raise ValueError(f"behavior {name!r} is not prepared in this env; prepared: {', '.join(self._postures)}.")
+            raise InvalidValueError(
+                f"behavior {name!r} is not prepared in this env; prepared: {', '.join(self._postures)}.")
         initial = (self if seen_by is None else seen_by)._initial
         if initial is None:
             raise RuntimeError("feasible() needs an object: call reset() first.")
@@ -577,7 +584,8 @@ class TapAffordanceEnv(gym.Env):
         if not isinstance(state, EnvState):
             raise TypeError(f"state must be what get_state() returned (an EnvState), got {type(state).__name__}.")
         if state.robot != self.physics.variant.name:
-            raise ValueError(f"the state was made by an env of behavior {state.behavior!r} with the {state.robot!r} "
+            raise IncompatibleStateError(
+                f"the state was made by an env of behavior {state.behavior!r} with the {state.robot!r} "
                              f"robot model; this env (behavior {self.behavior.name!r}) has the "
                              f"{self.physics.variant.name!r} robot model: a state restores only into an env of the "
                              "same robot model.")

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import matmul
 
 #: The minimum-jerk profile 10 t^3 - 15 t^4 + 6 t^5 peaks at this multiple of its mean speed.
@@ -54,7 +55,7 @@ class JointTrajectory:
 def _check_limits(velocity_limit: np.ndarray | float, n_joints: int) -> np.ndarray:
     limit = np.broadcast_to(np.asarray(velocity_limit, dtype=np.float64), (n_joints,))
     if not np.all(np.isfinite(limit) & (limit > 0)):
-        raise ValueError(f"velocity_limit must be positive and finite for every joint, got {velocity_limit!r}.")
+        raise InvalidValueError(f"velocity_limit must be positive and finite for every joint, got {velocity_limit!r}.")
     return limit
 
 
@@ -83,12 +84,12 @@ def minimum_jerk(q_from: np.ndarray, waypoints: list[np.ndarray] | np.ndarray, v
     q_from = np.asarray(q_from, dtype=np.float64)
     points = np.atleast_2d(np.asarray(waypoints, dtype=np.float64))
     if points.shape[1:] != q_from.shape or q_from.ndim != 1 or len(points) == 0:
-        raise ValueError(f"waypoints must be (n, {q_from.size}) for a start of shape {q_from.shape}, got "
+        raise InvalidValueError(f"waypoints must be (n, {q_from.size}) for a start of shape {q_from.shape}, got "
                          f"{points.shape}.")
     if not (0.0 <= blend < 1.0):
-        raise ValueError(f"blend must lie in [0, 1), got {blend!r}.")
+        raise InvalidValueError(f"blend must lie in [0, 1), got {blend!r}.")
     if not dt > 0:
-        raise ValueError(f"dt must be positive [s], got {dt!r}.")
+        raise InvalidValueError(f"dt must be positive [s], got {dt!r}.")
     limit = _check_limits(velocity_limit, q_from.size)
     deltas = np.diff(np.vstack([q_from, points]), axis=0)
     lengths = np.maximum(max(min_duration, 1e-9), PEAK_SPEED_FACTOR * np.max(np.abs(deltas) / limit, axis=1))
@@ -134,11 +135,11 @@ def line_profile(length: float, speed: float, dt: float, *, ramp: float = 0.0, f
         (samples, 2): distance [m] and speed [m/s]; the last sample is at ``length``.
     """
     if not (length > 0 and np.isfinite(length)):
-        raise ValueError(f"length must be positive [m], got {length!r}.")
+        raise InvalidValueError(f"length must be positive [m], got {length!r}.")
     if not (speed > 0 and np.isfinite(speed)):
-        raise ValueError(f"speed must be positive [m/s], got {speed!r}.")
+        raise InvalidValueError(f"speed must be positive [m/s], got {speed!r}.")
     if not (dt > 0 and ramp >= 0):
-        raise ValueError(f"dt must be positive and ramp non-negative [s], got dt={dt!r}, ramp={ramp!r}.")
+        raise InvalidValueError(f"dt must be positive and ramp non-negative [s], got dt={dt!r}, ramp={ramp!r}.")
     up = ramp if from_rest else 0.0
     down = ramp if to_rest else 0.0
     ramp_length = speed * (up + down) / 2

@@ -15,6 +15,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from affordance_env.exceptions import InvalidValueError
+
 #: The side of a cell [m].
 SPACING = 0.025
 #: Each behaviour's workspace: runs of cells (x, y_first, y_last), the centres [m] (root frame) of the run's cells
@@ -47,7 +49,7 @@ WORKSPACES: Mapping[str, tuple[tuple[float, float, float], ...]] = {
 
 def _check_name(name: str) -> None:
     if name not in WORKSPACES:
-        raise ValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(WORKSPACES)}.")
+        raise InvalidValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(WORKSPACES)}.")
 
 
 @functools.cache

@@ -24,6 +24,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.results import current_results
 
 #: Standard errors a number may move by (two-sided, about 0.3 % by chance for a normal difference).
@@ -67,7 +68,7 @@ def compare_results(reference: Mapping[str, Any], found: Mapping[str, Any]) -> l
     same = ("behavior", "seed", "episodes", "ks", "relevancies", "range_noise")
     differ = [f"{key} {cb.get(key)!r} (reference {ca.get(key)!r})" for key in same if ca.get(key) != cb.get(key)]
     if differ:
-        raise ValueError(f"the results are not of the same experiment: {', '.join(differ)}.")
+        raise InvalidValueError(f"the results are not of the same experiment: {', '.join(differ)}.")
     trials = min(int(ca.get("n_trials") or ca.get("trials") or 1), int(cb.get("n_trials") or cb.get("trials") or 1))
     n_a, n_b = int(ca["n_rows"]), int(cb["n_rows"])
 

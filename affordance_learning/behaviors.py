@@ -9,6 +9,8 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+from affordance_learning.exceptions import InvalidValueError
+
 #: Per behaviour, how its success and its failure read: ``(success, failure)``.
 OUTCOME_WORDS: dict[str, tuple[str, str]] = {
     "tap": ("rolled", "did not roll"),
@@ -29,7 +31,7 @@ GENERIC_WORDS = ("success", "fail")
 def check_behavior(behavior: str) -> str:
     """``behavior`` if it is one of :data:`BEHAVIORS`; raises ValueError naming the valid ones otherwise."""
     if behavior not in BEHAVIORS:
-        raise ValueError(f"Unknown behavior {behavior!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
+        raise InvalidValueError(f"Unknown behavior {behavior!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
     return behavior
 
 
@@ -43,13 +45,13 @@ def check_env_offers(behaviors: Iterable[str], hint: str = "") -> list[str]:
 
     behaviors = list(behaviors)
     if not behaviors or any(not isinstance(b, str) for b in behaviors):
-        raise ValueError(f"behaviors must be one or more behaviour names, got {behaviors!r}.")
+        raise InvalidValueError(f"behaviors must be one or more behaviour names, got {behaviors!r}.")
     if len(set(behaviors)) != len(behaviors):
-        raise ValueError(f"behaviors must not repeat a name, got {behaviors!r}.")
+        raise InvalidValueError(f"behaviors must not repeat a name, got {behaviors!r}.")
     offered = list(env_behaviors.BEHAVIORS)
     for behavior in behaviors:
         if behavior not in offered:
-            raise ValueError(
+            raise InvalidValueError(
                 f"the environment has no {behavior!r} behaviour (it offers {', '.join(offered)}), so its "
                 f"interactions cannot be collected: install an affordance_env that has it{hint}."
             )
@@ -68,5 +70,5 @@ def outcome_words(behavior: str, label: str = "success") -> tuple[str, str]:
     if label == "rolled":
         return ROLLED_WORDS
     if label != "success":
-        raise ValueError(f"label must be 'success' or 'rolled', got {label!r}.")
+        raise InvalidValueError(f"label must be 'success' or 'rolled', got {label!r}.")
     return OUTCOME_WORDS.get(behavior, GENERIC_WORDS)

@@ -22,6 +22,8 @@ from affordance_env.collect_cli import (
     non_negative_int,
     positive_int,
 )
+from affordance_env.exceptions import AffordanceEnvError
+from affordance_learning.exceptions import AffordanceLearningError, InvalidValueError
 
 #: The sizes of ``affordance plan`` (:class:`~affordance_learning.plan_experiment.PlanSettings`' defaults), for its
 #: help; an option not given keeps PlanSettings' own default.
@@ -87,11 +89,12 @@ def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
         name, _, path = item.partition("=")
         if not path or name not in {*behaviors, *BEHAVIORS}:  # a bare path (which may hold "=" itself)
             if len(behaviors) != 1:
-                raise ValueError(f"--dataset {item}: say whose dataset it is, as BEHAVIOR=PATH with BEHAVIOR one "
+                raise InvalidValueError(
+                    f"--dataset {item}: say whose dataset it is, as BEHAVIOR=PATH with BEHAVIOR one "
                                  f"of {', '.join(behaviors)} (a bare PATH is for a single --behavior).")
             name, path = behaviors[0], item
         if name in datasets:
-            raise ValueError(f"--dataset given twice for {name!r}.")
+            raise InvalidValueError(f"--dataset given twice for {name!r}.")
         datasets[name] = Path(path)
     return datasets
 
@@ -117,7 +120,7 @@ def _train_default(args: argparse.Namespace) -> int:
     if (dataset / MANIFEST).exists():  # say so plainly, before the collection refuses its other settings
         found = read_manifest(dataset)["settings"]["env_options"].get("behavior", "tap")
         if found != behavior:
-            raise ValueError(f"{dataset} holds {found!r} interactions, not {behavior!r} ones: give --dataset a "
+            raise InvalidValueError(f"{dataset} holds {found!r} interactions, not {behavior!r} ones: give --dataset a "
                              f"dataset of {behavior} interactions, or a new directory to collect them into.")
     check_env_offers([behavior])
     collect(dataset, 1000, seed=0, workers=args.workers, env_options={"behavior": behavior})
@@ -160,7 +163,7 @@ def _compare(args: argparse.Namespace) -> int:
 def _results_of(where: Path) -> dict:
     results = _read_json(where / "results.json" if where.is_dir() else where)
     if not isinstance(results, dict) or "config" not in results:
-        raise ValueError(f"{where} holds no results.json of `affordance reproduce`.")
+        raise InvalidValueError(f"{where} holds no results.json of `affordance reproduce`.")
     return results
 
 
@@ -192,44 +195,46 @@ def _check_plan_out(out: Path, seed: int) -> None:
     if not out.exists():
         return
     if not out.is_dir():
-        raise ValueError(f"--out {out} is a file, not a directory.")
+        raise InvalidValueError(f"--out {out} is a file, not a directory.")
     from affordance_env.dataset.format import GOAL_ENV_ID, MANIFEST
 
     hint = (f"affordance plan writes its goal episodes into OUT/{PLAN_DATASET} and results.json, REPORT.md and "
             "figures beside it: give a new or empty directory, or an earlier plan's to resume it")
     if (out / MANIFEST).exists():
-        raise ValueError(f"--out {out} is a dataset directory ({_dataset_kind(_read_json(out / MANIFEST))}), not a "
+        raise InvalidValueError(
+            f"--out {out} is a dataset directory ({_dataset_kind(_read_json(out / MANIFEST))}), not a "
                          f"plan's: {hint}.")
     own = False
     dataset = out / PLAN_DATASET
     if dataset.exists() and not dataset.is_dir():
-        raise ValueError(f"--out {out} holds a file {PLAN_DATASET}, not the plan's dataset directory: {hint}.")
+        raise InvalidValueError(f"--out {out} holds a file {PLAN_DATASET}, not the plan's dataset directory: {hint}.")
     if (dataset / MANIFEST).exists():
         manifest = _read_json(dataset / MANIFEST)
         settings = manifest.get("settings") if isinstance(manifest, dict) else None
         if not (isinstance(settings, dict) and settings.get("env_id") == GOAL_ENV_ID
                 and settings.get("action") == "random"):
-            raise ValueError(f"{dataset} holds {_dataset_kind(manifest)}, not the plan's {GOAL_ENV_ID} episodes "
+            raise InvalidValueError(f"{dataset} holds {_dataset_kind(manifest)}, not the plan's {GOAL_ENV_ID} episodes "
                              f"with random actions: {hint}.")
         if settings.get("seed") != seed:
-            raise ValueError(f"{dataset} holds the plan's episodes of seed {settings.get('seed')!r}, not of --seed "
+            raise InvalidValueError(
+                f"{dataset} holds the plan's episodes of seed {settings.get('seed')!r}, not of --seed "
                              f"{seed}: give --seed {settings.get('seed')!r} to resume that plan, or another --out.")
         own = True
     elif dataset.is_dir() and any(p.name != ".lock" for p in dataset.iterdir()):
-        raise ValueError(f"{dataset} holds files but no {MANIFEST}, so it is not a dataset the plan can resume: "
+        raise InvalidValueError(f"{dataset} holds files but no {MANIFEST}, so it is not a dataset the plan can resume: "
                          f"{hint}.")
     results = out / "results.json"
     if results.exists():
         found = _read_json(results)
         if not (isinstance(found, dict) and found.get("format") == PLAN_RESULTS_FORMAT):
             what = f"of format {found.get('format')!r}" if isinstance(found, dict) else "that is not a plan's"
-            raise ValueError(f"--out {out} holds a results.json {what}, not a plan's ({PLAN_RESULTS_FORMAT}): "
+            raise InvalidValueError(f"--out {out} holds a results.json {what}, not a plan's ({PLAN_RESULTS_FORMAT}): "
                              f"{hint}.")
         own = True
     others = sorted(p.name for p in out.iterdir() if not p.name.startswith(".") and p.name != PLAN_DATASET)
     if others and not own:
         listed = ", ".join(others[:3]) + (", ..." if len(others) > 3 else "")
-        raise ValueError(f"--out {out} is not empty ({listed}) and holds no earlier plan's results or dataset: "
+        raise InvalidValueError(f"--out {out} is not empty ({listed}) and holds no earlier plan's results or dataset: "
                          f"{hint}.")
 
 
@@ -369,7 +374,8 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``affordance`` console script.
 
     A user error (a bad option, a path that cannot be used or written, a dataset that cannot be read or
-    extended, a missing optional package) is one line on stderr and exit status 2; a command-line mistake is
+    extended, a missing optional package: an error of the packages' ``exceptions`` modules or an ``OSError``) is
+    one line on stderr and exit status 2; a command-line mistake is
     found before any work starts (a value that cannot be used at all raises SystemExit(2) as it is parsed, the
     others are checked before the subcommand imports what it runs). Ctrl-C is one line and status 130, and what
     was finished is kept (a dataset's chunks: the same command resumes it). Anything else is a bug and keeps its
@@ -391,7 +397,7 @@ def main(argv: list[str] | None = None) -> int:
             print("affordance: interrupted; what was finished is kept (the same command resumes a collection "
                   "from its last finished chunk)", file=sys.stderr)
             return INTERRUPTED
-        except (ValueError, OSError, ImportError) as exc:  # FileNotFoundError, PermissionError: OSErrors
+        except (AffordanceEnvError, AffordanceLearningError, OSError) as exc:  # FileNotFoundError: an OSError
             print(f"affordance: error: {_one_line(exc)}", file=sys.stderr)
             return 2
 

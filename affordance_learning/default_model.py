@@ -34,6 +34,7 @@ import pandas as pd
 from numpy.typing import ArrayLike
 
 from affordance_learning.behaviors import check_behavior
+from affordance_learning.exceptions import DefaultModelError, DefaultModelMissingError, InvalidValueError
 from affordance_learning.model import AffordanceModel, EffectPrediction
 from affordance_learning.validation import first_non_finite
 
@@ -58,14 +59,6 @@ FORMAT = 3
 #: The command that rebuilds the default tap model (see :func:`rebuild_command` for the others).
 REBUILD_COMMAND = "affordance train-default"
 _N_FEATURES = 49
-
-
-class DefaultModelError(RuntimeError):
-    """A default model is unusable: unreadable, of another format or behaviour, or of other library versions."""
-
-
-class DefaultModelMissingError(DefaultModelError, FileNotFoundError):
-    """A default model file does not exist."""
 
 
 def user_model_dir() -> Path:
@@ -159,7 +152,7 @@ def train_default_model(
     names = _feature_names()
     missing = [c for n in names for c in (f"initial_{n}", f"effect_{n}") if c not in df.columns]
     if missing:
-        raise ValueError(
+        raise InvalidValueError(
             f"the dataset lacks {len(missing)} column(s) that the default model needs, e.g. {missing[:4]}; "
             "expected initial_<name> and effect_<name> for every name in affordance_env's FEATURE_NAMES."
         )
@@ -285,16 +278,16 @@ def predict_effect(
         names = _feature_names()
         missing = [n for n in names if n not in features.columns]
         if missing:
-            raise ValueError(
+            raise InvalidValueError(
                 f"the features DataFrame lacks {len(missing)} feature column(s), e.g. {missing[:4]}; "
                 "expected the names of affordance_env's FEATURE_NAMES."
             )
         features = features[names].to_numpy()
     X = np.asarray(features)
     if X.dtype == object or not (np.issubdtype(X.dtype, np.number) or X.dtype == bool) or np.iscomplexobj(X):
-        raise ValueError(f"features must be real numbers, got dtype {X.dtype}.")
+        raise InvalidValueError(f"features must be real numbers, got dtype {X.dtype}.")
     if X.ndim not in (1, 2) or X.shape[-1] != _N_FEATURES or (X.ndim == 2 and X.shape[0] == 0):
-        raise ValueError(
+        raise InvalidValueError(
             f"features must have shape ({_N_FEATURES},) or (n, {_N_FEATURES}) with n >= 1, got {X.shape}."
         )
     single = X.ndim == 1
@@ -302,7 +295,8 @@ def predict_effect(
     found = first_non_finite(X)
     if found:
         count, row, col, value = found
-        raise ValueError(f"features must be finite; row {row}, feature {col} is {value} ({count} non-finite value(s)).")
+        raise InvalidValueError(
+            f"features must be finite; row {row}, feature {col} is {value} ({count} non-finite value(s)).")
     model, names = _load_checked(path, behavior)
     prediction = model.predict_effect(pd.DataFrame(X, columns=list(names)))
     if single:  # one vector in, one result out

@@ -20,6 +20,7 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.ensemble import ExtraTreesRegressor, RandomForestRegressor
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.goals import Goal, Place
 
 
@@ -67,7 +68,7 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
     def fit(self, X, y):
         forests = {"random": RandomForestRegressor, "extra": ExtraTreesRegressor}
         if self.trees not in forests:
-            raise ValueError(f"trees must be one of {sorted(forests)}, got {self.trees!r}.")
+            raise InvalidValueError(f"trees must be one of {sorted(forests)}, got {self.trees!r}.")
         names = list(y.columns) if isinstance(y, pd.DataFrame) else None
         X, y = validate_data(self, X, y, multi_output=True, y_numeric=True, dtype=np.float64)
         y = np.asarray(y, dtype=np.float64)

@@ -32,6 +32,7 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.results import current_results
 
 _REQUIRED = ("uniformity", "svm_accuracy", "shape_fraction", "size_fraction", "n_selected", "case_studies")
@@ -295,7 +296,7 @@ def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: boo
     results = current_results(results)
     missing = [key for key in _REQUIRED if key not in results]
     if missing:
-        raise ValueError(f"results lack {missing}; expected the dict returned by run_protocol.")
+        raise InvalidValueError(f"results lack {missing}; expected the dict returned by run_protocol.")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     drawings = [

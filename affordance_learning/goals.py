@@ -25,18 +25,21 @@ from typing import Any
 
 import numpy as np
 
+from affordance_learning.exceptions import InvalidValueError
+
 
 def _column(outcomes: Any, name: str) -> np.ndarray:
     try:
         return np.asarray(outcomes[name])
     except (KeyError, IndexError):
-        raise ValueError(f"the outcomes lack {name!r} (an outcome table of affordance_learning.outcomes)") from None
+        raise InvalidValueError(
+            f"the outcomes lack {name!r} (an outcome table of affordance_learning.outcomes)") from None
 
 
 def _finite(name: str, value: Any, shape: tuple[int, ...] | None = None) -> np.ndarray:
     array = np.asarray(value, dtype=np.float64)
     if (shape is not None and array.shape != shape) or not np.all(np.isfinite(array)):
-        raise ValueError(f"{name} must be {'a finite number' if not shape else f'{shape} finite values'}, "
+        raise InvalidValueError(f"{name} must be {'a finite number' if not shape else f'{shape} finite values'}, "
                          f"got {value!r}.")
     return array
 
@@ -79,11 +82,11 @@ class Move:
     def __post_init__(self) -> None:
         d = _finite("direction", self.direction, (2,))
         if np.linalg.norm(d) < 1e-9:
-            raise ValueError(f"direction must be a non-zero (x, y) vector, got {self.direction!r}.")
+            raise InvalidValueError(f"direction must be a non-zero (x, y) vector, got {self.direction!r}.")
         object.__setattr__(self, "direction", tuple(float(v) for v in d / np.linalg.norm(d)))
         distance = float(_finite("min_distance", self.min_distance))
         if distance <= 0:
-            raise ValueError(f"min_distance must be a positive distance [m], got {self.min_distance!r}.")
+            raise InvalidValueError(f"min_distance must be a positive distance [m], got {self.min_distance!r}.")
         object.__setattr__(self, "min_distance", distance)
 
     def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
@@ -98,13 +101,13 @@ def check_start(start_xy: Any) -> np.ndarray:
     """``start_xy``, where the object was (x, y) [m], (2,) or (n, 2), as a float array; raises ValueError naming
     the value given otherwise (None included: a :class:`Place` goal cannot be judged without it)."""
     if start_xy is None:
-        raise ValueError("a Place goal needs start_xy, where the object is (x, y) [m]; got None.")
+        raise InvalidValueError("a Place goal needs start_xy, where the object is (x, y) [m]; got None.")
     try:
         start = np.asarray(start_xy, dtype=np.float64)
     except (TypeError, ValueError):
         start = np.full(1, np.nan)
     if start.ndim not in (1, 2) or start.shape[-1] != 2 or not np.all(np.isfinite(start)):
-        raise ValueError(f"start_xy must be where the object is, finite (x, y) [m] ((2,) or (n, 2)), got "
+        raise InvalidValueError(f"start_xy must be where the object is, finite (x, y) [m] ((2,) or (n, 2)), got "
                          f"{np.array2string(start, threshold=6) if start.size > 6 else start_xy!r} "
                          f"(shape {start.shape}).")
     return start
@@ -122,7 +125,7 @@ class Place:
         object.__setattr__(self, "target_xy", tuple(float(v) for v in _finite("target_xy", self.target_xy, (2,))))
         tolerance = float(_finite("tolerance", self.tolerance))
         if tolerance <= 0:
-            raise ValueError(f"tolerance must be a positive distance [m], got {self.tolerance!r}.")
+            raise InvalidValueError(f"tolerance must be a positive distance [m], got {self.tolerance!r}.")
         object.__setattr__(self, "tolerance", tolerance)
 
     def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
@@ -149,16 +152,16 @@ class Percept:
     def __post_init__(self) -> None:
         target = _finite("target_effect", self.target_effect)
         if target.ndim != 1 or target.size == 0:
-            raise ValueError(f"target_effect must be a vector of effect features, got shape {target.shape}.")
+            raise InvalidValueError(f"target_effect must be a vector of effect features, got shape {target.shape}.")
         object.__setattr__(self, "target_effect", tuple(float(v) for v in target))
         if self.scale is not None:
             scale = _finite("scale", self.scale, target.shape)
             if np.any(scale <= 0):
-                raise ValueError("scale must be positive for every feature.")
+                raise InvalidValueError("scale must be positive for every feature.")
             object.__setattr__(self, "scale", tuple(float(v) for v in scale))
         tolerance = float(_finite("tolerance", self.tolerance))
         if tolerance <= 0:
-            raise ValueError(f"tolerance must be positive, got {self.tolerance!r}.")
+            raise InvalidValueError(f"tolerance must be positive, got {self.tolerance!r}.")
         object.__setattr__(self, "tolerance", tolerance)
 
     def distance(self, effects: np.ndarray) -> np.ndarray:
@@ -174,7 +177,7 @@ class Percept:
             columns = [c for c in outcomes.columns if str(c).startswith("effect_")]
             effects = outcomes[columns].to_numpy(np.float64) if columns else None
         if effects is None or effects.shape[-1] != len(self.target_effect):
-            raise ValueError(f"the outcomes lack the {len(self.target_effect)} effect columns the target has.")
+            raise InvalidValueError(f"the outcomes lack the {len(self.target_effect)} effect columns the target has.")
         return self.distance(effects) <= self.tolerance
 
     def to_dict(self) -> dict[str, Any]:
@@ -200,12 +203,12 @@ def check_goal(goal: Any) -> Goal:
 def goal_from_dict(data: Mapping[str, Any]) -> Goal:
     """The goal ``goal.to_dict()`` wrote; an unknown kind or a wrong field raises ValueError naming it."""
     if not isinstance(data, Mapping) or data.get("kind") not in GOAL_KINDS:
-        raise ValueError(f"a goal must be a dict with 'kind' one of {sorted(GOAL_KINDS)}, got {data!r}.")
+        raise InvalidValueError(f"a goal must be a dict with 'kind' one of {sorted(GOAL_KINDS)}, got {data!r}.")
     fields = {k: v for k, v in data.items() if k != "kind"}
     try:
         return GOAL_KINDS[data["kind"]](**fields)
     except TypeError as exc:
-        raise ValueError(f"bad fields for a {data['kind']!r} goal: {exc}") from None
+        raise InvalidValueError(f"bad fields for a {data['kind']!r} goal: {exc}") from None
 
 
 def describe(goal: Goal) -> str:

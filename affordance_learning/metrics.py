@@ -16,18 +16,20 @@ from sklearn.pipeline import Pipeline, make_pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVC
 
+from affordance_learning.exceptions import InvalidValueError
+
 
 def _paired(clusters: ArrayLike, labels: ArrayLike, name: str) -> tuple[np.ndarray, np.ndarray]:
     clusters = np.asarray(clusters)
     labels = np.asarray(labels)
     if clusters.ndim != 1 or labels.ndim != 1 or clusters.shape != labels.shape or clusters.size == 0:
-        raise ValueError(
+        raise InvalidValueError(
             f"clusters and {name} must be non-empty 1-D arrays of the same length, got shapes "
             f"{clusters.shape} and {labels.shape}."
         )
     for label, values in (("clusters", clusters), (name, labels)):
         if values.dtype.kind == "f" and np.isnan(values).any():
-            raise ValueError(f"{label} contains NaN; expected a label for every instance.")
+            raise InvalidValueError(f"{label} contains NaN; expected a label for every instance.")
     return clusters, labels
 
 
@@ -36,7 +38,7 @@ def _as_success(success: np.ndarray) -> np.ndarray:
         return success
     values = np.unique(success)
     if values.dtype.kind not in "iuf" or not set(values.tolist()) <= {0, 1}:
-        raise ValueError(f"success must be boolean or 0/1, got values {values.tolist()[:10]}.")
+        raise InvalidValueError(f"success must be boolean or 0/1, got values {values.tolist()[:10]}.")
     return success.astype(bool)
 
 
@@ -120,12 +122,12 @@ def svm_cv_accuracy(
     X = np.asarray(X, dtype=np.float64)
     y = np.asarray(y)
     if X.ndim != 2 or y.shape != (X.shape[0],):
-        raise ValueError(f"X must be (n, d) and y (n,), got shapes {X.shape} and {y.shape}.")
+        raise InvalidValueError(f"X must be (n, d) and y (n,), got shapes {X.shape} and {y.shape}.")
     classes, counts = np.unique(y, return_counts=True)
     if classes.size < 2:
-        raise ValueError(f"y needs at least 2 classes for an SVM, got only {classes.tolist()}.")
+        raise InvalidValueError(f"y needs at least 2 classes for an SVM, got only {classes.tolist()}.")
     if counts.min() < n_splits:
-        raise ValueError(
+        raise InvalidValueError(
             f"every class needs at least n_splits={n_splits} members for stratified folds; class "
             f"{classes[np.argmin(counts)]!r} has {counts.min()}."
         )
@@ -172,9 +174,9 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
     sizes, success = _paired(np.asarray(sizes, dtype=np.float64), success, "success")
     success = _as_success(success)
     if not np.all(np.isfinite(sizes)):
-        raise ValueError("sizes must be finite [m].")
+        raise InvalidValueError("sizes must be finite [m].")
     if isinstance(n_bins, bool) or not isinstance(n_bins, int | np.integer) or n_bins < 1:
-        raise ValueError(f"n_bins must be an integer >= 1, got {n_bins!r}.")
+        raise InvalidValueError(f"n_bins must be an integer >= 1, got {n_bins!r}.")
     low, high = float(sizes.min()), float(sizes.max())
     edges = np.linspace(low, high, n_bins + 1) if high > low else np.array([low, high])
     index = np.clip(np.searchsorted(edges, sizes, side="right") - 1, 0, edges.size - 2)
@@ -232,7 +234,7 @@ def wilson_interval(successes: int, n: int, z: float = Z_95) -> tuple[float, flo
         (low, high), fractions in [0, 1].
     """
     if n < 0 or not 0 <= successes <= n:
-        raise ValueError(f"need 0 <= successes <= n, got {successes} of {n}.")
+        raise InvalidValueError(f"need 0 <= successes <= n, got {successes} of {n}.")
     if n == 0:
         return 0.0, 1.0
     p = successes / n

@@ -35,6 +35,7 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.utils import Tags
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.metrics import make_svm
 from affordance_learning.relieff import MULTICLASS_THRESHOLD, relieff_weights
 from affordance_learning.som import SOMClustering, som_seed
@@ -73,7 +74,7 @@ def select_features(weights: ArrayLike, relevancy: float) -> np.ndarray:
     """
     weights = np.asarray(weights, dtype=np.float64)
     if weights.ndim != 1 or weights.size == 0 or not np.all(np.isfinite(weights)):
-        raise ValueError(
+        raise InvalidValueError(
             f"weights must be a non-empty 1-D array of finite numbers, got shape {weights.shape}."
         )
     relevancy = _check_relevancy(relevancy)
@@ -89,7 +90,7 @@ def _check_relevancy(relevancy: object) -> float:
         or not np.isfinite(relevancy)
         or not 0.0 <= float(relevancy) <= 1.0
     ):
-        raise ValueError(
+        raise InvalidValueError(
             f"relevancy must be a number in [0, 1] (a share of the largest weight), got {relevancy!r}."
         )
     return float(relevancy)
@@ -103,7 +104,7 @@ def _check_int(name: str, value: object, low: int, high: int | None = None) -> i
         or (high is not None and value > high)
     ):
         bound = f"in [{low}, {high}]" if high is not None else f">= {low}"
-        raise ValueError(f"{name} must be an integer {bound}, got {value!r}.")
+        raise InvalidValueError(f"{name} must be an integer {bound}, got {value!r}.")
     return int(value)
 
 
@@ -170,18 +171,18 @@ class AffordanceModel(BaseEstimator):
         _check_int("som_n_init", self.som_n_init, 1)
         C = self.svm_C
         if isinstance(C, bool) or not isinstance(C, numbers.Real) or not np.isfinite(C) or C <= 0:
-            raise ValueError(f"svm_C must be a finite number > 0, got {C!r}.")
+            raise InvalidValueError(f"svm_C must be a finite number > 0, got {C!r}.")
         gamma = self.svm_gamma
         if isinstance(gamma, str):
             if gamma not in ("scale", "auto"):
-                raise ValueError(f"svm_gamma must be 'scale', 'auto' or a number > 0, got {gamma!r}.")
+                raise InvalidValueError(f"svm_gamma must be 'scale', 'auto' or a number > 0, got {gamma!r}.")
         elif (
             isinstance(gamma, bool)
             or not isinstance(gamma, numbers.Real)
             or not np.isfinite(gamma)
             or gamma <= 0
         ):
-            raise ValueError(f"svm_gamma must be 'scale', 'auto' or a number > 0, got {gamma!r}.")
+            raise InvalidValueError(f"svm_gamma must be 'scale', 'auto' or a number > 0, got {gamma!r}.")
 
     def fit(self, X: ArrayLike, y: ArrayLike) -> AffordanceModel:
         """Learn effect categories from the effects, and their prediction from the initial features.
@@ -260,9 +261,9 @@ class AffordanceModel(BaseEstimator):
         if E.ndim == 1:
             E = E[:, None]
         if E.ndim != 2 or E.shape[1] != self.n_effects_:
-            raise ValueError(f"effects must have {self.n_effects_} column(s), got shape {np.shape(y)}.")
+            raise InvalidValueError(f"effects must have {self.n_effects_} column(s), got shape {np.shape(y)}.")
         if not np.all(np.isfinite(E)):
-            raise ValueError("effects contain NaN or inf; expected finite values.")
+            raise InvalidValueError("effects contain NaN or inf; expected finite values.")
         return self.som_.predict(self.effect_scaler_.transform(E))
 
     def score(self, X: ArrayLike, y: ArrayLike) -> float:
@@ -270,7 +271,7 @@ class AffordanceModel(BaseEstimator):
         predicted = self.predict(X)
         observed = self.categorize_effects(y)
         if observed.shape != predicted.shape:
-            raise ValueError(f"X has {predicted.size} rows but y has {observed.size}.")
+            raise InvalidValueError(f"X has {predicted.size} rows but y has {observed.size}.")
         return float(np.mean(predicted == observed))
 
     def __sklearn_tags__(self) -> Tags:

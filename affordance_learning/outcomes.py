@@ -22,6 +22,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.schema import feature_names
 
 #: The motion columns of an outcome table, in order; the effect columns follow.
@@ -40,7 +41,7 @@ def outcome_table(frame: pd.DataFrame) -> pd.DataFrame:
               "behavior")
     missing = [c for c in needed if c not in frame.columns]
     if missing:
-        raise ValueError(f"the frame lacks {missing}: an outcome is read from the ground truth of a frame of "
+        raise InvalidValueError(f"the frame lacks {missing}: an outcome is read from the ground truth of a frame of "
                          "affordance_env.load_dataset (schema version 5 or later names).")
     names = feature_names(frame)
     table = pd.DataFrame(index=frame.index)
@@ -60,6 +61,7 @@ def model_inputs(frame: pd.DataFrame) -> np.ndarray:
     names = feature_names(frame)
     missing = [c for c in ACTION_COLUMNS if c not in frame.columns]
     if missing:
-        raise ValueError(f"the frame lacks the action columns {missing} (a frame of affordance_env.load_dataset).")
+        raise InvalidValueError(
+            f"the frame lacks the action columns {missing} (a frame of affordance_env.load_dataset).")
     return np.hstack([frame[[f"initial_{n}" for n in names]].to_numpy(np.float64),
                       frame[list(ACTION_COLUMNS)].to_numpy(np.float64)])

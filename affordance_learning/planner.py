@@ -20,6 +20,7 @@ from scipy.stats import qmc
 
 from affordance_learning.behaviors import BEHAVIORS
 from affordance_learning.effect_model import ActionEffectModel
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.goals import Goal, Place, check_goal, check_start
 
 #: An outcome that leaves the table counts as this far from any place [m] when actions are ranked by distance.
@@ -63,14 +64,14 @@ def table_extent() -> tuple[tuple[float, float], tuple[float, float]]:
 def _check_on_table(name: str, value, xy: np.ndarray) -> None:
     (x0, y0), (x1, y1) = table_extent()
     if xy.shape != (2,) or not np.all(np.isfinite(xy)) or not (x0 <= xy[0] <= x1 and y0 <= xy[1] <= y1):
-        raise ValueError(f"{name} must be (x, y) [m] on the table top, x in [{x0:.2f}, {x1:.2f}] and y in "
+        raise InvalidValueError(f"{name} must be (x, y) [m] on the table top, x in [{x0:.2f}, {x1:.2f}] and y in "
                          f"[{y0:.2f}, {y1:.2f}], got {value!r}.")
 
 
 def _check_start(start_xy) -> np.ndarray:
     start = check_start(start_xy)
     if start.shape != (2,):
-        raise ValueError(f"start_xy must be where the object is, one (x, y) [m], got shape {start.shape}.")
+        raise InvalidValueError(f"start_xy must be where the object is, one (x, y) [m], got shape {start.shape}.")
     return start
 
 
@@ -78,7 +79,7 @@ def candidate_params(n: int, random_state: int = 0) -> np.ndarray:
     """(n, 3) action parameters in [-1, 1]: the canonical action (zeros) and n - 1 points of a scrambled Sobol
     sequence seeded by ``random_state``."""
     if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
-        raise ValueError(f"n must be an integer >= 1, got {n!r}.")
+        raise InvalidValueError(f"n must be an integer >= 1, got {n!r}.")
     power = int(np.ceil(np.log2(max(2, n - 1))))  # Sobol's balance holds for powers of 2: the first n - 1 of them
     sobol = qmc.Sobol(3, scramble=True, seed=random_state).random_base2(power)[: n - 1]
     return np.vstack([np.zeros((1, 3)), 2.0 * sobol - 1.0])
@@ -129,19 +130,19 @@ class Planner:
     def __init__(self, models: Mapping[str, ActionEffectModel], n_candidates: int = 64, threshold: float = 0.5,
                  random_state: int = 0) -> None:
         if not models:
-            raise ValueError("models must map at least one behaviour name to its fitted ActionEffectModel.")
+            raise InvalidValueError("models must map at least one behaviour name to its fitted ActionEffectModel.")
         if not (isinstance(threshold, int | float) and 0.0 <= threshold <= 1.0):
-            raise ValueError(f"threshold must be a probability in [0, 1], got {threshold!r}.")
+            raise InvalidValueError(f"threshold must be a probability in [0, 1], got {threshold!r}.")
         unknown = [name for name in models if name not in BEHAVIORS]
         if unknown:
-            raise ValueError(f"Unknown behavior(s) {', '.join(map(repr, unknown))} in models. Valid behaviors: "
+            raise InvalidValueError(f"Unknown behavior(s) {', '.join(map(repr, unknown))} in models. Valid behaviors: "
                              f"{', '.join(BEHAVIORS)}.")
         for name, model in models.items():
             if not isinstance(model, ActionEffectModel) or not hasattr(model, "forest_"):
                 raise TypeError(f"models[{name!r}] must be a fitted ActionEffectModel, got {type(model).__name__}.")
         inputs = {name: model.n_features_in_ for name, model in models.items()}
         if len(set(inputs.values())) > 1:
-            raise ValueError(f"the models must take the same inputs, got {inputs} input columns per behaviour.")
+            raise InvalidValueError(f"the models must take the same inputs, got {inputs} input columns per behaviour.")
         self.models = dict(models)
         self.threshold = float(threshold)
         self.params = candidate_params(n_candidates, random_state)
@@ -152,11 +153,12 @@ class Planner:
         x = np.asarray(features, dtype=np.float64)
         if x.size != self.n_features or x.ndim > 2:
             named = " (affordance_env.FEATURE_NAMES)" if self.n_features == 49 else ""
-            raise ValueError(f"features must be the object's {self.n_features} feature values{named}, the models' "
+            raise InvalidValueError(
+                f"features must be the object's {self.n_features} feature values{named}, the models' "
                              f"inputs but the {self.params.shape[1]} action parameters; got shape {x.shape}.")
         x = x.ravel()
         if not np.all(np.isfinite(x)):
-            raise ValueError("features must be finite (the object must have been seen).")
+            raise InvalidValueError("features must be finite (the object must have been seen).")
         return np.hstack([np.repeat(x[None], len(self.params), axis=0), self.params])
 
     def scores(self, features: np.ndarray, goal: Goal, start_xy=None) -> dict[str, np.ndarray]:
@@ -212,7 +214,7 @@ class Planner:
                 ``OFF_TABLE_DISTANCE`` away when actions are ranked by distance. None: everywhere.
         """
         if isinstance(steps_left, bool) or not isinstance(steps_left, int | np.integer) or steps_left < 1:
-            raise ValueError(f"steps_left must be an integer >= 1, got {steps_left!r}.")
+            raise InvalidValueError(f"steps_left must be an integer >= 1, got {steps_left!r}.")
         goal = Place(target_xy, tolerance)
         target = np.asarray(goal.target_xy)
         _check_on_table("target_xy", target_xy, target)
@@ -280,7 +282,8 @@ class Planner:
         keys = list(states)
         for name in {n for n, _ in keys}:
             if len(self.models[name].effect_columns_) != len(features):
-                raise ValueError(f"the model of {name!r} has {len(self.models[name].effect_columns_)} effect columns "
+                raise InvalidValueError(
+                    f"the model of {name!r} has {len(self.models[name].effect_columns_)} effect columns "
                                  f"for {len(features)} features: looking ahead needs models fitted on outcome tables "
                                  "with the perceptual effect (affordance_learning.outcomes.outcome_table).")
         xy = np.array([ends[n][0][j] for n, j in keys])

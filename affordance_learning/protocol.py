@@ -51,6 +51,7 @@ from sklearn.preprocessing import StandardScaler
 
 from affordance_learning.behaviors import ROLLED_IS_SUCCESS, outcome_words
 from affordance_learning.diagnostics import effect_summary
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
 from affordance_learning.model import _check_int, select_features
 from affordance_learning.relieff import MULTICLASS_THRESHOLD, ReliefFScorer
@@ -84,10 +85,10 @@ class _Data:
 
 def _frame_data(frame: pd.DataFrame) -> _Data:
     if not isinstance(frame, pd.DataFrame):
-        raise ValueError(f"expected a pandas DataFrame in the dataset schema, got {type(frame).__name__}.")
+        raise InvalidValueError(f"expected a pandas DataFrame in the dataset schema, got {type(frame).__name__}.")
     for column in ("type", "size"):
         if column not in frame.columns:
-            raise ValueError(
+            raise InvalidValueError(
                 f"the frame has no {column!r} column (ground truth the protocol evaluates against)."
             )
     label = label_column(frame)
@@ -98,18 +99,18 @@ def _frame_data(frame: pd.DataFrame) -> _Data:
         found = first_non_finite(values)
         if found:
             count, row, col, value = found
-            raise ValueError(
+            raise InvalidValueError(
                 f"{count} non-finite value(s) in the {prefix} columns, the first in row {row}, "
                 f"column {prefix}{names[col]}: {value}; expected finite features."
             )
     success = frame[label].to_numpy()
     if success.dtype != bool:
         if not set(pd.unique(success).tolist()) <= {0, 1}:
-            raise ValueError(f"{label!r} must be boolean, got values {pd.unique(success).tolist()[:5]}.")
+            raise InvalidValueError(f"{label!r} must be boolean, got values {pd.unique(success).tolist()[:5]}.")
         success = success.astype(bool)
     sizes = frame["size"].to_numpy(dtype=np.float64)
     if not np.all(np.isfinite(sizes)):
-        raise ValueError("'size' must be finite [m] for every row.")
+        raise InvalidValueError("'size' must be finite [m] for every row.")
     scaler = StandardScaler().fit(E)
     return _Data(
         names=names,
@@ -246,24 +247,24 @@ def _check_protocol_args(
         isinstance(k, bool) or not isinstance(k, numbers.Integral) or not 2 <= k <= MULTICLASS_THRESHOLD
         for k in ks
     ):
-        raise ValueError(f"ks must be integers in [2, {MULTICLASS_THRESHOLD}] (map sizes), got {ks!r}.")
+        raise InvalidValueError(f"ks must be integers in [2, {MULTICLASS_THRESHOLD}] (map sizes), got {ks!r}.")
     if len(set(ks)) != len(ks):
-        raise ValueError(f"ks must not repeat a value, got {ks!r}.")
+        raise InvalidValueError(f"ks must not repeat a value, got {ks!r}.")
     relevancies = list(relevancies)
     if not relevancies or any(
         isinstance(r, bool) or not isinstance(r, numbers.Real) or not 0.0 <= r <= 1.0 for r in relevancies
     ):
-        raise ValueError(f"relevancies must be numbers in [0, 1], got {relevancies!r}.")
+        raise InvalidValueError(f"relevancies must be numbers in [0, 1], got {relevancies!r}.")
     if len({str(float(r)) for r in relevancies}) != len(relevancies):
-        raise ValueError(f"relevancies must not repeat a value, got {relevancies!r}.")
+        raise InvalidValueError(f"relevancies must not repeat a value, got {relevancies!r}.")
     if isinstance(n_trials, bool) or not isinstance(n_trials, numbers.Integral) or n_trials < 1:
-        raise ValueError(f"n_trials must be an integer >= 1, got {n_trials!r}.")
+        raise InvalidValueError(f"n_trials must be an integer >= 1, got {n_trials!r}.")
     if isinstance(random_state, bool) or not isinstance(random_state, numbers.Integral) or random_state < 0:
-        raise ValueError(
+        raise InvalidValueError(
             f"random_state must be an integer >= 0 (the protocol is always seeded), got {random_state!r}."
         )
     if isinstance(test_size, bool) or not isinstance(test_size, numbers.Real) or not 0.0 < test_size < 1.0:
-        raise ValueError(f"test_size must be a share in (0, 1), got {test_size!r}.")
+        raise InvalidValueError(f"test_size must be a share in (0, 1), got {test_size!r}.")
     _check_int("n_neighbors", n_neighbors, 1)
     _check_int("som_iterations", som_iterations, 1)
     return [int(k) for k in ks], [float(r) for r in relevancies]
@@ -330,7 +331,7 @@ def run_protocol(
     data = _frame_data(df)
     behavior = frame_behavior(df, behavior)
     if data.label == "rolled" and behavior not in ROLLED_IS_SUCCESS:
-        raise ValueError(
+        raise InvalidValueError(
             f"the frame has no 'success' column, and the success of {behavior!r} is not 'rolled' (that stands in "
             f"only for {', '.join(ROLLED_IS_SUCCESS)}): load the dataset with an affordance_env that stores or "
             "derives 'success' (dataset schema 4)."
@@ -339,7 +340,7 @@ def run_protocol(
     type_counts = pd.Series(data.types).value_counts()
     n_test = int(np.ceil(test_size * len(data.X)))
     if min(n_test, len(data.X) - n_test) < 2:
-        raise ValueError(
+        raise InvalidValueError(
             f"{len(data.X)} rows with test_size={test_size} leave {n_test} test and {len(data.X) - n_test} "
             "training rows; expected at least 2 of each."
         )

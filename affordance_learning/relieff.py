@@ -52,6 +52,7 @@ from scipy.spatial.distance import pdist, squareform
 from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.validation import first_non_finite
 
 #: Distance skrebate gives an instance to itself, so that it sorts after every other instance.
@@ -68,7 +69,7 @@ DataType = Literal["continuous", "discrete", "mixed", "constant"]
 
 def _check_n_neighbors(n_neighbors: object) -> int:
     if isinstance(n_neighbors, bool) or not isinstance(n_neighbors, int | np.integer) or n_neighbors < 1:
-        raise ValueError(
+        raise InvalidValueError(
             f"n_neighbors must be an integer >= 1 (neighbours per class), got {n_neighbors!r}; skrebate's "
             "float form (a fraction of the instances) is not replicated."
         )
@@ -78,16 +79,16 @@ def _check_n_neighbors(n_neighbors: object) -> int:
 def _check_features(X: ArrayLike) -> np.ndarray:
     X = np.asarray(X)
     if X.ndim != 2:
-        raise ValueError(f"X must be a 2-D array (n_samples, n_features), got shape {X.shape}.")
+        raise InvalidValueError(f"X must be a 2-D array (n_samples, n_features), got shape {X.shape}.")
     if X.shape[0] < 2 or X.shape[1] < 1:
-        raise ValueError(f"X needs at least 2 rows and 1 feature, got shape {X.shape}.")
+        raise InvalidValueError(f"X needs at least 2 rows and 1 feature, got shape {X.shape}.")
     if not (np.issubdtype(X.dtype, np.number) or X.dtype == bool) or np.iscomplexobj(X):
-        raise ValueError(f"X must hold real numbers, got dtype {X.dtype}.")
+        raise InvalidValueError(f"X must hold real numbers, got dtype {X.dtype}.")
     X = X.astype(np.float64)
     found = first_non_finite(X)
     if found:
         count, row, col, value = found
-        raise ValueError(
+        raise InvalidValueError(
             f"X has {count} non-finite value(s), the first X[{row}, {col}] = {value}; "
             "missing data (skrebate's NaN handling) is not replicated, expected finite values."
         )
@@ -108,7 +109,7 @@ class ReliefFScorer:
 
     def __init__(self, X: ArrayLike, *, discrete_threshold: int = DISCRETE_THRESHOLD) -> None:
         if isinstance(discrete_threshold, bool) or not isinstance(discrete_threshold, int | np.integer):
-            raise ValueError(f"discrete_threshold must be an integer, got {discrete_threshold!r}.")
+            raise InvalidValueError(f"discrete_threshold must be an integer, got {discrete_threshold!r}.")
         X = _check_features(X)
         self.X = X
         self.n_samples, self.n_features = X.shape
@@ -231,17 +232,17 @@ class ReliefFScorer:
         k = _check_n_neighbors(n_neighbors)
         y = np.asarray(y)
         if y.ndim != 1 or y.shape[0] != self.n_samples:
-            raise ValueError(
+            raise InvalidValueError(
                 f"y must be 1-D with one label per row of X ({self.n_samples}), got shape {y.shape}."
             )
         if y.dtype.kind == "f" and np.isnan(y).any():
-            raise ValueError("y contains NaN; expected a class label for every instance.")
+            raise InvalidValueError("y contains NaN; expected a class label for every instance.")
         classes, codes = np.unique(y, return_inverse=True)
         n_classes = classes.size
         if n_classes < 2:
-            raise ValueError(f"ReliefF needs at least 2 classes, but every label is {classes[0]!r}.")
+            raise InvalidValueError(f"ReliefF needs at least 2 classes, but every label is {classes[0]!r}.")
         if n_classes > MULTICLASS_THRESHOLD:
-            raise ValueError(
+            raise InvalidValueError(
                 f"y has {n_classes} classes; skrebate treats more than {MULTICLASS_THRESHOLD} distinct "
                 "labels as a continuous endpoint, which is not replicated here. Expected 2 to 10 classes."
             )

@@ -26,6 +26,7 @@ from affordance_learning.claims import (  # noqa: F401  (AGREES ... Claim: re-ex
     evaluate_claims,
     results_behavior,
 )
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.results import UNIFORMITY_DEFINITION, UNITS, current_results
 
 
@@ -241,7 +242,7 @@ def write_report(results: Mapping[str, Any], out_dir: str | Path) -> Path:
         The path of ``REPORT.md``.
     """
     if not isinstance(results, Mapping) or "uniformity" not in results:
-        raise ValueError("results must be the dict returned by run_protocol (it has no 'uniformity').")
+        raise InvalidValueError("results must be the dict returned by run_protocol (it has no 'uniformity').")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     figures = sorted(p.name for p in out.glob("*.png"))
@@ -325,7 +326,7 @@ def write_overview(runs: Mapping[str, Mapping[str, Any]], out_dir: str | Path) -
         The path of ``REPORT.md``.
     """
     if not runs or not all(isinstance(r, Mapping) and "uniformity" in r for r in runs.values()):
-        raise ValueError("runs must map each behaviour to the dict returned by run_protocol.")
+        raise InvalidValueError("runs must map each behaviour to the dict returned by run_protocol.")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     figures = {b: sorted(p.name for p in (out / b).glob("*.png")) for b in runs}

@@ -31,6 +31,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from affordance_learning.exceptions import InvalidValueError
+
 if TYPE_CHECKING:
     from affordance_env.dataset.fingerprint import FingerprintCheck
 
@@ -99,11 +101,11 @@ def reproduce(
     datasets = {b: Path(p) for b, p in (datasets or {}).items()}
     unknown = sorted(set(datasets) - set(behaviors))
     if unknown:
-        raise ValueError(f"datasets given for {unknown}, which are not run (behaviors {behaviors}).")
+        raise InvalidValueError(f"datasets given for {unknown}, which are not run (behaviors {behaviors}).")
     if episodes < 20:
-        raise ValueError(f"episodes must be at least 20 for the protocol's splits, got {episodes!r}.")
+        raise InvalidValueError(f"episodes must be at least 20 for the protocol's splits, got {episodes!r}.")
     if trials < 1:
-        raise ValueError(f"trials must be at least 1, got {trials!r}.")
+        raise InvalidValueError(f"trials must be at least 1, got {trials!r}.")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
@@ -192,7 +194,7 @@ def _collect_reference(where: Path, workers: int = 1) -> dict[str, Any]:
         config = json.loads((where / "results.json").read_text())["config"]
         behavior, seed = config["behavior"], int(config["seed"])
     except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise ValueError(f"{where} holds no results.json of `affordance reproduce` (with config.behavior and "
+        raise InvalidValueError(f"{where} holds no results.json of `affordance reproduce` (with config.behavior and "
                          f"config.seed): {exc}") from None
     env_options: dict[str, Any] = {"behavior": behavior}
     if config.get("range_noise", "none") != "none":
@@ -222,7 +224,7 @@ def check_fingerprint(where: str | Path, workers: int = 1) -> FingerprintCheck:
     try:
         expected = json.loads((where / FINGERPRINT).read_text())
     except (OSError, ValueError) as exc:
-        raise ValueError(f"{where / FINGERPRINT} cannot be read ({exc}); write it with `affordance fingerprint "
+        raise InvalidValueError(f"{where / FINGERPRINT} cannot be read ({exc}); write it with `affordance fingerprint "
                          f"{where}`.") from None
     return compare_fingerprints(expected, _collect_reference(where, workers))
 

@@ -16,6 +16,8 @@ import copy
 from collections.abc import Mapping
 from typing import Any
 
+from affordance_learning.exceptions import InvalidValueError
+
 #: Version of the results dict; raise it when the meaning or the unit of a key changes.
 RESULTS_FORMAT = 2
 UNITS = ("shares (uniformity, SVM accuracy and baseline, feature shares, success shares, purity) are fractions "
@@ -36,7 +38,8 @@ def current_results(results: Mapping[str, Any]) -> Mapping[str, Any]:
     if found == RESULTS_FORMAT:
         return results
     if found != 1:
-        raise ValueError(f"results of format {found!r}; this tap-affordance reads formats 1 to {RESULTS_FORMAT}: "
+        raise InvalidValueError(
+            f"results of format {found!r}; this tap-affordance reads formats 1 to {RESULTS_FORMAT}: "
                          "upgrade the package.")
     upgraded = copy.deepcopy(dict(results))
     for entry in upgraded.get("uniformity", {}).values():

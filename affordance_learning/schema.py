@@ -11,6 +11,8 @@ from collections.abc import Sequence
 
 import pandas as pd
 
+from affordance_learning.exceptions import InvalidValueError
+
 #: The object types of the paper, in the order figures and case studies list them.
 OBJECT_TYPES = ("sphere", "horizontal_cylinder", "box", "vertical_cylinder")
 #: Feature groups and their sizes in the order of ``FEATURE_NAMES`` (paper, section III.B).
@@ -36,13 +38,13 @@ def feature_names(frame: pd.DataFrame) -> list[str]:
         c.removeprefix("initial_") for c in frame.columns if isinstance(c, str) and c.startswith("initial_")
     ]
     if not names:
-        raise ValueError(
+        raise InvalidValueError(
             "the frame has no initial_<name> columns; expected the dataset schema (initial_, final_, effect_ "
             f"columns per feature), got columns {list(frame.columns)[:8]}..."
         )
     missing = [f"effect_{n}" for n in names if f"effect_{n}" not in columns]
     if missing:
-        raise ValueError(f"the frame lacks effect columns {missing[:5]} for its initial_ columns.")
+        raise InvalidValueError(f"the frame lacks effect columns {missing[:5]} for its initial_ columns.")
     return names
 
 
@@ -61,7 +63,7 @@ def feature_groups(names: Sequence[str]) -> list[str]:
     total = sum(size for _, size in GROUP_SIZES)
     if len(names) != total:
         unknown = [n for n in names if n not in FEATURE_GROUPS]
-        raise ValueError(
+        raise InvalidValueError(
             f"cannot tell the group of features {unknown[:5]}: they are not in affordance_env's "
             f"FEATURE_GROUPS and there are {len(names)} features, not the paper's {total} (24 shape, "
             "18 size, 7 relation)."
@@ -75,7 +77,7 @@ def label_column(frame: pd.DataFrame) -> str:
     for column in LABEL_COLUMNS:
         if column in frame.columns:
             return column
-    raise ValueError(
+    raise InvalidValueError(
         "the frame has no 'success' column (nor 'rolled', the tap's label in frames without it): the "
         "success/fail labels the protocol evaluates against."
     )
@@ -94,20 +96,20 @@ def frame_behavior(frame: pd.DataFrame, behavior: str | None = None) -> str:
             ``behavior`` column and ``behavior`` is None.
     """
     if behavior is not None and (not isinstance(behavior, str) or not behavior):
-        raise ValueError(f"behavior must be a behaviour name such as 'tap', got {behavior!r}.")
+        raise InvalidValueError(f"behavior must be a behaviour name such as 'tap', got {behavior!r}.")
     if "behavior" not in frame.columns:
         if behavior is None:
-            raise ValueError(
+            raise InvalidValueError(
                 "the frame has no 'behavior' column; pass the behaviour of its interactions (behavior='tap', "
                 "'grasp', ...)."
             )
         return behavior
     found = sorted(pd.unique(frame["behavior"].astype(str)).tolist())
     if len(found) != 1:
-        raise ValueError(
+        raise InvalidValueError(
             f"the frame mixes the behaviours {found}; the model learns one behaviour at a time (a separate "
             "map and SVM per behaviour): select one, e.g. frame[frame['behavior'] == 'tap']."
         )
     if behavior is not None and found[0] != behavior:
-        raise ValueError(f"the frame holds {found[0]!r} interactions, not {behavior!r} ones.")
+        raise InvalidValueError(f"the frame holds {found[0]!r} interactions, not {behavior!r} ones.")
     return found[0]

@@ -14,6 +14,8 @@ from numpy.typing import ArrayLike
 from sklearn.base import BaseEstimator, ClusterMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from affordance_learning.exceptions import InvalidValueError
+
 #: Largest seed minisom's ``numpy.random.RandomState`` accepts.
 _MAX_SEED = 2**32 - 1
 
@@ -28,13 +30,13 @@ def som_seed(random_state: int | np.random.RandomState | np.random.Generator | N
         return None
     if isinstance(random_state, numbers.Integral) and not isinstance(random_state, bool):
         if not 0 <= int(random_state) <= _MAX_SEED:
-            raise ValueError(f"random_state must be an integer in [0, 2**32 - 1], got {random_state!r}.")
+            raise InvalidValueError(f"random_state must be an integer in [0, 2**32 - 1], got {random_state!r}.")
         return int(random_state)
     if isinstance(random_state, np.random.RandomState):
         return int(random_state.randint(0, 2**31 - 1))
     if isinstance(random_state, np.random.Generator):
         return int(random_state.integers(0, 2**31 - 1))
-    raise ValueError(
+    raise InvalidValueError(
         f"random_state must be None, an integer, a numpy RandomState or Generator, got {random_state!r}."
     )
 
@@ -99,7 +101,7 @@ class SOMClustering(ClusterMixin, BaseEstimator):
         for name, low in (("n_clusters", 1), ("n_iterations", 1), ("n_init", 1)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
-                raise ValueError(f"{name} must be an integer >= {low}, got {value!r}.")
+                raise InvalidValueError(f"{name} must be an integer >= {low}, got {value!r}.")
         for name in ("sigma", "learning_rate"):
             value = getattr(self, name)
             if (
@@ -108,7 +110,7 @@ class SOMClustering(ClusterMixin, BaseEstimator):
                 or not np.isfinite(value)
                 or value <= 0
             ):
-                raise ValueError(f"{name} must be a finite number > 0, got {value!r}.")
+                raise InvalidValueError(f"{name} must be a finite number > 0, got {value!r}.")
 
     def fit(self, X: ArrayLike, y: object = None) -> SOMClustering:
         """Train the map on the rows of ``X`` (n_samples, n_features) and label them; returns ``self``.

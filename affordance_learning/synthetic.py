@@ -10,6 +10,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.schema import OBJECT_TYPES
 
 #: Behaviours :func:`make_synthetic_frame` can imitate, with their object size ranges [m].
@@ -43,9 +44,9 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
         behavior: ``"tap"`` or ``"grasp"`` (the ``behavior`` column).
     """
     if isinstance(n_rows, bool) or not isinstance(n_rows, numbers.Integral) or n_rows < 8:
-        raise ValueError(f"n_rows must be an integer >= 8, got {n_rows!r}.")
+        raise InvalidValueError(f"n_rows must be an integer >= 8, got {n_rows!r}.")
     if behavior not in SYNTHETIC_SIZE_RANGES:
-        raise ValueError(f"behavior must be one of {tuple(SYNTHETIC_SIZE_RANGES)}, got {behavior!r}.")
+        raise InvalidValueError(f"behavior must be one of {tuple(SYNTHETIC_SIZE_RANGES)}, got {behavior!r}.")
     grasp = behavior == "grasp"
     try:
         from affordance_env.features import FEATURE_NAMES

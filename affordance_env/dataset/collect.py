@@ -56,6 +56,7 @@ from affordance_env.dataset.format import (
     write_atomically,
     write_manifest,
 )
+from affordance_env.exceptions import InvalidValueError, MissingDependencyError
 from affordance_env.options import EnvOptions
 from affordance_env.progress import progress_bar, show_progress  # noqa: F401  (show_progress: re-exported)
 
@@ -73,7 +74,7 @@ def interaction_action(seed: int, episode: int, action: str) -> np.ndarray:
     if action == "canonical":
         return np.zeros(ACTION_DIM, dtype=np.float32)
     if action != "random":
-        raise ValueError(f"action must be one of {ACTIONS}, got {action!r}.")
+        raise InvalidValueError(f"action must be one of {ACTIONS}, got {action!r}.")
     rng = np.random.default_rng(np.random.SeedSequence([seed, episode, 1]))
     return rng.uniform(-1.0, 1.0, ACTION_DIM).astype(np.float32)
 
@@ -91,7 +92,7 @@ def goal_episode_actions(seed: int, episode: int, action: str) -> Iterator[dict[
     """The actions of goal episode ``episode``, step after step: a behaviour uniform over the four, and its
     parameters zeros (``"canonical"``) or uniform in [-1, 1]^3, all from ``SeedSequence([seed, episode, 1])``."""
     if action not in ACTIONS:
-        raise ValueError(f"action must be one of {ACTIONS}, got {action!r}.")
+        raise InvalidValueError(f"action must be one of {ACTIONS}, got {action!r}.")
     rng = np.random.default_rng(np.random.SeedSequence([seed, episode, 1]))
     while True:
         behavior = int(rng.integers(4))
@@ -218,7 +219,7 @@ def _full_options(env_options: dict[str, Any], env_id: str = ENV_IDS[0]) -> dict
     checked (:class:`~affordance_env.options.EnvOptions`) without building an env or importing the simulator.
     TapAffordanceGoal-v0 chooses the behaviour at every step: it has no ``behavior`` option."""
     if env_id == GOAL_ENV_ID and "behavior" in env_options:
-        raise ValueError(f"{GOAL_ENV_ID} chooses among all four behaviours at every step: drop the behavior "
+        raise InvalidValueError(f"{GOAL_ENV_ID} chooses among all four behaviours at every step: drop the behavior "
                          f"option (--behavior), got {env_options['behavior']!r}.")
     EnvOptions.checked(**env_options)
     full = {f.name: f.default for f in dataclasses.fields(EnvOptions)}
@@ -302,16 +303,16 @@ def collect(
     for name, value, low in (("episodes", episodes, 1), ("workers", workers, 1),
                              ("chunk_size", chunk_size, 1), ("seed", seed, 0)):
         if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
-            raise ValueError(f"{name} must be an integer >= {low}, got {value!r}.")
+            raise InvalidValueError(f"{name} must be an integer >= {low}, got {value!r}.")
     if action not in ACTIONS:
-        raise ValueError(f"action must be one of {ACTIONS}, got {action!r}.")
+        raise InvalidValueError(f"action must be one of {ACTIONS}, got {action!r}.")
     if isinstance(max_failure_share, bool) or not (isinstance(max_failure_share, int | float | np.floating)
                                                    and 0.0 <= max_failure_share <= 1.0):
-        raise ValueError(f"max_failure_share must be a share in [0, 1], got {max_failure_share!r}.")
+        raise InvalidValueError(f"max_failure_share must be a share in [0, 1], got {max_failure_share!r}.")
     if env_id not in ENV_IDS:
-        raise ValueError(f"env_id must be one of {ENV_IDS}, got {env_id!r}.")
+        raise InvalidValueError(f"env_id must be one of {ENV_IDS}, got {env_id!r}.")
     if scheduler not in SCHEDULERS:
-        raise ValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}.")
+        raise InvalidValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}.")
     if dask_address is not None:
         scheduler = "dask"
     options = _full_options(dict(env_options or {}), env_id)
@@ -456,8 +457,8 @@ def _run_dask(tasks: list[tuple], workers: int, address: str | None) -> Iterator
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError as exc:
-        raise ImportError("scheduler='dask' needs Dask distributed: pip install 'tap-affordance[dask]'"
-                          ) from exc
+        raise MissingDependencyError("scheduler='dask' needs Dask distributed: pip install "
+                                     "'tap-affordance[dask]'") from exc
     with contextlib.ExitStack() as stack:
         if address is None:
             address = stack.enter_context(

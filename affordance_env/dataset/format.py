@@ -40,6 +40,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from affordance_env.behaviors import ACTION_DIM
+from affordance_env.exceptions import DatasetError
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
 from affordance_env.fileio import write_atomically
 
@@ -75,10 +76,6 @@ GOAL_COLUMNS = ("goal_x", "goal_y", "achieved_x", "achieved_y", "goal_distance",
 #: one was made with that value.
 LATER_SETTINGS = {"env_id": "TapAffordance-v1"}
 LATER_ENV_OPTIONS = {"position_range": "canonical"}
-
-
-class DatasetError(ValueError):
-    """A dataset that cannot be read or extended, with the reason."""
 
 
 def arrow_schema(save_images: bool = False, goal: bool = False) -> pa.Schema:

@@ -32,6 +32,7 @@ from affordance_env.dataset.format import (
     is_goal_dataset,
     read_manifest,
 )
+from affordance_env.exceptions import InvalidValueError
 
 #: The names the columns of datasets of schema versions 1 to 4 had, where version 5 renamed them.
 _OLD_IMAGE_NAMES = {f"{stage}_{kind}": f"image_{stage}_{kind}" for stage in STAGES for kind in ("range", "mask")}
@@ -60,9 +61,9 @@ def images(frame: pd.DataFrame, column: str) -> np.ndarray:
     """
     if column not in IMAGE_COLUMNS:
         renamed = f" ({column!r} is named {_OLD_IMAGE_NAMES[column]!r} now)" if column in _OLD_IMAGE_NAMES else ""
-        raise ValueError(f"column must be one of {IMAGE_COLUMNS}, got {column!r}{renamed}.")
+        raise InvalidValueError(f"column must be one of {IMAGE_COLUMNS}, got {column!r}{renamed}.")
     if column not in frame.columns:
-        raise ValueError(f"the frame has no {column!r} column: collect with save_images=True (--save-images) "
+        raise InvalidValueError(f"the frame has no {column!r} column: collect with save_images=True (--save-images) "
                          "and load with load_dataset(path, with_images=True).")
     options = frame.attrs["manifest"]["settings"]["env_options"]
     shape = (int(options["camera_height"]), int(options["camera_width"]))
@@ -217,16 +218,16 @@ def learning_data(frame: pd.DataFrame, behavior: str | None = None) -> tuple[pd.
     missing = [f"{prefix}{n}" for prefix in (FEATURE_PREFIXES[0], FEATURE_PREFIXES[2]) for n in FEATURE_NAMES
                if f"{prefix}{n}" not in frame.columns]
     if missing:
-        raise ValueError(f"the frame lacks {len(missing)} feature column(s), e.g. {missing[:3]}; expected "
+        raise InvalidValueError(f"the frame lacks {len(missing)} feature column(s), e.g. {missing[:3]}; expected "
                          "initial_<f> and effect_<f> for every name f of FEATURE_NAMES (a frame of load_dataset).")
     found = sorted(pd.unique(frame["behavior"].astype(str))) if "behavior" in frame.columns else []
     if behavior is not None:
         if "behavior" in frame.columns:
             if behavior not in found:
-                raise ValueError(f"the frame holds no {behavior!r} interactions (it holds {found}).")
+                raise InvalidValueError(f"the frame holds no {behavior!r} interactions (it holds {found}).")
             frame = frame[frame["behavior"] == behavior]
     elif len(found) > 1:
-        raise ValueError(f"the frame mixes the behaviours {found}; pass behavior= one of them (one model per "
+        raise InvalidValueError(f"the frame mixes the behaviours {found}; pass behavior= one of them (one model per "
                          "behaviour).")
     X = frame[[f"initial_{n}" for n in FEATURE_NAMES]].set_axis(list(FEATURE_NAMES), axis=1)
     E = frame[[f"effect_{n}" for n in FEATURE_NAMES]].set_axis(list(FEATURE_NAMES), axis=1)

@@ -41,6 +41,7 @@ import numpy as np
 
 from affordance_env.dataset.format import GROUND_TRUTH_COLUMNS, POSE_FIELDS, STAGES, DatasetError, is_goal_dataset
 from affordance_env.dataset.load import images, load_dataset
+from affordance_env.exceptions import InvalidValueError, MissingDependencyError
 from affordance_env.features import FEATURE_NAMES
 
 #: Data formats Minari writes.
@@ -61,7 +62,7 @@ def _minari():
         import minari
         from minari.data_collector import EpisodeBuffer
     except ImportError as exc:
-        raise ImportError(
+        raise MissingDependencyError(
             "exporting to Minari needs the minari package: pip install 'tap-affordance[minari]'"
         ) from exc
     return minari, EpisodeBuffer
@@ -111,7 +112,7 @@ def check_dataset_id_form(dataset_id: str) -> None:
     with a version; Minari need not be installed."""
     problem = dataset_id_problem(dataset_id)
     if problem is not None:
-        raise ValueError(f"Minari dataset id {dataset_id!r} is malformed: expected {ID_FORM}; {problem}.")
+        raise InvalidValueError(f"Minari dataset id {dataset_id!r} is malformed: expected {ID_FORM}; {problem}.")
 
 
 def check_dataset_id(dataset_id: str) -> tuple[str | None, str, int]:
@@ -123,7 +124,7 @@ def check_dataset_id(dataset_id: str) -> tuple[str | None, str, int]:
     check_dataset_id_form(dataset_id)
     match = DATASET_ID_RE.fullmatch(dataset_id)
     if match is None or match.group("version") is None:  # the installed Minari has rules of its own
-        raise ValueError(f"Minari dataset id {dataset_id!r} is malformed: expected {ID_FORM}; the installed "
+        raise InvalidValueError(f"Minari dataset id {dataset_id!r} is malformed: expected {ID_FORM}; the installed "
                          "Minari refuses it.")
     return parse_dataset_id(dataset_id)
 
@@ -194,7 +195,7 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
         DatasetError: ``dataset`` is not a complete dataset.
     """
     if data_format not in DATA_FORMATS:
-        raise ValueError(f"data_format must be one of {DATA_FORMATS}, got {data_format!r}.")
+        raise InvalidValueError(f"data_format must be one of {DATA_FORMATS}, got {data_format!r}.")
     minari, EpisodeBuffer = _minari()
     namespace, _, _ = check_dataset_id(dataset_id)
     from minari.storage.datasets_root_dir import get_dataset_path
@@ -202,7 +203,7 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
     root = get_dataset_path()
     target = root / dataset_id
     if dataset_id in minari.list_local_datasets() or target.exists():
-        raise ValueError(f"a Minari dataset {dataset_id!r} exists already ({target}); delete it with "
+        raise InvalidValueError(f"a Minari dataset {dataset_id!r} exists already ({target}); delete it with "
                          f"`minari delete {dataset_id}` (or remove that directory) or choose another id.")
     frame = load_dataset(dataset, with_images=True)
     manifest = frame.attrs["manifest"]
