@@ -60,6 +60,7 @@ import numpy as np
 from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import matmul
 from affordance_env.objects import ObjectGeometry
+from affordance_env.registry import check_behavior_name
 from affordance_env.robot_model import HAND_OPEN
 
 ACTION_DIM = 3
@@ -219,10 +220,8 @@ def is_success(rule: str, rolled: bool | np.ndarray, displacement: float | np.nd
 
 
 def get_behavior(name: str) -> Behavior | GraspBehavior:
-    """The behaviour called ``name``; raises ValueError listing the valid names."""
-    if name not in BEHAVIORS:
-        raise InvalidValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
-    return BEHAVIORS[name]
+    """The behaviour called ``name``; raises InvalidValueError listing the valid names."""
+    return BEHAVIORS[check_behavior_name(name)]
 
 
 @dataclass(frozen=True)

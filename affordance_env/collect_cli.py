@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 from affordance_env.exceptions import InvalidValueError
+from affordance_env.registry import ENV_ID, ENV_IDS, GOAL_ENV_ID
 
 #: Command-line flags that are env options, and the env keyword each one sets.
 _ENV_FLAGS = ("behavior", "object_types", "size_range", "camera_width", "camera_height", "camera_fovy",
@@ -76,7 +77,7 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     parser.add_argument("--seed", type=non_negative_int, default=0, help="dataset seed (default 0)")
     parser.add_argument("--workers", type=positive_int, default=1,
                         help="worker processes, or workers of the local Dask cluster (default 1)")
-    parser.add_argument("--env", default="TapAffordance-v1", choices=("TapAffordance-v1", "TapAffordanceGoal-v0"),
+    parser.add_argument("--env", default=ENV_ID, choices=ENV_IDS,
                         dest="env_id",
                         help="TapAffordance-v1: one interaction per episode; TapAffordanceGoal-v0: goal episodes of "
                              "up to 5 interactions, a reachable behaviour and parameters drawn at each, one row per "
@@ -142,7 +143,6 @@ def check_collect_args(args: argparse.Namespace) -> None:
     and before anything is built or written: ValueError naming the options. (Each value alone is checked as it is
     parsed.)"""
     from affordance_env.options import EnvOptions
-    from affordance_env.registration import GOAL_ENV_ID
 
     if args.scheduler == "joblib" and args.dask_address is not None:
         raise InvalidValueError("--dask-address runs on Dask: drop --scheduler joblib (or use --scheduler dask).")
@@ -188,7 +188,7 @@ def run_collect(args: argparse.Namespace) -> int:
     details = ""
     if failures["count"]:
         details = f" ({failure_summary(failures['episodes'])}; all reasons in {out / MANIFEST})"
-    if manifest["settings"].get("env_id") == "TapAffordanceGoal-v0":
+    if manifest["settings"].get("env_id") == GOAL_ENV_ID:
         print(f"{out}: {manifest['episodes']} goal episodes, {manifest['rows']} interactions written; "
               f"{failures['count']} episodes ended at a failed interaction, left out{details}; {elapsed:.1f} s")
     else:

@@ -12,13 +12,14 @@ from gymnasium import spaces
 from affordance_env.behaviors import ACTION_DIM, check_action
 from affordance_env.exceptions import InvalidValueError
 from affordance_env.options import EnvOptions
+from affordance_env.registry import BEHAVIOR_ARMS, BEHAVIOR_NAMES
 from affordance_env.tap_env import RESET_OPTIONS, TapAffordanceEnv
 from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
 
-#: The behaviours, in the order of the action's ``behavior`` index.
-BEHAVIORS: tuple[str, ...] = ("tap", "tap_back", "push", "grasp")
+#: The behaviours, in the order of the action's ``behavior`` index (:mod:`affordance_env.registry`).
+BEHAVIORS: tuple[str, ...] = BEHAVIOR_NAMES
 #: The arm that does each behaviour.
-ARM_OF: Mapping[str, str] = {"tap": "right", "tap_back": "right", "push": "right", "grasp": "left"}
+ARM_OF: Mapping[str, str] = BEHAVIOR_ARMS
 #: Keys of ``reset(options=...)``.
 GOAL_RESET_OPTIONS = ("goal", *RESET_OPTIONS)
 #: Goals are drawn this far from the object [m] ...

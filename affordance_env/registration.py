@@ -1,4 +1,4 @@
-"""Gymnasium registration of the TapAffordance environments (the one place ids are defined)."""
+"""Gymnasium registration of the TapAffordance environments (their ids: :mod:`affordance_env.registry`)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,8 @@ from typing import Any
 import gymnasium as gym
 
 from affordance_env.exceptions import InvalidValueError
+from affordance_env.registry import ENV_ID, GOAL_ENV_ID
 
-ENV_ID = "TapAffordance-v1"
-GOAL_ENV_ID = "TapAffordanceGoal-v0"
 #: Interactions per episode of the goal env, after which it is truncated.
 GOAL_MAX_EPISODE_STEPS = 5
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+from affordance_env.registry import BEHAVIOR_NAMES, check_behavior_name
 from affordance_learning.exceptions import InvalidValueError
 
 #: Per behaviour, how its success and its failure read: ``(success, failure)``.
@@ -18,8 +19,9 @@ OUTCOME_WORDS: dict[str, tuple[str, str]] = {
     "tap_back": ("rolled", "did not roll"),
     "push": ("moved", "did not move"),
 }
-#: The behaviours of the environment, in the order reports list them: the paper's two, then the others.
-BEHAVIORS: tuple[str, ...] = tuple(OUTCOME_WORDS)
+#: The behaviours of the environment (:mod:`affordance_env.registry`), in the order reports list them: the
+#: paper's two, then the others.
+BEHAVIORS: tuple[str, ...] = ("tap", "grasp", *(name for name in BEHAVIOR_NAMES if name not in ("tap", "grasp")))
 #: How the ``rolled`` label reads: the label of a frame that has no ``success`` column.
 ROLLED_WORDS = ("rolled", "did not roll")
 #: The behaviours whose success is ``rolled``: only their frames may stand in ``rolled`` for a missing ``success``.
@@ -29,10 +31,8 @@ GENERIC_WORDS = ("success", "fail")
 
 
 def check_behavior(behavior: str) -> str:
-    """``behavior`` if it is one of :data:`BEHAVIORS`; raises ValueError naming the valid ones otherwise."""
-    if behavior not in BEHAVIORS:
-        raise InvalidValueError(f"Unknown behavior {behavior!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
-    return behavior
+    """``behavior`` if it is one of :data:`BEHAVIORS`; raises InvalidValueError naming the valid ones otherwise."""
+    return check_behavior_name(behavior)
 
 
 def check_env_offers(behaviors: Iterable[str], hint: str = "") -> list[str]:

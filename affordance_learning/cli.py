@@ -23,6 +23,7 @@ from affordance_env.collect_cli import (
     positive_int,
 )
 from affordance_env.exceptions import AffordanceEnvError
+from affordance_env.registry import ENV_ID
 from affordance_learning.exceptions import AffordanceLearningError, InvalidValueError
 
 #: The sizes of ``affordance plan`` (:class:`~affordance_learning.plan_experiment.PlanSettings`' defaults), for its
@@ -60,7 +61,7 @@ def _demo(args: argparse.Namespace) -> int:
     kwargs = {"behavior": args.behavior}
     if args.object:
         kwargs["object_types"] = (args.object,)
-    env = gym.make("TapAffordance-v1", **kwargs)
+    env = gym.make(ENV_ID, **kwargs)
     print(f"TapAffordance-v1, behavior={args.behavior!r}: {args.episodes} interaction(s) from seed {args.seed}")
     start = time.perf_counter()
     for i in range(args.episodes):
@@ -182,9 +183,9 @@ def _dataset_kind(manifest: object) -> str:
     if not isinstance(manifest, dict) or manifest.get("format") != FORMAT:
         return f"a {MANIFEST} that is not a TapAffordance dataset's"
     settings = manifest.get("settings") if isinstance(manifest.get("settings"), dict) else {}
-    env_id = settings.get("env_id", "TapAffordance-v1")
+    env_id = settings.get("env_id", ENV_ID)
     options = settings.get("env_options") if isinstance(settings.get("env_options"), dict) else {}
-    what = f"{options.get('behavior', 'tap')} interactions" if env_id == "TapAffordance-v1" else "episodes"
+    what = f"{options.get('behavior', 'tap')} interactions" if env_id == ENV_ID else "episodes"
     return (f"a {env_id} dataset of {manifest.get('episodes', '?')} {what} with {settings.get('action', '?')} "
             f"actions, seed {settings.get('seed', '?')}")
 

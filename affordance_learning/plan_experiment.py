@@ -45,12 +45,13 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
 from affordance_learning.effect_model import ActionEffectModel
 from affordance_learning.goals import Goal, Lift, Move, Place, Roll, goal_from_dict
 from affordance_learning.outcomes import model_inputs, outcome_table
 from affordance_learning.planner import Planner, candidate_params
 
-BEHAVIORS = ("tap", "tap_back", "push", "grasp")
+BEHAVIORS = BEHAVIOR_NAMES
 GOAL_KINDS = ("roll", "lift", "move", "place")
 SHAPES = ("sphere", "box", "horizontal_cylinder", "vertical_cylinder")
 POLICIES = ("planner", "random", "best_fixed", "canonical_choice", "som_categories", "oracle")
@@ -444,7 +445,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
     start = time.perf_counter()
     say(f"[1/5] collecting {settings.episodes} goal episodes with random actions into {out / 'dataset'}")
     collect(out / "dataset", settings.episodes, seed=seed, workers=workers, action="random",
-            env_id="TapAffordanceGoal-v0",
+            env_id=GOAL_ENV_ID,
             env_options={"position_range": "workspace", "camera_width": camera[0], "camera_height": camera[1]},
             max_failure_share=1.0, chunk_size=25)
     frame = load_dataset(out / "dataset")

@@ -98,7 +98,7 @@ def test_train_default_checks_the_behaviour_before_collecting(tmp_path, capsys, 
     from affordance_env.dataset.format import FORMAT, MANIFEST, SCHEMA_VERSION
 
     assert main(["train-default", "--behavior", "juggle", "--dataset", str(tmp_path / "d")]) == 2
-    assert "Unknown behavior 'juggle'. Valid behaviors: tap, grasp" in capsys.readouterr().err
+    assert "Unknown behavior 'juggle'. Valid behaviors: tap, tap_back, push, grasp" in capsys.readouterr().err
     taps = tmp_path / "taps"
     taps.mkdir()
     (taps / MANIFEST).write_text(json.dumps({"format": FORMAT, "schema_version": SCHEMA_VERSION, "episodes": 6,

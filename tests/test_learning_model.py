@@ -562,7 +562,7 @@ def test_each_behaviour_has_its_own_default_model(tmp_path: object, monkeypatch:
 
 
 def test_default_models_refuse_unknown_behaviours_and_other_behaviours_data(tmp_path: object) -> None:
-    with pytest.raises(ValueError, match="Unknown behavior 'juggle'. Valid behaviors: tap, grasp, tap_back, push"):
+    with pytest.raises(ValueError, match="Unknown behavior 'juggle'. Valid behaviors: tap, tap_back, push, grasp"):
         predict_effect(np.zeros(49), "juggle")
     with pytest.raises(ValueError, match="Unknown behavior 'juggle'"):
         load_default_model(behavior="juggle")

@@ -43,6 +43,7 @@ from affordance_env.behaviors import ACTION_DIM
 from affordance_env.exceptions import DatasetError
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
 from affordance_env.fileio import write_atomically
+from affordance_env.registry import ENV_IDS, GOAL_ENV_ID
 
 #: Version of the on-disk format; :func:`~affordance_env.dataset.load_dataset` reads versions 1 up to this one.
 #: Version 4 added the ``success`` column. Version 5 named the object's pose ``true_initial_x`` ... (it was
@@ -67,8 +68,6 @@ IMAGE_COLUMNS = tuple(f"image_{stage}_{kind}" for stage in STAGES for kind in ("
 #: The manifest's record of each finished chunk's SHA-256 (hex), by file name.
 CHECKSUMS = "chunk_sha256"
 #: The environments a dataset can be collected from: one interaction per episode, or goal episodes of several.
-ENV_IDS = ("TapAffordance-v1", "TapAffordanceGoal-v0")
-GOAL_ENV_ID = "TapAffordanceGoal-v0"
 #: The goal columns of a dataset of TapAffordanceGoal-v0 episodes: the goal (x, y) [m], where the object was seen
 #: after the interaction (``achieved_goal``) [m], its distance to the goal [m] and whether it reached it.
 GOAL_COLUMNS = ("goal_x", "goal_y", "achieved_x", "achieved_y", "goal_distance", "goal_reached")

@@ -1,0 +1,37 @@
+"""One registry of names: every part of the package offers exactly the behaviours and environments it lists."""
+
+import gymnasium as gym
+import pytest
+
+from affordance_env import registry
+from affordance_env.behaviors import BEHAVIORS as ENV_BEHAVIORS
+from affordance_env.dataset.format import ENV_IDS
+from affordance_env.goal_env import ARM_OF
+from affordance_env.goal_env import BEHAVIORS as GOAL_BEHAVIORS
+from affordance_env.interactions import INTERACTIONS
+from affordance_learning.behaviors import BEHAVIORS as LEARNING_BEHAVIORS
+from affordance_learning.behaviors import OUTCOME_WORDS, check_behavior
+from affordance_learning.plan_experiment import BEHAVIORS as PLAN_BEHAVIORS
+
+
+def test_every_part_offers_the_registrys_behaviours():
+    names = registry.BEHAVIOR_NAMES
+    assert tuple(ENV_BEHAVIORS) == names and tuple(INTERACTIONS) == names
+    assert GOAL_BEHAVIORS == names and dict(ARM_OF) == dict(registry.BEHAVIOR_ARMS) and PLAN_BEHAVIORS == names
+    assert sorted(LEARNING_BEHAVIORS) == sorted(names) and sorted(OUTCOME_WORDS) == sorted(names)
+    assert set(registry.BEHAVIOR_ARMS.values()) <= {"right", "left"}
+
+
+def test_every_registered_id_is_a_gymnasium_env():
+    import affordance_env  # noqa: F401  (registers them)
+
+    assert ENV_IDS == registry.ENV_IDS and all(env_id in gym.registry for env_id in registry.ENV_IDS)
+
+
+@pytest.mark.parametrize("check", [registry.check_behavior_name, check_behavior])
+def test_an_unknown_name_is_refused_with_the_valid_ones(check):
+    assert check("push") == "push"
+    with pytest.raises(ValueError, match="Unknown behavior 'kick'. Valid behaviors: tap, tap_back, push, grasp"):
+        check("kick")
+    with pytest.raises(ValueError, match="Valid ids: TapAffordance-v1, TapAffordanceGoal-v0"):
+        registry.check_env_id("TapAffordance-v0")
