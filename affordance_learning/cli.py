@@ -242,7 +242,12 @@ def _check_plan_out(out: Path, seed: int) -> None:
 def _plan(args: argparse.Namespace) -> int:
     _check_plan_out(args.out, args.seed)
     from affordance_learning.plan_experiment import PlanSettings, record_episode, run_plan
-    from affordance_learning.plan_report import measured_targets, target_met, write_plan_figures, write_plan_report
+    from affordance_learning.plan_report import (
+        measured_targets,
+        target_verdict,
+        write_plan_figures,
+        write_plan_report,
+    )
 
     settings = PlanSettings(**{name: getattr(args, name) for name in PLAN_DEFAULTS
                                if getattr(args, name) is not None})
@@ -250,9 +255,11 @@ def _plan(args: argparse.Namespace) -> int:
     frames = record_episode(args.out, results, seed=args.seed)
     write_plan_figures(results, args.out, frames)
     report = write_plan_report(results, args.out)
-    met = {name: target_met(name, value) for name, value in measured_targets(results).items()}
-    print(f"{sum(bool(v) for v in met.values())} of {len(met)} targets met; {report} says why each other is missed; "
-          f"{args.out / 'results.json'} holds every number ({results['timings_s']['total'] / 60:.1f} min)")
+    verdicts = [target_verdict(name, value) for name, value in measured_targets(results).items()]
+    counts = ", ".join(f"{verdicts.count(v)} {v}" for v in dict.fromkeys(verdicts))
+    print(f"{len(verdicts)} targets: {counts} (a verdict only on enough data); {report} gives each with its n and "
+          f"why a missed one is missed; {args.out / 'results.json'} holds every number "
+          f"({results['timings_s']['total'] / 60:.1f} min)")
     return 0
 
 
