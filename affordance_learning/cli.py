@@ -149,13 +149,15 @@ def _fingerprint(args: argparse.Namespace) -> int:
 
 
 def _compare(args: argparse.Namespace) -> int:
-    from affordance_learning.agreement import compare_results
+    from affordance_learning.agreement import UNSTABLE_SPREAD, compare_results
 
     found = [_results_of(where) for where in (args.reference, args.found)]
     comparisons = compare_results(*found)
     outside = [c for c in comparisons if not c.ok]
-    print(f"{args.found} against {args.reference}: {len(comparisons) - len(outside)} of {len(comparisons)} numbers "
-          "within their tolerances")
+    held = [c for c in comparisons if c.held]
+    print(f"{args.found} against {args.reference}: {len(held) - len(outside)} of {len(held)} numbers within their "
+          f"tolerances; {len(comparisons) - len(held)} whose trials spread by more than "
+          f"{100 * UNSTABLE_SPREAD:.0f} points are shown, not held to one")
     for comparison in comparisons:
         print(f"  {comparison}")
     return 1 if outside else 0

@@ -34,10 +34,11 @@ PARTS = ("action", "truth", "initial", "final", "effect")
 #: algebra, the robot's model) or of the learning on it.
 PACKAGES = ("mujoco", "numpy", "pin", "eigenpy", "icub-models", "scipy", "scikit-learn")
 #: Across machines or versions, interactions of a fingerprint whose outcome label (failed, success, outcome) may
-#: differ. Measured between OpenBLAS's Haswell and SkylakeX kernels (two CPUs, the same versions), before the
-#: simulation's linear algebra was made independent of them: of 1000 canonical interactions, 0 taps and 5 grasps
-#: changed their success label (none of the first 30). At 0.5 %, more than 2 of 30 change with probability 5e-4.
-MAX_LABEL_CHANGES = 2
+#: differ. Measured over 1000 canonical interactions: between OpenBLAS's Haswell and SkylakeX kernels (two CPUs, the
+#: same versions, before the simulation's linear algebra was made independent of them) 0 taps and 5 grasps changed
+#: their success label; between MuJoCo 3.17 and 4.0, 0 taps and 27 grasps (2.7 %; 2 of the first 30). At 2.7 %,
+#: more than 4 of 30 change with probability 0.1 %.
+MAX_LABEL_CHANGES = 4
 
 
 def made_with() -> dict[str, Any]:
