@@ -16,7 +16,15 @@ import numpy as np
 
 from affordance_env.behaviors import GraspPlan
 from affordance_env.kinematics import IKResult
-from affordance_env.motion import CONTROL_DT, MIN_MOVE_TIME, MotionExecutor, ReachOutcome, ik_verdict, object_at_rest
+from affordance_env.motion import (
+    CONTROL_DT,
+    MIN_MOVE_TIME,
+    HandTarget,
+    MotionExecutor,
+    ReachOutcome,
+    ik_verdict,
+    object_at_rest,
+)
 from affordance_env.trajectory import minimum_jerk
 
 #: Speed of the grasp's guarded moves [m/s]: the hand's final approach to the object, with its lowest point
@@ -113,12 +121,18 @@ def move_fingers(motion: MotionExecutor, hand: Mapping[str, float], speed_scale:
         physics.limit_torques(fingers, None)
 
 
+def hand_target(plan: GraspPlan) -> HandTarget:
+    """How the IK holds the hand through the grasp: the plan's palm orientation, the joints' own ranges."""
+    return HandTarget(plan.R_world_hand)
+
+
 def grasp_poses(motion: MotionExecutor, plan: GraspPlan) -> list[IKResult]:
     """IK of the grasp's poses above the object, at the grasp and lifted, the hand open."""
+    hand = hand_target(plan)
     q_open = with_hand(motion, motion.physics.joint_targets(), plan.hand_open)
-    results = [motion.ik(plan.p_above, q_open, plan)]
+    results = [motion.ik(plan.p_above, q_open, hand)]
     for p in (plan.p_grasp, plan.p_lift):
-        results.append(motion.ik(p, results[-1].q, plan))
+        results.append(motion.ik(p, results[-1].q, hand))
     return results
 
 
@@ -127,12 +141,13 @@ def grasp_reachable(motion: MotionExecutor, plan: GraspPlan) -> bool:
     the lift and the put-down beside); kinematics only. The descent stops at the first touch, anywhere between
     the pose above and the grasp pose, and the lift rises from there: the lifts from both ends are checked."""
     above, at, lifted = grasp_poses(motion, plan)
-    descent = motion.line(plan.p_above, plan.p_grasp, plan, GUARDED_SPEED, q_start=above.q)
-    lift = motion.line(plan.p_grasp, plan.p_lift, plan, LIFT_SPEED, q_start=at.q)
-    high_lift = motion.line(plan.p_above, plan.p_above + (plan.p_lift - plan.p_grasp), plan, LIFT_SPEED,
+    hand = hand_target(plan)
+    descent = motion.line(plan.p_above, plan.p_grasp, hand, GUARDED_SPEED, q_start=above.q)
+    lift = motion.line(plan.p_grasp, plan.p_lift, hand, LIFT_SPEED, q_start=at.q)
+    high_lift = motion.line(plan.p_above, plan.p_above + (plan.p_lift - plan.p_grasp), hand, LIFT_SPEED,
                             q_start=above.q)
     place = motion.ik(np.array([plan.p_place[0], plan.p_place[1], plan.p_grasp[2] + PLACE_APPROACH]), lifted.q,
-                     plan)
+                      hand)
     return ik_verdict([above, at, lifted, *descent.results, *lift.results, *high_lift.results, place])[0]
 
 
@@ -141,6 +156,7 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
     pose, close the hand, lift, hold; if the object is held, carry it beside and put it down until it rests on
     the table; open the hand once the object rests. Not the way home, which rises first (``q_retreat``)."""
     physics = motion.physics
+    hand = hand_target(plan)
     results = grasp_poses(motion, plan)
     z_start = float(physics.object_pose()[2])
     # Reach: to above the object, fast, the hand open.
@@ -149,7 +165,7 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
     motion.settle(plan.p_above, tolerance=0.005)
     # Descend: slowly, stopping at the first touch.
     motion.phase = "descend"
-    descent = motion.line(plan.p_above, plan.p_grasp, plan, GUARDED_SPEED)
+    descent = motion.line(plan.p_above, plan.p_grasp, hand, GUARDED_SPEED)
     results += descent.results
     touch = motion.follow_line(descent, physics.hand_touches_object)
     # Close: the fingers at the plan's share of their speed limit, until their motors' torque holds the object.
@@ -157,7 +173,7 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
     move_fingers(motion, plan.hand_closed, plan.close_speed, until_held=True)
     motion.phase = "lift"
     p_from = motion.palm.copy()
-    lift = motion.line(p_from, p_from + (plan.p_lift - plan.p_grasp), plan, LIFT_SPEED)
+    lift = motion.line(p_from, p_from + (plan.p_lift - plan.p_grasp), hand, LIFT_SPEED)
     results += lift.results
     motion.follow_line(lift)
     motion.phase = "hold"
@@ -172,7 +188,7 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
         # where the object would touch the table, from how far it has risen with the hand
         z_touch = float(motion.palm[2]) - (float(physics.object_pose()[2]) - z_start)
         p_carry = np.array([plan.p_place[0], plan.p_place[1], z_touch + PLACE_APPROACH])
-        carry = motion.ik(p_carry, physics.joint_targets(), plan)
+        carry = motion.ik(p_carry, physics.joint_targets(), hand)
         results.append(carry)
         motion.move_through([carry.q])
         # Place: down until the object meets the table (sensed as the arm's load leaving it), then still until
@@ -181,14 +197,14 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
         motion.phase = "place"
         p_hand = motion.palm.copy()
         p_low = p_hand - np.array([0.0, 0.0, PLACE_APPROACH + PLACE_OVERTRAVEL])
-        down = motion.line(p_hand, p_low, plan, GUARDED_SPEED)
+        down = motion.line(p_hand, p_low, hand, GUARDED_SPEED)
         placed = motion.follow_line(down, lambda: physics.object_touches_table()
                                   or physics.hand_touches_table()).touched and physics.object_touches_table()
         if not placed:  # the fingers under the object met the table: they loosen and yield as the hand goes on
             fingers = np.array([motion.kinematics.joint_names.index(name) for name in plan.hand_closed])
             physics.limit_torques(fingers, CLOSING_TORQUE)
             p_hand = motion.palm.copy()
-            on_down = motion.line(p_hand, p_hand - np.array([0.0, 0.0, PLACE_OVERTRAVEL]), plan, GUARDED_SPEED)
+            on_down = motion.line(p_hand, p_hand - np.array([0.0, 0.0, PLACE_OVERTRAVEL]), hand, GUARDED_SPEED)
             placed = motion.follow_line(on_down, physics.object_touches_table).touched
             physics.limit_torques(fingers, None)
         motion.hold_still(also=object_at_rest)
@@ -200,6 +216,6 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
     release_time = float(physics.data.time)
     # The way home rises first: straight up from where the hand let go.
     p_up = motion.palm.copy() + np.array([0.0, 0.0, plan.p_retreat[2] - plan.p_place[2]])
-    retreat = motion.ik(p_up, physics.joint_targets(), plan)
+    retreat = motion.ik(p_up, physics.joint_targets(), hand)
     return GraspOutcome(*ik_verdict(results), touch.touched, touch.time, touch.speed, rise, holding,
                         on_table, release_time, placed, retreat.q)

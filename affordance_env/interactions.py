@@ -37,7 +37,7 @@ from affordance_env.grasping import GraspOutcome, grasp_reachable, run_grasp
 from affordance_env.motion import MotionExecutor, ReachOutcome
 from affordance_env.objects import ObjectGeometry, object_geometry
 from affordance_env.outcome import Labels, grasp_success
-from affordance_env.stroke import StrokeOutcome, run_stroke, stroke_reachable
+from affordance_env.stroke import StrokeOutcome, approach_posture, run_stroke, stroke_reachable
 
 #: The hand may start the stroke at most this far from the planned pre-stroke pose [m], and may have moved
 #: the object at most this much before the stroke [m]; otherwise the interaction is marked failed.
@@ -52,8 +52,10 @@ class Interaction(Protocol):
     #: What it is, for messages: ``"stroke"`` or ``"grasp"``.
     kind: str
 
-    def prepare(self, motion: MotionExecutor, placement_centre: np.ndarray, size: float) -> None:
-        """Set up what does not depend on the object (once, when the environment is built)."""
+    def prepare(self, motion: MotionExecutor, placement_centre: np.ndarray, size: float) -> np.ndarray | None:
+        """What does not depend on the object, solved once when the environment is built: the arm posture the IK of
+        every approach starts from (None: the current servo targets), which the environment hands back to
+        :meth:`execute` and :meth:`reachable`."""
 
     def free_stepping(self, motion: MotionExecutor) -> contextlib.AbstractContextManager:
         """The timestep of the interaction while the hand moves in free space and the object comes to rest."""
@@ -62,10 +64,11 @@ class Interaction(Protocol):
              action: np.ndarray) -> StrokePlan | GraspPlan:
         """The plan of the interaction with the object at ``p_object`` [m] and ``yaw`` [rad]."""
 
-    def execute(self, motion: MotionExecutor, plan: StrokePlan | GraspPlan) -> ReachOutcome:
-        """Run the plan on the robot up to the way home."""
+    def execute(self, motion: MotionExecutor, plan: StrokePlan | GraspPlan, posture: np.ndarray | None
+                ) -> ReachOutcome:
+        """Run the plan on the robot up to the way home, the IK starting from ``posture`` (:meth:`prepare`)."""
 
-    def reachable(self, motion: MotionExecutor, plan: StrokePlan | GraspPlan) -> bool:
+    def reachable(self, motion: MotionExecutor, plan: StrokePlan | GraspPlan, posture: np.ndarray | None) -> bool:
         """Whether the arm can reach every pose of the plan (kinematics only: no physics step)."""
 
     def via_home(self, outcome: ReachOutcome) -> np.ndarray | None:
@@ -95,14 +98,14 @@ class StrokeInteraction:
     #: ... and may have moved the object at most this much before the stroke [m].
     max_object_moved: float = MAX_OBJECT_MOVED_BEFORE
 
-    def prepare(self, motion: MotionExecutor, placement_centre: np.ndarray, size: float) -> None:
+    def prepare(self, motion: MotionExecutor, placement_centre: np.ndarray, size: float) -> np.ndarray:
         # Every approach's IK starts from one posture: that of the canonical stroke of a sphere of the given size
         # at the centre of the placement region.
         table_top = motion.physics.table_top
         geometry = object_geometry("sphere", size)
         centre = np.array([*placement_centre, table_top + geometry.half_height])
         motion.physics.reset_home()
-        motion.set_approach_posture(self.plan(geometry, centre, 0.0, table_top, np.zeros(ACTION_DIM)))
+        return approach_posture(motion, self.plan(geometry, centre, 0.0, table_top, np.zeros(ACTION_DIM)))
 
     def free_stepping(self, motion: MotionExecutor) -> contextlib.AbstractContextManager:
         return motion.stepping(motion.free_timestep)  # the stroke itself keeps the scene's 2 ms
@@ -111,11 +114,11 @@ class StrokeInteraction:
              action: np.ndarray) -> StrokePlan:
         return plan_stroke(self.behavior, geometry, p_object, yaw, table_top, action)
 
-    def execute(self, motion: MotionExecutor, plan: StrokePlan) -> StrokeOutcome:
-        return run_stroke(motion, plan)
+    def execute(self, motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> StrokeOutcome:
+        return run_stroke(motion, plan, posture)
 
-    def reachable(self, motion: MotionExecutor, plan: StrokePlan) -> bool:
-        return stroke_reachable(motion, plan)
+    def reachable(self, motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> bool:
+        return stroke_reachable(motion, plan, posture)
 
     def via_home(self, outcome: StrokeOutcome) -> np.ndarray | None:
         return outcome.q_withdraw
@@ -147,7 +150,7 @@ class GraspInteraction:
     kind: str = "grasp"
 
     def prepare(self, motion: MotionExecutor, placement_centre: np.ndarray, size: float) -> None:
-        pass
+        return None  # each grasp's IK starts from where the arm is
 
     def free_stepping(self, motion: MotionExecutor) -> contextlib.AbstractContextManager:
         return contextlib.nullcontext()  # the grasp scene's own timestep throughout
@@ -156,10 +159,10 @@ class GraspInteraction:
              action: np.ndarray) -> GraspPlan:
         return plan_grasp(self.behavior, geometry, p_object, yaw, table_top, action)
 
-    def execute(self, motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
+    def execute(self, motion: MotionExecutor, plan: GraspPlan, posture: np.ndarray | None) -> GraspOutcome:
         return run_grasp(motion, plan)
 
-    def reachable(self, motion: MotionExecutor, plan: GraspPlan) -> bool:
+    def reachable(self, motion: MotionExecutor, plan: GraspPlan, posture: np.ndarray | None) -> bool:
         return grasp_reachable(motion, plan)
 
     def via_home(self, outcome: GraspOutcome) -> np.ndarray | None:

@@ -13,13 +13,12 @@ the hand does to an object is bounded by what its motors give.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 
-from affordance_env.behaviors import GraspPlan, StrokePlan
 from affordance_env.exceptions import InvalidValueError
 from affordance_env.kinematics import IKResult, Kinematics
 from affordance_env.linalg import dot, norm
@@ -129,6 +128,20 @@ def ik_verdict(results: list[IKResult]) -> tuple[bool, float, float]:
     return pos_err <= IK_POSITION_TOLERANCE and rot_err <= IK_ORIENTATION_TOLERANCE, pos_err, rot_err
 
 
+@dataclass(frozen=True)
+class HandTarget:
+    """How the inverse kinematics holds the hand on a move, whatever the behaviour: the palm's orientation and the
+    joint ranges the solution keeps to.
+
+    Attributes:
+        R_world_hand: Palm orientation in the world frame (3x3 rotation matrix).
+        joint_ranges: Narrower ranges for some joints, ``{name: (low, high)}`` [rad]; None: the joints' own.
+    """
+
+    R_world_hand: np.ndarray
+    joint_ranges: Mapping[str, tuple[float, float]] | None = None
+
+
 class LinePath:
     """A straight line of the palm as joint targets, one per control tick, along a speed profile.
 
@@ -142,8 +155,7 @@ class LinePath:
         p_start: Start of the palm [m], (3,).
         direction: Unit direction of the line, (3,).
         length: Length [m].
-        orientation: Palm orientation along the line and the joint ranges the IK keeps to: a plan with
-            ``R_world_hand`` and optionally ``joint_ranges``.
+        hand: Palm orientation along the line and the joint ranges the IK keeps to.
         speed: Cruise speed [m/s].
         q_start: Joint targets at the start.
         ramp: Time to reach the speed from rest [s].
@@ -152,9 +164,9 @@ class LinePath:
     """
 
     def __init__(self, executor: MotionExecutor, p_start: np.ndarray, direction: np.ndarray, length: float,
-                 orientation: StrokePlan | GraspPlan, speed: float, q_start: np.ndarray, *, ramp: float = LINE_RAMP,
+                 hand: HandTarget, speed: float, q_start: np.ndarray, *, ramp: float = LINE_RAMP,
                  to_rest: bool = True, check_waypoints: int | None = None) -> None:
-        self._executor, self._plan = executor, orientation
+        self._executor, self._hand = executor, hand
         self.p_start, self.direction = np.asarray(p_start, dtype=float), np.asarray(direction, dtype=float)
         self._s_ik = np.linspace(0.0, length, max(2, int(np.ceil(length / IK_SPACING - 1e-9)) + 1))
         self._q_ik: list[np.ndarray] = [np.asarray(q_start, dtype=float)]
@@ -178,7 +190,7 @@ class LinePath:
         while len(self._q_ik) <= k:
             n = len(self._q_ik)
             q_init = self._q_ik[-1] if n < 2 else 2.0 * self._q_ik[-1] - self._q_ik[-2]  # extrapolated one spacing
-            result = self._executor.ik(self.p_start + self._s_ik[n] * self.direction, q_init, self._plan)
+            result = self._executor.ik(self.p_start + self._s_ik[n] * self.direction, q_init, self._hand)
             self.results.append(result)
             self._q_ik.append(result.q)
         return self._q_ik[k]
@@ -217,23 +229,9 @@ class MotionExecutor:
         #: Timestep [s] of a tap interaction outside its stroke (FREE_TIMESTEP); the scene's own (2 ms) steps the
         #: whole interaction as finely as the stroke (``benchmarks/timestep.py`` compares the two).
         self.free_timestep = free_timestep
-        #: Where the IK of every pre-stroke pose starts (see :meth:`set_approach_posture`); None: the current
-        #: servo targets.
-        self.approach_posture: np.ndarray | None = None
         #: What the robot is doing now ("reach", "stroke", "descend", "close", "lift", "hold", "carry", "place",
         #: "open", "retreat", "home", ...): for diagnostics and pictures.
         self.phase = "idle"
-
-    def set_approach_posture(self, plan: StrokePlan) -> IKResult:
-        """Start the IK of every later pre-stroke pose from the arm posture that reaches ``plan``'s (solved now,
-        from the current servo targets), instead of from wherever the arm is.
-
-        The posture does not depend on the interactions run before, so neither do the data; from it a pre-stroke
-        pose anywhere in the placement region is 3-8 IK iterations away instead of 11-23 from home.
-        """
-        result = self.ik(plan.p_start, self.physics.joint_targets(), plan)
-        self.approach_posture = result.q
-        return result
 
     @property
     def steps_per_tick(self) -> int:
@@ -339,11 +337,11 @@ class MotionExecutor:
                     break
         return norm(self.palm - p_world_target)
 
-    def ik(self, p: np.ndarray, q_init: np.ndarray, plan: StrokePlan | GraspPlan) -> IKResult:
-        """IK of a palm position with the plan's hand orientation (and joint ranges, if it has any)."""
+    def ik(self, p: np.ndarray, q_init: np.ndarray, hand: HandTarget) -> IKResult:
+        """IK of a palm position [m] with the hand's orientation and joint ranges, from ``q_init``."""
         return self.kinematics.solve_ik(
-            p, q_init, plan.R_world_hand, position_tolerance=1e-3, orientation_tolerance=IK_ORIENTATION_TOLERANCE,
-            joint_ranges=getattr(plan, "joint_ranges", None),
+            p, q_init, hand.R_world_hand, position_tolerance=1e-3, orientation_tolerance=IK_ORIENTATION_TOLERANCE,
+            joint_ranges=hand.joint_ranges,
         )
 
     # --- lines of the palm -------------------------------------------------------------------------------------
@@ -394,14 +392,14 @@ class MotionExecutor:
                 break
         return LineResult(touched_yet, time, speed, p_touch)
 
-    def line(self, p_from: np.ndarray, p_to: np.ndarray, orientation: StrokePlan | GraspPlan, speed: float,
+    def line(self, p_from: np.ndarray, p_to: np.ndarray, hand: HandTarget, speed: float,
              q_start: np.ndarray | None = None, **kwargs) -> LinePath:
         """The :class:`LinePath` from ``p_from`` to ``p_to`` [m] at ``speed`` [m/s], from ``q_start`` (default: the
         current servo targets)."""
         delta = np.asarray(p_to, dtype=float) - np.asarray(p_from, dtype=float)
         length = norm(delta)
         q0 = self.physics.joint_targets() if q_start is None else q_start
-        return LinePath(self, p_from, delta / length, length, orientation, speed, q0, **kwargs)
+        return LinePath(self, p_from, delta / length, length, hand, speed, q0, **kwargs)
 
     # --- the way home ------------------------------------------------------------------------------------------
     def go_home(self, q_home: np.ndarray, via: np.ndarray | None = None) -> HomeOutcome:

@@ -316,9 +316,9 @@ class TapAffordanceEnv(gym.Env):
                                   support="table_top")
         self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy,
                                             support="table_top")
-        self.interaction.prepare(self.motion, PLACEMENT_CENTRE, float(np.mean(self.size_range)))
+        posture = self.interaction.prepare(self.motion, PLACEMENT_CENTRE, float(np.mean(self.size_range)))
         #: The approach posture of each behaviour prepared (see :meth:`prepare_behaviors`).
-        self._postures = {self.behavior.name: self.motion.approach_posture}
+        self._postures = {self.behavior.name: posture}
         self._renderer = None
         self._render_size = (render_width, render_height)
         #: With a render mode: pictures taken every 1/render_fps s of simulated time since the last ``reset``
@@ -510,10 +510,8 @@ class TapAffordanceEnv(gym.Env):
                     f"behavior {name!r} needs the {interaction.behavior.robot!r} arm; this env has the "
                                  f"{self.behavior.robot!r} arm.")
             if name not in self._postures:
-                self.motion.approach_posture = None
-                interaction.prepare(self.motion, PLACEMENT_CENTRE, float(np.mean(self.size_range)))
-                self._postures[name] = self.motion.approach_posture
-        self.motion.approach_posture = self._postures[self.behavior.name]
+                self._postures[name] = interaction.prepare(self.motion, PLACEMENT_CENTRE,
+                                                           float(np.mean(self.size_range)))
 
     def use_behavior(self, name: str) -> None:
         """Run the behaviour ``name`` (prepared by :meth:`prepare_behaviors`) from the next ``step`` on."""
@@ -522,7 +520,12 @@ class TapAffordanceEnv(gym.Env):
                 f"behavior {name!r} is not prepared in this env; prepared: {', '.join(self._postures)}.")
         self.interaction = get_interaction(name)
         self.behavior = self.interaction.behavior
-        self.motion.approach_posture = self._postures[name]
+
+    @property
+    def approach_posture(self) -> np.ndarray | None:
+        """The arm posture the IK of the current behaviour's approaches starts from (its interaction's
+        ``prepare``); None: the current servo targets."""
+        return self._postures[self.behavior.name]
 
     def observe(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
         """Look at the object again where it is now, without placing a new one: attend to it, wait until the robot
@@ -561,12 +564,7 @@ class TapAffordanceEnv(gym.Env):
             self.physics.adopt(seen_by.physics)
         interaction = get_interaction(name)
         plan = interaction.plan(initial["geometry"], initial["pose"][:3], initial["yaw"], self.physics.table_top, a)
-        saved = self.motion.approach_posture
-        self.motion.approach_posture = self._postures[name]
-        try:
-            return bool(interaction.reachable(self.motion, plan))
-        finally:
-            self.motion.approach_posture = saved
+        return bool(interaction.reachable(self.motion, plan, self._postures[name]))
 
     def get_state(self) -> EnvState:
         """A snapshot of the world and of the episode: the object and MuJoCo's state, what the initial snapshot
@@ -624,7 +622,7 @@ class TapAffordanceEnv(gym.Env):
         plan = interaction.plan(initial["geometry"], initial["pose"][:3], initial["yaw"], physics.table_top, action)
         monitor = physics.start_monitor()  # from now on, whatever the arm does
         try:
-            done = interaction.execute(self.motion, plan)
+            done = interaction.execute(self.motion, plan, self._postures[self.behavior.name])
             with interaction.free_stepping(self.motion):
                 home = self.motion.go_home(self._q_home, via=interaction.via_home(done))
                 since = interaction.awaited_since(done, float(physics.data.time))

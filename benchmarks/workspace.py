@@ -35,7 +35,7 @@ def reachable(env: TapAffordanceEnv, x: float, y: float) -> bool:
             g = object_geometry(object_type, size)
             for yaw in YAWS if object_type in ("box", "horizontal_cylinder") else (0.0,):
                 plan = env.interaction.plan(g, np.array([x, y, top + g.half_height]), yaw, top, np.zeros(3))
-                if not env.interaction.reachable(env.motion, plan):
+                if not env.interaction.reachable(env.motion, plan, env.approach_posture):
                     return False
     return True
 

@@ -42,3 +42,12 @@ def test_checking_a_collections_options_loads_neither_mujoco_nor_pinocchio():
             "print(sorted(m for m in ('mujoco', 'pinocchio', 'affordance_env.tap_env') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_motion_imports_no_behaviour():
+    # The motion executor takes neutral targets (a palm position, a HandTarget, joint targets) and the posture per
+    # call: the behaviours (their plans, strokes, grasps) build on it, not the other way round.
+    motion = Path(affordance_env.__file__).parent / "motion.py"
+    behaviours = {"affordance_env.behaviors", "affordance_env.stroke", "affordance_env.grasping",
+                  "affordance_env.interactions"}
+    assert not _imported_modules(motion) & behaviours
