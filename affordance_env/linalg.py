@@ -12,8 +12,9 @@ goes through these functions, which never call BLAS:
 - the small linear systems are solved by Eigen (through eigenpy, which Pinocchio brings), compiled into the wheel
   for one instruction set.
 
-Elementwise numpy arithmetic and reductions (``+``, ``*``, ``np.sum``) are exact or do not depend on the CPU, and
-stay as they are.
+Elementwise ``+``, ``-``, ``*``, ``/`` and ``np.sum`` give the same bits on every CPU. numpy's powers and
+transcendental functions (``**``, ``np.arccos``, ``np.exp``, ...) do not: numpy picks their SIMD code by the CPU
+(AVX2 or AVX-512), which is why a fingerprint records the CPU's features beside the versions.
 """
 
 from __future__ import annotations
@@ -55,14 +56,16 @@ def solve_spd(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``x`` with ``A x = b`` for a symmetric positive definite ``A`` (Cholesky, Eigen's ``LLT``)."""
     A = np.asarray(A, dtype=np.float64)
     decomposition = eigenpy.LLT(A)
-    if decomposition.info() != eigenpy.ComputationInfo.Success:
-        raise InvalidValueError(f"solve_spd needs a symmetric positive definite matrix, got {A!r}.")
+    if decomposition.info() != eigenpy.ComputationInfo.Success or not np.all(np.isfinite(A)):
+        # a numerical failure inside the simulation, not a user's value: numpy's own type for it
+        raise np.linalg.LinAlgError(f"solve_spd needs a finite symmetric positive definite matrix, got {A!r}.")
     return np.asarray(decomposition.solve(np.asarray(b, dtype=np.float64)), dtype=np.float64)
 
 
 def lstsq(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The minimum-norm least-squares solution of ``A x = b``, as ``np.linalg.lstsq(A, b)[0]`` gives it
     (Eigen's complete orthogonal decomposition, which also handles a rank-deficient ``A``)."""
-    A = np.asarray(A, dtype=np.float64)
-    return np.asarray(eigenpy.CompleteOrthogonalDecomposition(A).solve(np.asarray(b, dtype=np.float64)),
-                      dtype=np.float64)
+    A, b = np.asarray(A, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):  # as np.linalg.lstsq refuses them
+        raise np.linalg.LinAlgError(f"lstsq needs finite values, got A={A!r}, b={b!r}.")
+    return np.asarray(eigenpy.CompleteOrthogonalDecomposition(A).solve(b), dtype=np.float64)

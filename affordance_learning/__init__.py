@@ -16,6 +16,7 @@
 
 import importlib
 import importlib.metadata as _metadata
+import importlib.util
 
 try:  # the version has one source, the package's metadata (pyproject.toml)
     __version__ = _metadata.version("tap-affordance")
@@ -52,6 +53,8 @@ def __getattr__(name: str) -> object:
         value = getattr(importlib.import_module(_LAZY[name]), name)
         globals()[name] = value  # found directly from now on
         return value
+    if importlib.util.find_spec(f"{__name__}.{name}") is not None:  # a submodule: affordance_learning.model, ...
+        return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module 'affordance_learning' has no attribute {name!r}")
 
 

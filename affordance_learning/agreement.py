@@ -77,7 +77,15 @@ def compare_results(reference: Mapping[str, Any], found: Mapping[str, Any]) -> l
     """Every headline number of ``found`` beside ``reference`` (two ``results.json`` of ``affordance reproduce``
     for one behaviour), with its tolerance. Raises ValueError when they are not the same experiment."""
     reference, found = current_results(reference), current_results(found)
-    ca, cb = reference.get("config", {}), found.get("config", {})
+    for which, results in (("reference", reference), ("found", found)):
+        config = results.get("config")
+        missing = [key for key in ("uniformity", "svm_accuracy") if not isinstance(results.get(key), Mapping)]
+        missing += [f"config.{key}" for key in ("n_rows", "success_fraction")
+                    if not isinstance(config, Mapping) or not isinstance(config.get(key), int | float)]
+        if missing:
+            raise InvalidValueError(f"the {which} results lack {', '.join(missing)}: compare the results.json of "
+                                    "`affordance reproduce` of this version (older ones: run it again).")
+    ca, cb = reference["config"], found["config"]
     same = ("behavior", "seed", "episodes", "ks", "relevancies", "range_noise")
     differ = [f"{key} {cb.get(key)!r} (reference {ca.get(key)!r})" for key in same if ca.get(key) != cb.get(key)]
     if differ:

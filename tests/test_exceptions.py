@@ -67,3 +67,11 @@ def _with_func(parser, func):
         for sub in action.choices.values():
             sub.set_defaults(func=func)
     return parser
+
+
+def test_the_lazy_package_still_reaches_its_submodules():
+    import affordance_learning
+
+    assert affordance_learning.model.AffordanceModel is affordance_learning.AffordanceModel
+    with pytest.raises(AttributeError, match="no attribute 'nothing'"):
+        affordance_learning.nothing  # noqa: B018

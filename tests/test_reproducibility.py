@@ -215,3 +215,24 @@ def test_compare_command_sets_numbers_beside_the_reference(tmp_path, capsys):
     assert main(["compare", str(reference), str(tmp_path / "nothing")]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "holds no results.json" in err
+
+
+def test_results_without_the_compared_numbers_are_named(tmp_path, capsys):
+    from affordance_learning.cli import main
+
+    (tmp_path / "results.json").write_text(json.dumps({"config": {"behavior": "tap"}}))
+    assert main(["compare", str(ROOT / "docs" / "reproduction" / "tap"), str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "the found results lack uniformity, svm_accuracy, config.n_rows" in err
+
+
+def test_a_numerical_failure_in_the_simulation_is_no_users_mistake():
+    from affordance_env.linalg import lstsq, solve_spd
+
+    with pytest.raises(np.linalg.LinAlgError):
+        solve_spd(-np.eye(2), np.ones(2))
+    with pytest.raises(np.linalg.LinAlgError):
+        lstsq(np.array([[1.0, np.nan], [0.0, 1.0]]), np.ones(2))
+    from affordance_env.exceptions import AffordanceEnvError
+
+    assert not issubclass(np.linalg.LinAlgError, AffordanceEnvError)  # the CLI keeps its traceback
