@@ -16,12 +16,12 @@ from affordance_env.attention import attend
 from affordance_env.behaviors import ACTION_DIM, BEHAVIORS, check_action
 from affordance_env.camera import RangeCamera
 from affordance_env.exceptions import IncompatibleStateError, InvalidValueError
-from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, compute_features, effect_features
+from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, Features, compute_features, effect_features
 from affordance_env.interactions import Interaction, get_interaction
 from affordance_env.kinematics import Kinematics
 from affordance_env.linalg import norm
 from affordance_env.motion import HOLD_MAX_TIME, HOLD_SPEED_TOLERANCE, MotionExecutor, ReachOutcome
-from affordance_env.objects import as_resting, check_object_type, check_size, object_geometry
+from affordance_env.objects import ObjectGeometry, as_resting, check_object_type, check_size, object_geometry
 from affordance_env.options import EnvOptions
 from affordance_env.outcome import REST_DURATION, ObjectMonitor, outcome_labels
 from affordance_env.physics import TapPhysics
@@ -63,6 +63,27 @@ def _failure_reason(fault: str | None, visible_initially: bool, outcome: ReachOu
 
 
 @dataclass(frozen=True)
+class InitialSnapshot:
+    """What an interaction's initial snapshot saw, and what its plan is made from.
+
+    Attributes:
+        features: The 49 features of the object as the range camera saw it.
+        pose: The object's pose then, ``(x, y, z, qw, qx, qy, qz)`` [m] (read-only).
+        yaw: The object's yaw for the plan [rad].
+        geometry: The object's geometry as it rests (a cylinder lying or standing).
+        visible: Whether the camera saw the object.
+        still: Whether the robot and the object were still.
+    """
+
+    features: Features
+    pose: np.ndarray
+    yaw: float
+    geometry: ObjectGeometry
+    visible: bool
+    still: bool
+
+
+@dataclass(frozen=True)
 class EnvState:
     """A snapshot of :class:`TapAffordanceEnv` (:meth:`~TapAffordanceEnv.get_state`): treat it as opaque.
 
@@ -77,7 +98,7 @@ class EnvState:
     """
 
     physics: tuple[Any, np.ndarray]
-    initial: dict[str, Any] | None
+    initial: InitialSnapshot | None
     q_home: np.ndarray
     rng: dict[str, Any]
     robot: str
@@ -347,7 +368,7 @@ class TapAffordanceEnv(gym.Env):
             }
         )
         self.action_space = spaces.Box(-1.0, 1.0, (ACTION_DIM,), np.float32)
-        self._initial: dict[str, Any] | None = None
+        self._initial: InitialSnapshot | None = None
         self._q_home = np.zeros(nq)
 
     @classmethod
@@ -489,8 +510,9 @@ class TapAffordanceEnv(gym.Env):
         obs, features = self._snapshot()
         pose = physics.object_pose()
         geometry, yaw = as_resting(physics.geometry, pose[3:]) if plan_geometry is None else plan_geometry
-        self._initial = {"features": features, "pose": pose, "yaw": yaw, "geometry": geometry,
-                         "visible": features.visible, "still": still}
+        seen = pose.copy()
+        seen.flags.writeable = False
+        self._initial = InitialSnapshot(features, seen, yaw, geometry, features.visible, still)
         info = {
             "object": {"type": physics.geometry.object_type, "size": physics.geometry.size, "pose": pose.copy()},
             "attention": {"success": attention.success, "visible": attention.visible,
@@ -563,14 +585,14 @@ class TapAffordanceEnv(gym.Env):
         if seen_by is not None and seen_by is not self:  # the world as it is, as a take_over would continue it
             self.physics.adopt(seen_by.physics)
         interaction = get_interaction(name)
-        plan = interaction.plan(initial["geometry"], initial["pose"][:3], initial["yaw"], self.physics.table_top, a)
+        plan = interaction.plan(initial.geometry, initial.pose[:3], initial.yaw, self.physics.table_top, a)
         return bool(interaction.reachable(self.motion, plan, self._postures[name]))
 
     def get_state(self) -> EnvState:
         """A snapshot of the world and of the episode: the object and MuJoCo's state, what the initial snapshot
         saw, and the env's random generator. :meth:`set_state` puts it back; the same action then gives the same
         interaction, bit for bit (an oracle that tries several actions from one state does not replay the reset)."""
-        initial = None if self._initial is None else dict(self._initial)
+        initial = self._initial  # frozen: shared, not copied
         return EnvState(self.physics.get_state(), initial, self._q_home.copy(),
                         copy.deepcopy(self.np_random.bit_generator.state), self.physics.variant.name,
                         self.behavior.name)
@@ -588,7 +610,7 @@ class TapAffordanceEnv(gym.Env):
                              f"{self.physics.variant.name!r} robot model: a state restores only into an env of the "
                              "same robot model.")
         self.physics.set_state(state.physics)
-        self._initial = None if state.initial is None else dict(state.initial)
+        self._initial = state.initial
         self._q_home = state.q_home.copy()
         self.np_random.bit_generator.state = copy.deepcopy(state.rng)
 
@@ -619,7 +641,7 @@ class TapAffordanceEnv(gym.Env):
         initial, self._initial = self._initial, None
         physics = self.physics
         interaction = self.interaction
-        plan = interaction.plan(initial["geometry"], initial["pose"][:3], initial["yaw"], physics.table_top, action)
+        plan = interaction.plan(initial.geometry, initial.pose[:3], initial.yaw, physics.table_top, action)
         monitor = physics.start_monitor()  # from now on, whatever the arm does
         try:
             done = interaction.execute(self.motion, plan, self._postures[self.behavior.name])
@@ -642,25 +664,25 @@ class TapAffordanceEnv(gym.Env):
             final_features = NOT_VISIBLE_VALUES.copy()
             final_pose = np.full(7, np.nan)
             visible = False
-        failure = _failure_reason(fault, initial["visible"], done, (initial["still"], home.still), home.touched,
+        failure = _failure_reason(fault, initial.visible, done, (initial.still, home.still), home.touched,
                                   interaction)
         # Travel on the table: to where the object rests, or to where it left the table (not where it fell).
         p_end = monitor.exit_position if monitor.left_table else final_pose
-        displacement = 0.0 if fault else norm(p_end[:2] - initial["pose"][:2])
-        labels = None if fault else outcome_labels(monitor, initial["pose"][3:], final_pose[3:],
+        displacement = 0.0 if fault else norm(p_end[:2] - initial.pose[:2])
+        labels = None if fault else outcome_labels(monitor, initial.pose[3:], final_pose[3:],
                                                    self.roll_threshold)
         effect = (
             np.zeros(len(FEATURE_NAMES), np.float32)
             if fault
-            else effect_features(initial["features"].values, final_features)
+            else effect_features(initial.features.values, final_features)
         )
         # The success label: a failed interaction is no sample, so no success either.
         success = failure is None and labels is not None and interaction.success(done, labels, displacement,
                                                                                  self.roll_threshold)
         info = {
-            "object": {"type": initial["geometry"].object_type, "size": initial["geometry"].size,
-                       "initial_pose": initial["pose"].copy(), "final_pose": final_pose},
-            "initial_features": initial["features"].values.copy(),  # fresh: a restored state steps again
+            "object": {"type": initial.geometry.object_type, "size": initial.geometry.size,
+                       "initial_pose": initial.pose.copy(), "final_pose": final_pose},
+            "initial_features": initial.features.values.copy(),  # fresh: a restored state steps again
             "final_features": final_features,
             "effect": effect,
             "displacement": displacement,
@@ -718,4 +740,4 @@ class TapAffordanceEnv(gym.Env):
             self._renderer = None
 
 
-__all__ = ["TapAffordanceEnv", "default_reward", "BEHAVIORS"]
+__all__ = ["TapAffordanceEnv", "EnvState", "InitialSnapshot", "default_reward", "BEHAVIORS"]
