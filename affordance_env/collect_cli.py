@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import time
 from collections.abc import Callable
@@ -10,11 +11,14 @@ from pathlib import Path
 from typing import Any
 
 from affordance_env.exceptions import InvalidValueError
-from affordance_env.registry import ENV_ID, ENV_IDS, GOAL_ENV_ID
+from affordance_env.objects import OBJECT_TYPES, SIZE_LIMITS
+from affordance_env.options import POSITION_RANGES, EnvOptions
+from affordance_env.range_noise import RANGE_NOISE_MODELS
+from affordance_env.registry import BEHAVIOR_NAMES, ENV_ID, ENV_IDS, GOAL_ENV_ID
 
 #: Command-line flags that are env options, and the env keyword each one sets.
-_ENV_FLAGS = ("behavior", "object_types", "size_range", "camera_width", "camera_height", "camera_fovy",
-              "roll_threshold", "settle_timeout", "range_noise", "position_range")
+#: The environment options a collection takes on the command line: every field of EnvOptions, one flag each.
+_ENV_FLAGS = tuple(f.name for f in dataclasses.fields(EnvOptions))
 
 
 # --- argparse types: a value that cannot be used is refused as the command line is parsed --------------------
@@ -98,13 +102,11 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     parser.add_argument("--dask-address", default=None, metavar="ADDRESS",
                         help="Dask scheduler to run on (e.g. tcp://host:8786); implies --scheduler dask. Its "
                              "workers must see --out and have the same tap-affordance version")
-    from affordance_env.objects import SIZE_LIMITS
-
     low, high = SIZE_LIMITS
     env = parser.add_argument_group("environment options (default: the environment's own)")
-    env.add_argument("--behavior", default=None, help="tap | tap_back | push | grasp")
+    env.add_argument("--behavior", default=None, help=" | ".join(BEHAVIOR_NAMES))
     env.add_argument("--object-types", nargs="+", default=None, metavar="TYPE",
-                     help="object types to sample from: sphere box horizontal_cylinder vertical_cylinder")
+                     help=f"object types to sample from: {' '.join(OBJECT_TYPES)}")
     env.add_argument("--size-range", nargs=2, default=None, metavar=("LOW", "HIGH"),
                      type=real_within(low, high, expected=f"a size in metres in [{low:g}, {high:g}] (what the "
                                       "hand can tap)"),
@@ -120,9 +122,9 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     env.add_argument("--settle-timeout", default=None,
                      type=real_within(0.0, open_low=True, expected="a positive duration in seconds"),
                      help="longest simulated wait for the outcome after the first touch [s]")
-    env.add_argument("--range-noise", default=None, choices=("kinect_v1",),
+    env.add_argument("--range-noise", default=None, choices=RANGE_NOISE_MODELS,
                      help="depth noise of the range camera (default: none)")
-    env.add_argument("--position-range", default=None, choices=("canonical", "workspace"),
+    env.add_argument("--position-range", default=None, choices=POSITION_RANGES,
                      help="where objects are placed: within +-3 cm of the paper's spot (canonical), or uniformly "
                           "over the behaviour's workspace (workspace; for TapAffordanceGoal-v0, the union of the "
                           "four) (default canonical)")
@@ -142,7 +144,6 @@ def check_collect_args(args: argparse.Namespace) -> None:
     """What the options of ``affordance collect`` say together, and its ``--out``, checked without the simulator
     and before anything is built or written: ValueError naming the options. (Each value alone is checked as it is
     parsed.)"""
-    from affordance_env.options import EnvOptions
 
     if args.scheduler == "joblib" and args.dask_address is not None:
         raise InvalidValueError("--dask-address runs on Dask: drop --scheduler joblib (or use --scheduler dask).")

@@ -35,3 +35,18 @@ def test_an_unknown_name_is_refused_with_the_valid_ones(check):
         check("kick")
     with pytest.raises(ValueError, match="Valid ids: TapAffordance-v1, TapAffordanceGoal-v0"):
         registry.check_env_id("TapAffordance-v0")
+
+
+def test_collect_takes_every_env_option_as_a_flag():
+    import argparse
+    import dataclasses
+
+    from affordance_env.collect_cli import add_collect_parser, env_options_from_args
+    from affordance_env.options import EnvOptions
+
+    parser = argparse.ArgumentParser()
+    add_collect_parser(parser.add_subparsers())
+    names = [f.name for f in dataclasses.fields(EnvOptions)]
+    argv = ["collect", "--episodes", "1", "--out", "x"]
+    assert set(names) <= set(vars(parser.parse_args(argv)))  # a flag for every option, unset by default
+    assert env_options_from_args(parser.parse_args([*argv, "--camera-width", "40"])) == {"camera_width": 40}
