@@ -440,3 +440,15 @@ def build_model(variant: str = "tap") -> mujoco.MjModel:
     urdfs = (icub_urdf(), hand_urdf()) if get_variant(variant).mk3_hand else (icub_urdf(),)
     return cached_model(variant, urdfs, lambda: build_spec(variant).compile())
 
+
+@functools.cache
+def table_extent() -> tuple[tuple[float, float], tuple[float, float]]:
+    """The (lower, upper) corners (x, y) [m] of the table top of ``assets/scene.xml``, what
+    :meth:`TapPhysics.table_extent <affordance_env.physics.TapPhysics.table_extent>` gives in a built scene, read
+    from the table scene alone (no robot: milliseconds, once per process)."""
+    model = mujoco.MjModel.from_xml_path(str(assets_dir() / "scene.xml"))
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    table = model.geom("table_top").id
+    centre, half = data.geom_xpos[table, :2], model.geom_size[table, :2]
+    return tuple(map(float, centre - half)), tuple(map(float, centre + half))

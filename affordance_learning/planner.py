@@ -11,13 +11,13 @@ likely enough, the one whose predicted outcomes end nearest on average (re-plann
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
 from scipy.stats import qmc
 
+from affordance_env.scene import table_extent
 from affordance_learning.behaviors import BEHAVIORS
 from affordance_learning.effect_model import ActionEffectModel
 from affordance_learning.exceptions import InvalidValueError
@@ -43,22 +43,6 @@ def _ends(model: ActionEffectModel, start: np.ndarray) -> tuple[np.ndarray, np.n
 def _reached_by_any(reachable: Callable[[str, np.ndarray], np.ndarray], names: list[str], xy: np.ndarray
                     ) -> np.ndarray:
     return np.any([np.asarray(reachable(name, xy), dtype=bool) for name in names], axis=0)
-
-
-@functools.cache
-def table_extent() -> tuple[tuple[float, float], tuple[float, float]]:
-    """The (lower, upper) corners (x, y) [m] of the table top of the environment's scene (``assets/scene.xml``,
-    what ``affordance_env.physics.TapPhysics.table_extent`` gives), read from the scene without the robot."""
-    import mujoco
-
-    from affordance_env.assets_path import assets_dir
-
-    model = mujoco.MjModel.from_xml_path(str(assets_dir() / "scene.xml"))
-    data = mujoco.MjData(model)
-    mujoco.mj_kinematics(model, data)
-    table = model.geom("table_top").id
-    centre, half = data.geom_xpos[table, :2], model.geom_size[table, :2]
-    return tuple(map(float, centre - half)), tuple(map(float, centre + half))
 
 
 def _check_on_table(name: str, value, xy: np.ndarray) -> None:

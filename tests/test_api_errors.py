@@ -14,13 +14,13 @@ from gymnasium.utils.passive_env_checker import data_shares_objects
 import affordance_env  # noqa: F401 (registers the envs)
 from affordance_env.features import FEATURE_NAMES
 from affordance_env.physics import TapPhysics
-from affordance_env.scene import build_model
+from affordance_env.scene import build_model, table_extent
 from affordance_env.tap_env import TapAffordanceEnv
 from affordance_learning import predict_effect
 from affordance_learning.behaviors import BEHAVIORS
 from affordance_learning.effect_model import ActionEffectModel
 from affordance_learning.goals import Place, Roll
-from affordance_learning.planner import Planner, table_extent
+from affordance_learning.planner import Planner
 
 N = len(FEATURE_NAMES)
 
