@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import gymnasium as gym
@@ -11,9 +13,12 @@ from gymnasium import spaces
 
 from affordance_env.behaviors import ACTION_DIM, check_action
 from affordance_env.exceptions import InvalidValueError
+from affordance_env.features import FEATURE_NAMES
 from affordance_env.options import EnvOptions
+from affordance_env.placement import RESET_OPTIONS, draw_placement
 from affordance_env.registry import BEHAVIOR_ARMS, BEHAVIOR_NAMES
-from affordance_env.tap_env import RESET_OPTIONS, TapAffordanceEnv
+from affordance_env.results import InteractionResult, Snapshot
+from affordance_env.world import World, WorldState
 from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
 
 #: The behaviours, in the order of the action's ``behavior`` index (:mod:`affordance_env.registry`).
@@ -31,6 +36,23 @@ GOAL_TABLE_MARGIN = 0.05
 def goal_distance(achieved_goal: np.ndarray, desired_goal: np.ndarray) -> np.ndarray:
     """Distance on the table [m] between achieved and desired goals, (..., 2) -> (...)."""
     return np.linalg.norm(np.asarray(achieved_goal, dtype=float) - np.asarray(desired_goal, dtype=float), axis=-1)
+
+
+@dataclass(frozen=True)
+class GoalEnvState:
+    """A snapshot of :class:`TapAffordanceGoalEnv` (:meth:`~TapAffordanceGoalEnv.get_state`): treat it as opaque.
+
+    Attributes:
+        world: The world's state.
+        rng: The state of the env's random generator.
+        goal: The episode's goal (x, y) [m].
+        obs: The last observation, or None once the episode ended.
+    """
+
+    world: WorldState
+    rng: dict[str, Any]
+    goal: np.ndarray
+    obs: dict[str, Any] | None
 
 
 class TapAffordanceGoalEnv(gym.Env):
@@ -139,37 +161,48 @@ class TapAffordanceGoalEnv(gym.Env):
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise InvalidValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got "
                              f"{render_mode!r}.")
-        EnvOptions(position_range=position_range)  # checked
+        options = EnvOptions(object_types=object_types, size_range=size_range, camera_width=camera_width,
+                             camera_height=camera_height, camera_fovy=camera_fovy, roll_threshold=roll_threshold,
+                             settle_timeout=settle_timeout, range_noise=range_noise,
+                             position_range=position_range)  # checked and normalised
+        #: The data options, checked (:class:`~affordance_env.options.EnvOptions`; ``behavior`` is not used).
+        self.options = options
         #: Where objects are placed: ``"canonical"`` as in TapAffordance-v1, or ``"workspace"``: uniform over the
         #: union of the behaviours' workspaces.
-        self.position_range = position_range
-        common = dict(object_types=object_types, size_range=size_range, camera_width=camera_width,
-                      camera_height=camera_height, camera_fovy=camera_fovy, roll_threshold=roll_threshold,
-                      settle_timeout=settle_timeout, range_noise=range_noise, render_mode=render_mode,
-                      render_width=render_width, render_height=render_height, two_arms=True)
-        right = TapAffordanceEnv(behavior="tap", **common)
-        right.prepare_behaviors(("tap_back", "push"))
-        #: One TapAffordance env per arm, both of the scene with both arms; the env wires them into one world.
-        self.arms: dict[str, TapAffordanceEnv] = {"right": right, "left": TapAffordanceEnv(behavior="grasp", **common)}
-        self._arm = right
-        for arm in self.arms.values():  # render() draws the scene as it is: no frames recorded along the way
-            arm.physics.on_step = None
+        self.position_range = options.position_range
+        #: The world, with both arms: every behaviour acts in it.
+        self.world = World(BEHAVIORS, two_arms=True, camera_width=options.camera_width,
+                           camera_height=options.camera_height, camera_fovy=options.camera_fovy,
+                           range_noise=options.range_noise, roll_threshold=options.roll_threshold,
+                           settle_timeout=options.settle_timeout, typical_size=float(np.mean(options.size_range)))
+        self._render_size = (render_width, render_height)
         #: The behaviours, named by the action's ``behavior`` index.
         self.behaviors = BEHAVIORS
         self.goal_tolerance = float(goal_tolerance)
         self.reward_type = reward_type
         self.render_mode = render_mode
-        inner = right.observation_space
-        low, high = right.physics.table_extent()
+        H, W = options.camera_height, options.camera_width
+        table = self.world.table
         self.observation_space = spaces.Dict({
-            "observation": spaces.Dict({key: inner[key] for key in ("features", "range", "mask")}),
-            "achieved_goal": spaces.Box(low, high, (2,), np.float64),
-            "desired_goal": spaces.Box(low, high, (2,), np.float64),
+            "observation": spaces.Dict({
+                "features": spaces.Box(-np.inf, np.inf, (len(FEATURE_NAMES),), np.float32),
+                "range": spaces.Box(0.0, self.world.camera.max_range, (H, W), np.float32),
+                "mask": spaces.Box(0, 1, (H, W), np.int8),
+            }),
+            "achieved_goal": spaces.Box(table.low, table.high, (2,), np.float64),
+            "desired_goal": spaces.Box(table.low, table.high, (2,), np.float64),
         })
         self.action_space = spaces.Dict({"behavior": spaces.Discrete(len(BEHAVIORS)),
                                          "params": spaces.Box(-1.0, 1.0, (ACTION_DIM,), np.float32)})
         self._goal = np.zeros(2)
         self._obs: dict[str, Any] | None = None
+        self._last: InteractionResult | None = None
+
+    @property
+    def last_result(self) -> InteractionResult | None:
+        """The typed result of the last ``step``'s interaction (None before the first): what ``info`` is made
+        from, beside the goal's keys."""
+        return self._last
 
     # --- the goal ----------------------------------------------------------------------------------------------
     def compute_reward(self, achieved_goal: np.ndarray, desired_goal: np.ndarray, info: Any) -> np.ndarray | float:
@@ -180,20 +213,11 @@ class TapAffordanceGoalEnv(gym.Env):
         return float(reward) if np.ndim(reward) == 0 else reward
 
     def _check_goal(self, goal: Any) -> np.ndarray:
-        try:
-            xy = np.asarray(goal, dtype=np.float64)
-        except (TypeError, ValueError):
-            xy = np.full(1, np.nan)
-        low, high = self._arm.physics.table_extent()
-        if xy.shape != (2,) or not np.all(np.isfinite(xy)) or np.any(xy < low) or np.any(xy > high):
-            raise InvalidValueError(
-                f"goal must be (x, y) on the table top, x in [{low[0]:.2f}, {high[0]:.2f}] and y in "
-                             f"[{low[1]:.2f}, {high[1]:.2f}] m, got {goal!r}.")
-        return xy
+        return self.world.table.check_position(goal, "goal")
 
     def _draw_goal(self, xy: np.ndarray) -> np.ndarray:
         """A goal GOAL_DISTANCE from ``xy``, on the table and in some behaviour's workspace."""
-        low, high = self._arm.physics.table_extent()
+        low, high = self.world.table.low, self.world.table.high
         rng = self.np_random
         for _ in range(1000):
             angle = rng.uniform(-np.pi, np.pi)
@@ -205,13 +229,14 @@ class TapAffordanceGoalEnv(gym.Env):
                            "place the object inside the workspaces (affordance_env.workspace).")
 
     # --- observing ---------------------------------------------------------------------------------------------
-    def _observation(self, inner_obs: Mapping[str, np.ndarray], visible: bool) -> dict[str, Any]:
-        seen = self._arm.seen_position
-        physics = self._arm.physics
+    def _observation(self, snapshot: Snapshot, visible: bool) -> dict[str, Any]:
+        seen = snapshot.seen_position
+        table = self.world.table
         achieved = (seen.copy() if visible and np.all(np.isfinite(seen))
-                    else np.clip(physics.object_pose()[:2], *physics.table_extent()))  # off the table: at its edge
-        return {"observation": {key: inner_obs[key] for key in ("features", "range", "mask")},
-                "achieved_goal": achieved, "desired_goal": self._goal.copy()}
+                    else np.clip(self.world.object_pose()[:2], table.low, table.high))  # off the table: its edge
+        observation = {"features": snapshot.features.values.astype(np.float32), "range": snapshot.ranges.copy(),
+                       "mask": snapshot.mask.copy()}
+        return {"observation": observation, "achieved_goal": achieved, "desired_goal": self._goal.copy()}
 
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         """Place an object, attend to it, draw the goal (or take ``options["goal"]``) and observe."""
@@ -225,14 +250,13 @@ class TapAffordanceGoalEnv(gym.Env):
                 f"Unknown reset option(s) {unknown}. Valid options: {', '.join(GOAL_RESET_OPTIONS)}.")
         goal = options.pop("goal", None)
         goal = None if goal is None else self._check_goal(goal)
-        for arm in self.arms.values():
-            arm.np_random = self.np_random  # one random generator for the whole world
-        self._arm = self.arms["right"]
-        self.arms["left"].forget()
         if self.position_range == "workspace" and not {"position", "object_pose"} & set(options):
             options["position"] = sample_in_workspace(None, self.np_random)
-        inner_obs, info = self._arm.reset(options=options)
-        obs = self._observation(inner_obs, info["visible"])
+        o = self.options
+        placement = draw_placement(self.np_random, options, o.object_types, o.size_range, self.world.table)
+        seen = self.world.place(placement, self.np_random)
+        info = seen.info()
+        obs = self._observation(seen.snapshot, seen.visible)
         self._goal = self._draw_goal(obs["achieved_goal"]) if goal is None else goal
         obs["desired_goal"] = self._goal.copy()
         info["distance"] = float(goal_distance(obs["achieved_goal"], self._goal))
@@ -256,16 +280,6 @@ class TapAffordanceGoalEnv(gym.Env):
             name = BEHAVIORS[index]
         return name, check_action(action["params"])
 
-    def _switch_to(self, name: str) -> TapAffordanceEnv:
-        """The arm env of behaviour ``name``, in the world as it is now."""
-        arm = self.arms[ARM_OF[name]]
-        if arm is not self._arm:
-            arm.take_over(self._arm)
-            self._arm = arm
-        if arm.behavior.name != name:
-            arm.use_behavior(name)
-        return arm
-
     def feasible(self, behavior: int | str, params: Any) -> bool:
         """Whether the arm can reach every pose of ``behavior`` with ``params`` on the object where it is now, from
         the kinematics alone (no physics step); False: the interaction would fail with ``"ik: ..."``, or a stroke's
@@ -273,59 +287,51 @@ class TapAffordanceGoalEnv(gym.Env):
         name, a = self._check_action({"behavior": behavior, "params": params})
         if self._obs is None:
             raise RuntimeError("feasible() needs an object: call reset() first.")
-        return self.arms[ARM_OF[name]].feasible(a, behavior=name, seen_by=self._arm)
+        return self.world.feasible(name, a)
 
     def step(self, action):
         """Run one interaction with the chosen behaviour and parameters; the object stays where it ends."""
         if self._obs is None:
             raise RuntimeError("step() called before reset() or after the episode ended; call reset() first.")
         name, params = self._check_action(action)
-        arm = self._switch_to(name)
-        inner_obs, _, _, _, info = arm.step(params)
-        fault = info["outcome"] == "fault"
-        off_table = info["outcome"] == "off_table"
-        seen = {"visible": False, "attention": None}
-        if fault or off_table:  # nothing more to see: the episode ends on the interaction's final observation
-            obs = self._observation(inner_obs, False)
+        result = self._last = self.world.interact(name, params, self.np_random)
+        info = result.info()
+        seen = None
+        if result.final is None or result.outcome == "off_table":  # nothing more to see: the episode ends on the
+            obs = self._observation(result.final or self.world.blank_snapshot(), False)  # interaction's own view
         else:  # the head turns to the object where it rests, for the next interaction
-            inner_obs, seen = arm.observe()
-            obs = self._observation(inner_obs, seen["visible"])
+            seen = self.world.observe(self.np_random)
+            obs = self._observation(seen.snapshot, seen.visible)
         distance = float(goal_distance(obs["achieved_goal"], self._goal))
+        attention = None if seen is None else seen.info()["attention"]
         info.update(behavior=name, distance=distance, is_success=bool(distance <= self.goal_tolerance),
-                    observation_visible=bool(seen["visible"]), attention=seen["attention"])
+                    observation_visible=seen is not None and seen.visible, attention=attention)
         reward = self.compute_reward(obs["achieved_goal"], self._goal, info)
-        terminated = bool(info["is_success"] or off_table or fault)
+        terminated = bool(info["is_success"] or result.outcome in ("off_table", "fault"))
         self._obs = None if terminated else obs
         return obs, float(reward), terminated, False, info
 
     # --- snapshots -----------------------------------------------------------------------------------------------
-    def get_state(self) -> dict[str, Any]:
+    def get_state(self) -> GoalEnvState:
         """A snapshot of the world and the episode; :meth:`set_state` puts it back (treat it as opaque)."""
-        arm = next(key for key, value in self.arms.items() if value is self._arm)
-        return {"arm": arm, "behavior": self._arm.behavior.name, "world": self._arm.get_state(),
-                "goal": self._goal.copy(), "obs": self._obs}
+        return GoalEnvState(self.world.get_state(), copy.deepcopy(self.np_random.bit_generator.state),
+                            self._goal.copy(), self._obs)
 
-    def set_state(self, state: Mapping[str, Any]) -> None:
+    def set_state(self, state: GoalEnvState) -> None:
         """Put back the world and the episode as :meth:`get_state` saw them."""
-        if not isinstance(state, Mapping) or set(state) != {"arm", "behavior", "world", "goal", "obs"}:
-            raise TypeError(f"state must be what get_state() returned, got {type(state).__name__}.")
-        self._arm = self.arms[state["arm"]]
-        self._arm.set_state(state["world"])
-        if self._arm.behavior.name != state["behavior"]:
-            self._arm.use_behavior(state["behavior"])
-        for arm in self.arms.values():
-            if arm is not self._arm:
-                arm.forget()
-        self._goal = state["goal"].copy()
-        self._obs = state["obs"]
+        if not isinstance(state, GoalEnvState):
+            raise TypeError(f"state must be what get_state() returned (a GoalEnvState), got {type(state).__name__}.")
+        self.world.set_state(state.world)
+        self.np_random.bit_generator.state = copy.deepcopy(state.rng)
+        self._goal = state.goal.copy()
+        self._obs = state.obs
 
     def render(self):
         """A picture of the scene from the ``overview`` camera (``render_mode="rgb_array"``), else None."""
-        return self._arm.render() if self.render_mode == "rgb_array" else None
+        return self.world.picture(*self._render_size) if self.render_mode == "rgb_array" else None
 
     def close(self) -> None:
-        for arm in self.arms.values():
-            arm.close()
+        self.world.close()
 
 
 class FlatActionWrapper(gym.ActionWrapper):
@@ -344,4 +350,4 @@ class FlatActionWrapper(gym.ActionWrapper):
         return {"behavior": int(np.argmax(a[: len(BEHAVIORS)])), "params": a[len(BEHAVIORS):].astype(np.float32)}
 
 
-__all__ = ["TapAffordanceGoalEnv", "FlatActionWrapper", "BEHAVIORS", "goal_distance", "WORKSPACES"]
+__all__ = ["TapAffordanceGoalEnv", "GoalEnvState", "FlatActionWrapper", "BEHAVIORS", "goal_distance", "WORKSPACES"]

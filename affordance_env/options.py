@@ -13,11 +13,12 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from affordance_env.behaviors import ROLL_THRESHOLD, get_behavior
+from affordance_env.behaviors.success import ROLL_THRESHOLD
 from affordance_env.exceptions import InvalidValueError
 from affordance_env.objects import OBJECT_TYPES, check_object_type, check_size
 from affordance_env.pinhole import Intrinsics
 from affordance_env.range_noise import check_range_noise
+from affordance_env.registry import check_behavior_name
 
 #: Where objects are placed: ``"canonical"``, uniform within +-3 cm of the paper's spot in front of the robot;
 #: ``"workspace"``, uniform over the workspace of the behaviour (:mod:`affordance_env.workspace`; in
@@ -45,7 +46,7 @@ class EnvOptions:
     position_range: str = "canonical"
 
     def __post_init__(self) -> None:
-        get_behavior(self.behavior)
+        check_behavior_name(self.behavior)
         types = self.object_types
         if isinstance(types, str) or not isinstance(types, Sequence) or len(types) == 0:
             raise InvalidValueError(f"object_types must be a non-empty sequence of {OBJECT_TYPES}, got {types!r}.")

@@ -1,6 +1,7 @@
 """The one place the package's names are defined: the environments' ids, and the behaviours with the arm that
-does each. The environments, the dataset code, the command line and the learning package read them here; adding a
-behaviour adds its line to :data:`BEHAVIOR_ARMS` (and its module to :mod:`affordance_env.behaviors`).
+does each and the module that defines it. The environments, the dataset code, the command line and the learning
+package read them here; adding a behaviour is one module of :mod:`affordance_env.behaviors` that defines it and one
+line in :data:`REGISTERED`.
 
 It imports nothing heavy, so that a command can check a name before it loads the simulator.
 """
@@ -8,6 +9,7 @@ It imports nothing heavy, so that a command can check a name before it loads the
 from __future__ import annotations
 
 from collections.abc import Mapping
+from dataclasses import dataclass
 from types import MappingProxyType
 
 from affordance_env.exceptions import InvalidValueError
@@ -19,9 +21,32 @@ GOAL_ENV_ID = "TapAffordanceGoal-v0"
 #: The environments, as datasets record them.
 ENV_IDS: tuple[str, ...] = (ENV_ID, GOAL_ENV_ID)
 
-#: The behaviours, in the order of the goal env's ``behavior`` index, and the arm that does each.
-BEHAVIOR_ARMS: Mapping[str, str] = MappingProxyType({"tap": "right", "tap_back": "right", "push": "right",
-                                                     "grasp": "left"})
+#: The arms, as the behaviours name them.
+ARMS = ("right", "left")
+
+
+@dataclass(frozen=True)
+class Registered:
+    """A behaviour, as the registry lists it.
+
+    Attributes:
+        arm: The arm that does it, one of :data:`ARMS`.
+        module: The module of :mod:`affordance_env.behaviors` that defines it (in its ``BEHAVIORS``).
+    """
+
+    arm: str
+    module: str
+
+
+#: The behaviours, in the order of the goal env's ``behavior`` index.
+REGISTERED: Mapping[str, Registered] = MappingProxyType({
+    "tap": Registered("right", "stroke"),
+    "tap_back": Registered("right", "stroke"),
+    "push": Registered("right", "stroke"),
+    "grasp": Registered("left", "grasp"),
+})
+#: The arm that does each behaviour.
+BEHAVIOR_ARMS: Mapping[str, str] = MappingProxyType({name: entry.arm for name, entry in REGISTERED.items()})
 #: The behaviours' names, in that order.
 BEHAVIOR_NAMES: tuple[str, ...] = tuple(BEHAVIOR_ARMS)
 
@@ -40,5 +65,5 @@ def check_env_id(env_id: object) -> str:
     return env_id  # type: ignore[return-value]
 
 
-__all__ = ["BEHAVIOR_ARMS", "BEHAVIOR_NAMES", "ENV_ID", "ENV_IDS", "GOAL_ENV_ID", "check_behavior_name",
+__all__ = ["ARMS", "BEHAVIOR_ARMS", "REGISTERED", "Registered", "BEHAVIOR_NAMES", "ENV_ID", "ENV_IDS", "GOAL_ENV_ID", "check_behavior_name",
            "check_env_id"]

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import copy
-import numbers
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -12,75 +11,23 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from affordance_env.attention import attend
-from affordance_env.behaviors import ACTION_DIM, BEHAVIORS, check_action
+from affordance_env.behaviors import ACTION_DIM, get_behavior
 from affordance_env.camera import RangeCamera
-from affordance_env.exceptions import IncompatibleStateError, InvalidValueError
-from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, Features, compute_features, effect_features
-from affordance_env.interactions import Interaction, get_interaction
+from affordance_env.exceptions import InvalidValueError
+from affordance_env.features import FEATURE_NAMES
 from affordance_env.kinematics import Kinematics
-from affordance_env.linalg import norm
-from affordance_env.motion import HOLD_MAX_TIME, HOLD_SPEED_TOLERANCE, MotionExecutor, ReachOutcome
-from affordance_env.objects import ObjectGeometry, as_resting, check_object_type, check_size, object_geometry
+from affordance_env.motion import MotionExecutor
 from affordance_env.options import EnvOptions
-from affordance_env.outcome import REST_DURATION, ObjectMonitor, outcome_labels
 from affordance_env.physics import TapPhysics
-from affordance_env.range_noise import add_kinect_noise
-from affordance_env.scene import build_model
-from affordance_env.workspace import sample_in_workspace
-
-#: Region of the table where objects are placed: centre (x, y) and half-widths [m].
-PLACEMENT_CENTRE = np.array([-0.30, 0.03])
-PLACEMENT_HALF_WIDTH = np.array([0.03, 0.03])
-#: Keys of ``reset(options=...)`` that choose the object instead of drawing it.
-RESET_OPTIONS = ("object_type", "size", "position", "yaw", "object_pose")
-#: Depth of the object's top, whose centre is where the object is seen on the table [m].
-TOP_DEPTH = 0.003
-#: Yaw jitter of boxes and lying cylinders [rad].
-YAW_JITTER = 0.25
-#: The placed object is at rest for the initial snapshot when slower than these [m/s], [rad/s].
-REST_SPEED, REST_ANGULAR_SPEED = 1e-3, 1e-2
-
-def _failure_reason(fault: str | None, visible_initially: bool, outcome: ReachOutcome, still: tuple[bool, bool],
-                    touched_on_way_home: bool, interaction: Interaction) -> str | None:
-    """Why an interaction cannot be used, or None; see the class docstring. ``outcome``: what the interaction
-    reported; ``still``: whether the robot was still for the initial and for the final snapshot;
-    ``touched_on_way_home``: the arm touched the object again after it had been clear of it."""
-    if fault is not None:
-        return f"physics: {fault}"
-    for snapshot, was_still in zip(("initial", "final"), still, strict=True):
-        if not was_still:
-            return (f"snapshot: the robot was still moving at the {snapshot} snapshot (a joint faster than "
-                    f"{HOLD_SPEED_TOLERANCE:g} rad/s after {HOLD_MAX_TIME:g} s of holding still)")
-    if not visible_initially:
-        return "perception: the object was not visible in the initial snapshot"
-    if not outcome.ik_success:
-        return (f"ik: the {interaction.kind} was not reachable (position error "
-                f"{outcome.ik_position_error * 1e3:.1f} mm, orientation error {outcome.ik_orientation_error:.2f} rad)")
-    if touched_on_way_home:
-        return "home: the arm touched the object on its way home"
-    return interaction.failure(outcome)
-
-
-@dataclass(frozen=True)
-class InitialSnapshot:
-    """What an interaction's initial snapshot saw, and what its plan is made from.
-
-    Attributes:
-        features: The 49 features of the object as the range camera saw it.
-        pose: The object's pose then, ``(x, y, z, qw, qx, qy, qz)`` [m] (read-only).
-        yaw: The object's yaw for the plan [rad].
-        geometry: The object's geometry as it rests (a cylinder lying or standing).
-        visible: Whether the camera saw the object.
-        still: Whether the robot and the object were still.
-    """
-
-    features: Features
-    pose: np.ndarray
-    yaw: float
-    geometry: ObjectGeometry
-    visible: bool
-    still: bool
+from affordance_env.placement import (
+    PLACEMENT_CENTRE,
+    PLACEMENT_HALF_WIDTH,
+    RESET_OPTIONS,
+    YAW_JITTER,
+    draw_placement,
+)
+from affordance_env.results import InteractionResult, Snapshot
+from affordance_env.world import World, WorldState
 
 
 @dataclass(frozen=True)
@@ -88,32 +35,23 @@ class EnvState:
     """A snapshot of :class:`TapAffordanceEnv` (:meth:`~TapAffordanceEnv.get_state`): treat it as opaque.
 
     Attributes:
-        physics: The object's geometry and MuJoCo's integration state.
-        initial: What the episode's initial snapshot saw (None between episodes).
-        q_home: The arm's home targets, with the gaze on the object.
+        world: The world's state (:meth:`World.get_state <affordance_env.world.World.get_state>`).
         rng: The state of the env's random generator.
-        robot: The robot variant of the env's model (``TapPhysics.variant``); a state restores only into an env
-            of the same one.
-        behavior: The behaviour the env ran.
     """
 
-    physics: tuple[Any, np.ndarray]
-    initial: InitialSnapshot | None
-    q_home: np.ndarray
+    world: WorldState
     rng: dict[str, Any]
-    robot: str
-    behavior: str
-
-
-def _object_still(physics: TapPhysics) -> bool:
-    """Still enough for a snapshot: REST_SPEED and REST_ANGULAR_SPEED, ten and thirty times stricter than the
-    outcome's rest (:func:`affordance_env.motion.object_at_rest`)."""
-    return physics.object_speed() < REST_SPEED and physics.object_angular_speed() < REST_ANGULAR_SPEED
 
 
 def default_reward(info: dict[str, Any]) -> float:
     """The object's displacement on the table [m]: how much the interaction changed the world."""
     return float(info["displacement"])
+
+
+def observation(snapshot: Snapshot) -> dict[str, np.ndarray]:
+    """TapAffordance-v1's observation of a snapshot (fresh arrays)."""
+    return {"range": snapshot.ranges.copy(), "mask": snapshot.mask.copy(),
+            "features": snapshot.features.values.astype(np.float32), "joints": snapshot.joints.copy()}
 
 
 class TapAffordanceEnv(gym.Env):
@@ -222,6 +160,9 @@ class TapAffordanceEnv(gym.Env):
     table's edge), or ``settle_timeout`` seconds have passed since then; then the final snapshot is taken.
 
     ## Info
+    The step's ``info`` is made from the typed result of its interaction
+    (:class:`~affordance_env.results.InteractionResult`), which ``env.unwrapped.last_result`` gives; the world the
+    env adapts to Gymnasium is ``env.unwrapped.world`` (:class:`~affordance_env.world.World`).
     After ``reset``: ``object`` (``type``, ``size`` [m], ``pose`` (7,) position and quaternion), ``attention``,
     ``visible`` (object seen in the initial snapshot), ``still`` (the robot was still for it).
     After ``step`` also: ``effect`` (49,) final minus initial features, ``initial_features``,
@@ -315,409 +256,127 @@ class TapAffordanceEnv(gym.Env):
                              camera_width=camera_width, camera_height=camera_height, camera_fovy=camera_fovy,
                              roll_threshold=roll_threshold, settle_timeout=settle_timeout,
                              range_noise=range_noise, position_range=position_range)  # checked and normalised
-        self._check_render_mode(render_mode)
-        #: The interaction of the behaviour (:mod:`affordance_env.interactions`).
-        self.interaction = get_interaction(options.behavior)
-        self.behavior = self.interaction.behavior
-        self.object_types = options.object_types
-        self.size_range = options.size_range
-        self.roll_threshold = options.roll_threshold
-        self.range_noise = options.range_noise
-        self.position_range = options.position_range
-        self.settle_timeout = options.settle_timeout
+        if render_mode not in (None, *self.metadata["render_modes"]):
+            raise InvalidValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got "
+                                    f"{render_mode!r}.")
+        #: The data options, checked (:class:`~affordance_env.options.EnvOptions`).
+        self.options = options
+        #: The behaviour each step runs (:mod:`affordance_env.behaviors`).
+        self.behavior = get_behavior(options.behavior)
         self.reward_fn = default_reward if reward_fn is None else reward_fn
         self.render_mode = render_mode
-
-        # The behaviour's arm; with two_arms, in the scene with both arms (the other one held at home).
-        robot = {"tap": "two_arms", "grasp": "two_arms_left"}[self.behavior.robot] if two_arms else self.behavior.robot
-        self.physics = TapPhysics(build_model(robot), robot)
-        self.kinematics = Kinematics(variant=robot)
-        self.motion = MotionExecutor(self.physics, self.kinematics)
-        self.camera = RangeCamera(self.physics.model, width=camera_width, height=camera_height, fovy_deg=camera_fovy,
-                                  support="table_top")
-        self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy,
-                                            support="table_top")
-        posture = self.interaction.prepare(self.motion, PLACEMENT_CENTRE, float(np.mean(self.size_range)))
-        #: The approach posture of each behaviour prepared (see :meth:`prepare_behaviors`).
-        self._postures = {self.behavior.name: posture}
-        self._renderer = None
+        #: The world the behaviour acts in: the robot, the table, the object, the camera.
+        self.world = World((options.behavior,), two_arms=two_arms, camera_width=options.camera_width,
+                           camera_height=options.camera_height, camera_fovy=options.camera_fovy,
+                           range_noise=options.range_noise, roll_threshold=options.roll_threshold,
+                           settle_timeout=options.settle_timeout, typical_size=float(np.mean(options.size_range)))
         self._render_size = (render_width, render_height)
         #: With a render mode: pictures taken every 1/render_fps s of simulated time since the last ``reset``
         #: (the whole interaction: placing, attention, the behaviour, the wait for the outcome).
         self.frames: list[np.ndarray] = []
-        #: Where the last snapshot saw the object on the table: the centre (x, y) [m] of its top, the visible points
-        #: within TOP_DEPTH of its highest one (NaN when not seen). Every object's top lies over its centre.
-        self.seen_position = np.full(2, np.nan)
         self._next_frame_time = 0.0
         if render_mode is not None:
-            self.physics.on_step = self._record_frame
+            self.world.on_step(self._record_frame)
+        self._last: InteractionResult | None = None
 
-        H, W = camera_height, camera_width
-        nq = self.kinematics.nq
-        self.observation_space = spaces.Dict(
-            {
-                "range": spaces.Box(0.0, self.camera.max_range, (H, W), np.float32),
-                "mask": spaces.Box(0, 1, (H, W), np.int8),
-                "features": spaces.Box(-np.inf, np.inf, (len(FEATURE_NAMES),), np.float32),
-                "joints": spaces.Box(
-                    self.kinematics.lower.astype(np.float32) - 0.05,
-                    self.kinematics.upper.astype(np.float32) + 0.05,
-                    (nq,),
-                    np.float32,
-                ),
-            }
-        )
+        H, W = options.camera_height, options.camera_width
+        kinematics = self.world.kinematics()
+        self.observation_space = spaces.Dict({
+            "range": spaces.Box(0.0, self.world.camera.max_range, (H, W), np.float32),
+            "mask": spaces.Box(0, 1, (H, W), np.int8),
+            "features": spaces.Box(-np.inf, np.inf, (len(FEATURE_NAMES),), np.float32),
+            "joints": spaces.Box(kinematics.lower.astype(np.float32) - 0.05,
+                                 kinematics.upper.astype(np.float32) + 0.05, (kinematics.nq,), np.float32),
+        })
         self.action_space = spaces.Box(-1.0, 1.0, (ACTION_DIM,), np.float32)
-        self._initial: InitialSnapshot | None = None
-        self._q_home = np.zeros(nq)
 
-    @classmethod
-    def _check_render_mode(cls, render_mode: str | None) -> None:
-        if render_mode not in (None, *cls.metadata["render_modes"]):
-            raise InvalidValueError(f"render_mode must be None or one of {cls.metadata['render_modes']}, got "
-                             f"{render_mode!r}.")
+    # --- views into the world, for inspection ---------------------------------------------------------------------
+    @property
+    def physics(self) -> TapPhysics:
+        """The world's physics (:class:`~affordance_env.physics.TapPhysics`)."""
+        return self.world.physics
 
-    def _blank_observation(self) -> dict[str, np.ndarray]:
-        space = self.observation_space
-        return {
-            "range": np.zeros(space["range"].shape, np.float32),
-            "mask": np.zeros(space["mask"].shape, np.int8),
-            "features": NOT_VISIBLE_VALUES.astype(np.float32),
-            "joints": np.clip(self._q_home, space["joints"].low, space["joints"].high).astype(np.float32),
-        }
+    @property
+    def camera(self) -> RangeCamera:
+        """The range camera in the head."""
+        return self.world.camera
 
-    def _snapshot(self) -> tuple[dict[str, np.ndarray], Any]:
-        image = self.camera.capture(self.physics.data, normals=self.range_noise is not None,
-                                    occluded=self.physics.active_geom)
-        if self.range_noise is not None:
-            image = add_kinect_noise(image, self.np_random)
-        mask = image.mask_of(self.physics.active_geom)
-        p_world_hand = self.physics.hand_position()
-        uv_hand = image.project(p_world_hand)
-        if not np.all(np.isfinite(uv_hand)):  # hand behind the camera: no image position; use the image centre
-            uv_hand = np.array([image.intrinsics.cx, image.intrinsics.cy])
-        features = compute_features(
-            image.p_world_points, image.ranges, mask, image.p_world_camera, p_world_hand, uv_hand
-        )
-        points = image.p_world_points[mask]
-        top = points[points[:, 2] >= points[:, 2].max() - TOP_DEPTH] if len(points) else points
-        self.seen_position = top[:, :2].mean(axis=0) if len(top) else np.full(2, np.nan)
-        ranges = np.where(np.isfinite(image.ranges), image.ranges, 0.0).astype(np.float32)
-        obs = {
-            "range": ranges,
-            "mask": mask.astype(np.int8),
-            "features": features.values.astype(np.float32),
-            "joints": self.physics.joint_positions().astype(np.float32),
-        }
-        return obs, features
+    @property
+    def kinematics(self) -> Kinematics:
+        """The arm's kinematics."""
+        return self.world.kinematics()
 
-    def _sample_object(self, options: dict[str, Any] | None
-                       ) -> tuple[str, float, np.ndarray, float, np.ndarray | None]:
-        """Type, size, position and yaw of the next object: drawn from ``self.np_random``, then replaced by any
-        given in ``options`` (the draws are made either way, so the rest of the episode's randomness is the same)."""
-        rng = self.np_random
-        object_type = self.object_types[int(rng.integers(len(self.object_types)))]
-        size = float(rng.uniform(*self.size_range))
-        xy = PLACEMENT_CENTRE + rng.uniform(-1.0, 1.0, 2) * PLACEMENT_HALF_WIDTH
-        yaw = float(rng.uniform(-YAW_JITTER, YAW_JITTER))
-        if self.position_range == "workspace":
-            xy = sample_in_workspace(self.behavior.name, rng)
-        if options is not None and not isinstance(options, Mapping):
-            raise InvalidValueError(f"options must be a dict with keys among {RESET_OPTIONS}, got {options!r}.")
-        options = dict(options or {})
-        unknown = sorted(set(options) - set(RESET_OPTIONS))
-        if unknown:
-            raise InvalidValueError(f"Unknown reset option(s) {unknown}. Valid options: {', '.join(RESET_OPTIONS)}.")
-        if "object_type" in options:
-            object_type = check_object_type(options["object_type"])
-        if "size" in options:
-            try:
-                size = check_size(options["size"])
-            except ValueError as exc:
-                raise InvalidValueError(f"reset option 'size': {exc}") from None
-        if object_type in ("sphere", "vertical_cylinder"):
-            yaw = 0.0
-        if "position" in options:
-            xy = np.asarray(options["position"], dtype=np.float64)
-            low, high = self.physics.table_extent()
-            if xy.shape != (2,) or not np.all(np.isfinite(xy)) or np.any(xy < low) or np.any(xy > high):
-                raise InvalidValueError(
-                    f"position must be (x, y) on the table top, x in [{low[0]:.2f}, {high[0]:.2f}] and "
-                                 f"y in [{low[1]:.2f}, {high[1]:.2f}] m, got {options['position']!r}.")
-        if "yaw" in options:
-            real = isinstance(options["yaw"], numbers.Real) and not isinstance(options["yaw"], bool)
-            yaw = float(options["yaw"]) if real else float("nan")
-            if not np.isfinite(yaw):
-                raise InvalidValueError(f"yaw must be a finite angle [rad], got {options['yaw']!r}.")
-        pose = None
-        if "object_pose" in options:
-            if "position" in options or "yaw" in options:
-                raise InvalidValueError(
-                    "reset options 'object_pose' and 'position' or 'yaw' exclude each other: the pose "
-                                 "gives both.")
-            pose = self._check_pose(options["object_pose"], object_geometry(object_type, size))
-        return object_type, size, xy, yaw, pose
+    @property
+    def motion(self) -> MotionExecutor:
+        """The arm's motion executor."""
+        return self.world.motion
 
-    def _check_pose(self, value: Any, geometry: Any) -> np.ndarray:
-        try:
-            pose = np.asarray(value, dtype=np.float64)
-        except (TypeError, ValueError):
-            pose = np.full(1, np.nan)
-        low, high = self.physics.table_extent()
-        top = self.physics.table_top
-        ok = pose.shape == (7,) and bool(np.all(np.isfinite(pose)))
-        if ok:
-            ok = (bool(np.all(pose[:2] >= low) and np.all(pose[:2] <= high))
-                  and top + 0.5 * geometry.half_height <= pose[2] <= top + 3.0 * geometry.rbound
-                  and norm(pose[3:]) > 1e-6)
-        if not ok:
-            raise InvalidValueError(
-                f"object_pose must be (x, y, z, qw, qx, qy, qz): x in [{low[0]:.2f}, {high[0]:.2f}] and "
-                             f"y in [{low[1]:.2f}, {high[1]:.2f}] m on the table, z [m] the object's centre above the "
-                             f"table top ({top:.3f} m) by {0.5 * geometry.half_height:.3f} to "
-                             f"{3.0 * geometry.rbound:.3f} m, and a non-zero quaternion; got {value!r}.")
-        pose[3:] /= norm(pose[3:])
-        return pose
+    @property
+    def last_result(self) -> InteractionResult | None:
+        """The typed result of the last ``step`` (None before the first): what ``info`` is made from."""
+        return self._last
 
+    # --- Gymnasium ------------------------------------------------------------------------------------------------
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         """Place a new object, let it settle, attend to it and take the initial snapshot.
 
-        ``options`` may choose the object instead of drawing it: ``object_type`` (one of
-        ``affordance_env.OBJECT_TYPES``), ``size`` [m], ``position`` (x, y) on the table [m] and ``yaw`` [rad].
+        ``options`` may choose the object instead of drawing it (:data:`~affordance_env.placement.RESET_OPTIONS`):
+        ``object_type``, ``size`` [m], ``position`` (x, y) on the table [m], ``yaw`` [rad] or ``object_pose``.
         """
         super().reset(seed=seed)
-        object_type, size, xy, yaw, pose = self._sample_object(options)
+        o = self.options
+        workspace = o.behavior if o.position_range == "workspace" else None
+        placement = draw_placement(self.np_random, options, o.object_types, o.size_range, self.world.table, workspace)
         self.frames = []
         self._next_frame_time = 0.0
-        physics = self.physics
-        physics.reset_home()
-        self._q_home = physics.joint_targets()
-        geometry = object_geometry(object_type, size)
-        physics.set_object(geometry, xy, yaw)  # 0.1 mm above the table: it settles while the head turns
-        if pose is not None:  # any pose: it settles too, and the plan reads its geometry from where it rests
-            physics.set_object_pose(pose)
-        return self._observe(None if pose is not None else (geometry, yaw))
-
-    def _observe(self, plan_geometry: tuple[Any, float] | None = None) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
-        """Attend to the object where it is, wait until the robot (and the object) are still, and take the initial
-        snapshot. ``plan_geometry``: the geometry and yaw the interaction plans for; None: read from how the
-        object rests (a toppled cylinder lies)."""
-        physics = self.physics
-        with self.interaction.free_stepping(self.motion):
-            attention = attend(physics, self.attention_camera, self.motion.move_joints)
-            still = self.motion.hold_still(also=_object_still)
-        self._q_home = physics.joint_targets()  # the arm's home, with the gaze on the object
-        obs, features = self._snapshot()
-        pose = physics.object_pose()
-        geometry, yaw = as_resting(physics.geometry, pose[3:]) if plan_geometry is None else plan_geometry
-        seen = pose.copy()
-        seen.flags.writeable = False
-        self._initial = InitialSnapshot(features, seen, yaw, geometry, features.visible, still)
-        info = {
-            "object": {"type": physics.geometry.object_type, "size": physics.geometry.size, "pose": pose.copy()},
-            "attention": {"success": attention.success, "visible": attention.visible,
-                          "pixel_error": attention.pixel_error},
-            "visible": features.visible,
-            "still": still,
-        }
-        return obs, info
-
-    def prepare_behaviors(self, names: Sequence[str]) -> None:
-        """Make the env able to run the behaviours ``names`` too (:meth:`use_behavior`): those of the same arm.
-        Call it before ``reset``: it puts the robot at home."""
-        for name in names:
-            interaction = get_interaction(name)
-            if interaction.behavior.robot != self.behavior.robot:
-                raise InvalidValueError(
-                    f"behavior {name!r} needs the {interaction.behavior.robot!r} arm; this env has the "
-                                 f"{self.behavior.robot!r} arm.")
-            if name not in self._postures:
-                self._postures[name] = interaction.prepare(self.motion, PLACEMENT_CENTRE,
-                                                           float(np.mean(self.size_range)))
-
-    def use_behavior(self, name: str) -> None:
-        """Run the behaviour ``name`` (prepared by :meth:`prepare_behaviors`) from the next ``step`` on."""
-        if name not in self._postures:
-            raise InvalidValueError(
-                f"behavior {name!r} is not prepared in this env; prepared: {', '.join(self._postures)}.")
-        self.interaction = get_interaction(name)
-        self.behavior = self.interaction.behavior
-
-    @property
-    def approach_posture(self) -> np.ndarray | None:
-        """The arm posture the IK of the current behaviour's approaches starts from (its interaction's
-        ``prepare``); None: the current servo targets."""
-        return self._postures[self.behavior.name]
-
-    def observe(self) -> tuple[dict[str, np.ndarray], dict[str, Any]]:
-        """Look at the object again where it is now, without placing a new one: attend to it, wait until the robot
-        and the object are still and take the initial snapshot of the next ``step``. Returns ``(obs, info)`` as
-        ``reset`` does (TapAffordanceGoal-v0 calls it after every interaction: the object stays)."""
-        return self._observe()
-
-    def take_over(self, other: TapAffordanceEnv) -> None:
-        """Continue the world of ``other``, an env of the same scene with another arm acting
-        (:meth:`TapPhysics.adopt <affordance_env.physics.TapPhysics.adopt>`: the object's state bit for bit, the
-        shared joints', the time), and its initial snapshot: the next ``step`` here acts on what ``other`` saw;
-        ``other`` needs a ``reset`` or a ``take_over`` before its next ``step``."""
-        self.physics.adopt(other.physics)
-        self._q_home = self.physics.joint_targets()
-        self._initial, other._initial = other._initial, None
-
-    def forget(self) -> None:
-        """Forget the object: the next ``step`` needs a ``reset`` (or :meth:`take_over`) first."""
-        self._initial = None
-
-    def feasible(self, params: Any, behavior: str | None = None, seen_by: TapAffordanceEnv | None = None) -> bool:
-        """Whether the arm can reach every pose of the interaction with ``params`` (``behavior``, one prepared in
-        this env, by default the current one) on the object where the last snapshot saw it (of ``seen_by``, an env
-        of the same scene, if given: this env then takes over its world, as :meth:`take_over` would), from the
-        kinematics alone: no physics step. False: ``step`` would fail with ``"ik: ..."``, or a stroke's reach would
-        sweep the arm into the object (``"reach: ..."``)."""
-        a = check_action(params)
-        name = self.behavior.name if behavior is None else behavior
-        if name not in self._postures:
-            raise InvalidValueError(
-                f"behavior {name!r} is not prepared in this env; prepared: {', '.join(self._postures)}.")
-        initial = (self if seen_by is None else seen_by)._initial
-        if initial is None:
-            raise RuntimeError("feasible() needs an object: call reset() first.")
-        if seen_by is not None and seen_by is not self:  # the world as it is, as a take_over would continue it
-            self.physics.adopt(seen_by.physics)
-        interaction = get_interaction(name)
-        plan = interaction.plan(initial.geometry, initial.pose[:3], initial.yaw, self.physics.table_top, a)
-        return bool(interaction.reachable(self.motion, plan, self._postures[name]))
-
-    def get_state(self) -> EnvState:
-        """A snapshot of the world and of the episode: the object and MuJoCo's state, what the initial snapshot
-        saw, and the env's random generator. :meth:`set_state` puts it back; the same action then gives the same
-        interaction, bit for bit (an oracle that tries several actions from one state does not replay the reset)."""
-        initial = self._initial  # frozen: shared, not copied
-        return EnvState(self.physics.get_state(), initial, self._q_home.copy(),
-                        copy.deepcopy(self.np_random.bit_generator.state), self.physics.variant.name,
-                        self.behavior.name)
-
-    def set_state(self, state: EnvState) -> None:
-        """Put back the world and the episode as :meth:`get_state` saw them. The state must come from an env of
-        the same robot model (ValueError otherwise): ``behavior="grasp"`` builds another model than the tap,
-        tap back and push, and ``two_arms=True`` another again."""
-        if not isinstance(state, EnvState):
-            raise TypeError(f"state must be what get_state() returned (an EnvState), got {type(state).__name__}.")
-        if state.robot != self.physics.variant.name:
-            raise IncompatibleStateError(
-                f"the state was made by an env of behavior {state.behavior!r} with the {state.robot!r} "
-                             f"robot model; this env (behavior {self.behavior.name!r}) has the "
-                             f"{self.physics.variant.name!r} robot model: a state restores only into an env of the "
-                             "same robot model.")
-        self.physics.set_state(state.physics)
-        self._initial = state.initial
-        self._q_home = state.q_home.copy()
-        self.np_random.bit_generator.state = copy.deepcopy(state.rng)
-
-    def _wait_outcome(self, monitor: ObjectMonitor, since: float) -> tuple[str, float]:
-        """Simulate until the object has left the table, has been at rest since ``since`` [s] or later, or
-        ``settle_timeout`` has passed since ``since``; the monitor has followed it all along.
-
-        Returns the outcome and when it happened, in seconds after ``since``: the moment the object left the
-        table, or the moment it had been still for ``REST_DURATION``, which may lie before the arm was back.
-        """
-        physics = self.physics
-        t_end = since + self.settle_timeout
-        steps_per_tick = self.motion.steps_per_tick
-        while True:
-            if monitor.left_table:
-                return "off_table", monitor.exit_time - since
-            if monitor.at_rest(physics.data.time, since):
-                return "rest", max(monitor.still_since, since) + REST_DURATION - since
-            if physics.data.time >= t_end - 1e-9:
-                return "timeout", self.settle_timeout
-            physics.step(steps_per_tick)
+        seen = self.world.place(placement, self.np_random)
+        return observation(seen.snapshot), seen.info()
 
     def step(self, action):
         """Execute the behaviour with ``action`` and take the final snapshot; the episode then terminates."""
-        if self._initial is None:
+        if self.world.seen is None:
             raise RuntimeError("step() called before reset() or after the interaction ended; call reset() first.")
-        action = check_action(action)
-        initial, self._initial = self._initial, None
-        physics = self.physics
-        interaction = self.interaction
-        plan = interaction.plan(initial.geometry, initial.pose[:3], initial.yaw, physics.table_top, action)
-        monitor = physics.start_monitor()  # from now on, whatever the arm does
-        try:
-            done = interaction.execute(self.motion, plan, self._postures[self.behavior.name])
-            with interaction.free_stepping(self.motion):
-                home = self.motion.go_home(self._q_home, via=interaction.via_home(done))
-                since = interaction.awaited_since(done, float(physics.data.time))
-                outcome, outcome_time = self._wait_outcome(monitor, since)
-        finally:
-            physics.monitor = None
+        result = self._last = self.world.interact(self.behavior.name, action, self.np_random)
         if self.render_mode is not None:
             self.frames.append(self._picture())  # the scene as the final snapshot sees it
-        fault = physics.unstable()
-        if fault is None:
-            obs, features = self._snapshot()
-            final_features = features.values
-            final_pose = physics.object_pose()
-            visible = features.visible
-        else:  # the state is not to be trusted: nothing of it reaches obs or info
-            obs = self._blank_observation()
-            final_features = NOT_VISIBLE_VALUES.copy()
-            final_pose = np.full(7, np.nan)
-            visible = False
-        failure = _failure_reason(fault, initial.visible, done, (initial.still, home.still), home.touched,
-                                  interaction)
-        # Travel on the table: to where the object rests, or to where it left the table (not where it fell).
-        p_end = monitor.exit_position if monitor.left_table else final_pose
-        displacement = 0.0 if fault else norm(p_end[:2] - initial.pose[:2])
-        labels = None if fault else outcome_labels(monitor, initial.pose[3:], final_pose[3:],
-                                                   self.roll_threshold)
-        effect = (
-            np.zeros(len(FEATURE_NAMES), np.float32)
-            if fault
-            else effect_features(initial.features.values, final_features)
-        )
-        # The success label: a failed interaction is no sample, so no success either.
-        success = failure is None and labels is not None and interaction.success(done, labels, displacement,
-                                                                                 self.roll_threshold)
-        info = {
-            "object": {"type": initial.geometry.object_type, "size": initial.geometry.size,
-                       "initial_pose": initial.pose.copy(), "final_pose": final_pose},
-            "initial_features": initial.features.values.copy(),  # fresh: a restored state steps again
-            "final_features": final_features,
-            "effect": effect,
-            "displacement": displacement,
-            "rolling_distance": 0.0 if fault else monitor.rolling_distance,
-            "rolled": labels is not None and labels.rolled,
-            "success": bool(success),
-            "toppled": labels is not None and labels.toppled,
-            "tilt": 0.0 if fault else labels.tilt,
-            "outcome": "fault" if fault else outcome,
-            "outcome_time": 0.0 if fault else float(outcome_time),
-            "contact": done.contact,
-            "hand_speed": done.hand_speed,
-            "ik": {"success": done.ik_success, "position_error": done.ik_position_error,
-                   "orientation_error": done.ik_orientation_error},
-            "visible": visible,
-            "behavior": self.behavior.name,
-            "failure": failure,
-            **interaction.info(done),
-        }
-        reward = float(self.reward_fn(info))
-        return obs, reward, True, False, info
+        if result.final is None:  # a fault: nothing of the state reaches obs
+            obs = observation(self.world.blank_snapshot())
+            space = self.observation_space["joints"]
+            obs["joints"] = np.clip(obs["joints"], space.low, space.high).astype(np.float32)
+        else:
+            obs = observation(result.final)
+        info = result.info()
+        return obs, float(self.reward_fn(info)), True, False, info
 
-    def _record_frame(self, physics: TapPhysics) -> None:
-        if physics.data.time >= self._next_frame_time - 1e-9:
+    def feasible(self, params: Any) -> bool:
+        """Whether the arm can reach every pose of the interaction with ``params`` on the object where the last
+        snapshot saw it, from the kinematics alone (:meth:`World.feasible <affordance_env.world.World.feasible>`)."""
+        return self.world.feasible(self.behavior.name, params)
+
+    def get_state(self) -> EnvState:
+        """A snapshot of the world and of the episode, and the env's random generator. :meth:`set_state` puts it
+        back; the same action then gives the same interaction, bit for bit (an oracle that tries several actions
+        from one state does not replay the reset)."""
+        return EnvState(self.world.get_state(), copy.deepcopy(self.np_random.bit_generator.state))
+
+    def set_state(self, state: EnvState) -> None:
+        """Put back the world and the episode as :meth:`get_state` saw them. The state must come from an env of
+        the same robot model (IncompatibleStateError, a ValueError, otherwise): ``behavior="grasp"`` builds
+        another model than the tap, tap back and push, and ``two_arms=True`` another again."""
+        if not isinstance(state, EnvState):
+            raise TypeError(f"state must be what get_state() returned (an EnvState), got {type(state).__name__}.")
+        self.world.set_state(state.world)
+        self.np_random.bit_generator.state = copy.deepcopy(state.rng)
+
+    def _record_frame(self, time: float) -> None:
+        if time >= self._next_frame_time - 1e-9:
             self.frames.append(self._picture())
             period = 1.0 / self.metadata["render_fps"]
-            while self._next_frame_time <= physics.data.time + 1e-9:  # keep the clock: one frame per period
+            while self._next_frame_time <= time + 1e-9:  # keep the clock: one frame per period
                 self._next_frame_time += period
 
     def _picture(self) -> np.ndarray:
-        if self._renderer is None:
-            from affordance_env.rendering import SceneRenderer
-
-            self._renderer = SceneRenderer(self.physics.model, *self._render_size)
-        return self._renderer.render(self.physics.data)
+        return self.world.picture(*self._render_size)
 
     def render(self):
         """Pictures of the scene from the ``overview`` camera, (H, W, 3) uint8, headless.
@@ -735,9 +394,8 @@ class TapAffordanceEnv(gym.Env):
         return None
 
     def close(self) -> None:
-        if self._renderer is not None:
-            self._renderer.close()
-            self._renderer = None
+        self.world.close()
 
 
-__all__ = ["TapAffordanceEnv", "EnvState", "InitialSnapshot", "default_reward", "BEHAVIORS"]
+__all__ = ["TapAffordanceEnv", "EnvState", "default_reward", "observation", "PLACEMENT_CENTRE",
+           "PLACEMENT_HALF_WIDTH", "RESET_OPTIONS", "YAW_JITTER"]

@@ -43,10 +43,10 @@ class _Parser(argparse.ArgumentParser):
 
 
 def _check_demo(args: argparse.Namespace) -> None:
-    from affordance_env.behaviors import get_behavior
     from affordance_env.objects import check_object_type
+    from affordance_env.registry import check_behavior_name
 
-    get_behavior(args.behavior)
+    check_behavior_name(args.behavior)
     if args.object:
         check_object_type(args.object)
 

@@ -57,7 +57,7 @@ def main() -> None:
         rows.append((info["object"]["type"], info["object"]["size"], info["success"], info["grasp"]["rise"]))
     wall = time.perf_counter() - start
     n = args.episodes
-    print(f"{n} canonical grasps, sizes {env.size_range[0]:.3f}-{env.size_range[1]:.3f} m, "
+    print(f"{n} canonical grasps, sizes {env.options.size_range[0]:.3f}-{env.options.size_range[1]:.3f} m, "
           f"timestep {env.physics.model.opt.timestep * 1e3:g} ms")
     print(f"  valid: {len(rows)}/{n} ({100 * len(rows) / n:.0f} %)"
           + (f"; failures: {dict(failures)}" if failures else ""))

@@ -16,26 +16,31 @@ import argparse
 
 import numpy as np
 
+from affordance_env.behaviors import get_behavior
 from affordance_env.objects import OBJECT_TYPES, object_geometry
+from affordance_env.registry import BEHAVIOR_ARMS
 from affordance_env.tap_env import TapAffordanceEnv
+from affordance_env.world import World
 
 YAWS = (0.0, -0.25, 0.25)  # the env's yaw jitter: boxes and lying cylinders are drawn within +-0.25 rad
 SIZES = (0.04, 0.10)
 
 
-def reachable(env: TapAffordanceEnv, x: float, y: float) -> bool:
-    """Whether the canonical action of the env's behaviour is reachable on every object at (x, y)."""
-    top = env.physics.table_top
+def reachable(world: World, name: str, x: float, y: float) -> bool:
+    """Whether the canonical action of behaviour ``name`` (of the world's one arm) is reachable on every object at
+    (x, y)."""
+    behavior, physics = get_behavior(name), world.physics
+    top = physics.table_top
     # The object out of the scene (a metre under the table): a workspace is where the arm's IK reaches every pose;
     # whether a stroke's reach sweeps through the object is asked per object and action (feasible()).
-    env.physics.reset_home()
-    env.physics.set_object_pose(np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]))
+    physics.reset_home()
+    physics.set_object_pose(np.array([0.0, 0.0, -1.0, 1.0, 0.0, 0.0, 0.0]))
     for object_type in OBJECT_TYPES:
         for size in SIZES:
             g = object_geometry(object_type, size)
             for yaw in YAWS if object_type in ("box", "horizontal_cylinder") else (0.0,):
-                plan = env.interaction.plan(g, np.array([x, y, top + g.half_height]), yaw, top, np.zeros(3))
-                if not env.interaction.reachable(env.motion, plan, env.approach_posture):
+                plan = behavior.plan(g, np.array([x, y, top + g.half_height]), yaw, top, np.zeros(3))
+                if not behavior.reachable(world.motion, plan, world.approach_posture(name)):
                     return False
     return True
 
@@ -54,23 +59,20 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--spacing", type=float, default=0.025, help="grid spacing [m]")
     args = parser.parse_args()
-    right = TapAffordanceEnv(behavior="tap", two_arms=True, camera_width=80, camera_height=60)
-    right.prepare_behaviors(("tap_back", "push"))
-    left = TapAffordanceEnv(behavior="grasp", two_arms=True, camera_width=80, camera_height=60)
-    low, high = right.physics.table_extent()
+    # one world per arm, each in the scene with both arms
+    worlds = {arm: World([name for name, a in BEHAVIOR_ARMS.items() if a == arm], two_arms=True, camera_width=80,
+                         camera_height=60) for arm in sorted(set(BEHAVIOR_ARMS.values()))}
+    low, high = worlds["right"].table.low, worlds["right"].table.high
     h = args.spacing
     grid = np.array([(x, y) for x in np.arange(low[0] + h / 2, high[0], h)
                      for y in np.arange(low[1] + h / 2, high[1], h)])
     reach = {}
-    for name, env in (("tap", right), ("tap_back", right), ("push", right), ("grasp", left)):
-        if name != "grasp":
-            env.use_behavior(name)
-        env.physics.reset_home()
-        reach[name] = np.array([reachable(env, x, y) for x, y in grid])
+    for name, arm in BEHAVIOR_ARMS.items():
+        reach[name] = np.array([reachable(worlds[arm], name, x, y) for x, y in grid])
     candidates = np.any(list(reach.values()), axis=0)
     visible = np.zeros(len(grid), dtype=bool)
-    right.use_behavior("tap")
-    visible[candidates] = [seen(right, x, y) for x, y in grid[candidates]]
+    looking = TapAffordanceEnv(behavior="tap", two_arms=True, camera_width=80, camera_height=60)
+    visible[candidates] = [seen(looking, x, y) for x, y in grid[candidates]]
     print(f"# {candidates.sum()} cells reachable by some behaviour, {visible.sum()} of them seen by the head")
     print(f"SPACING = {h}")
     print("WORKSPACES = {")

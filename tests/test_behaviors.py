@@ -3,17 +3,8 @@
 import numpy as np
 import pytest
 
-from affordance_env.behaviors import (
-    BEHAVIORS,
-    CLEARANCE,
-    FOLLOW_THROUGH,
-    SPEED_CANONICAL,
-    check_action,
-    get_behavior,
-    half_extent_along,
-    is_success,
-    plan_stroke,
-)
+from affordance_env.behaviors import BEHAVIORS, check_action, get_behavior, is_success
+from affordance_env.behaviors.stroke import CLEARANCE, FOLLOW_THROUGH, SPEED_CANONICAL, half_extent_along, plan_stroke
 from affordance_env.objects import object_geometry
 
 TABLE = -0.07

@@ -159,13 +159,13 @@ def test_an_arm_that_hides_nothing_changes_nothing():
     for name, value in (("r_shoulder_pitch", -1.0), ("r_shoulder_roll", 0.45), ("r_elbow", 1.2)):
         physics.data.qpos[physics.model.jnt_qposadr[physics.model.joint(name).id]] = value
     mujoco.mj_forward(physics.model, physics.data)
-    obs, _ = env._snapshot()
+    seen = env.world.look(env.np_random)
     everywhere = env.camera.capture(physics.data)
     blind = RangeCamera(physics.model, width=80, height=60, fovy_deg=57.4, geom_groups=(0,)).capture(physics.data)
     assert (everywhere.geom_ids != blind.geom_ids).any()  # the arm is in view at home, beside the object ...
     # ... and the observation, which casts it only where it could hide the object, is the world's exactly
-    np.testing.assert_array_equal(obs["range"], np.where(np.isfinite(blind.ranges), blind.ranges, 0.0))
-    np.testing.assert_array_equal(obs["mask"], blind.mask_of(physics.active_geom))
+    np.testing.assert_array_equal(seen.ranges, np.where(np.isfinite(blind.ranges), blind.ranges, 0.0))
+    np.testing.assert_array_equal(seen.mask, blind.mask_of(physics.active_geom))
 
 
 def _images_along_interactions(env, interactions, every=37):

@@ -2,6 +2,7 @@
 
 import argparse
 import contextlib
+import dataclasses
 import hashlib
 import json
 import os
@@ -271,13 +272,14 @@ def assert_same_dataset_prefix(path, reference, episodes):
 
 
 def _patch_env(monkeypatch, change):
-    """Make TapAffordanceEnv.step call ``change(episode_seed, info)`` on what it returns (may raise)."""
+    """Make TapAffordanceEnv.step replace the fields of its result that ``change(episode_seed)`` returns (a dict;
+    it may raise)."""
     reset, step = TapAffordanceEnv.reset, TapAffordanceEnv.step
 
     def patched_step(self, action):
-        obs, reward, terminated, truncated, info = step(self, action)
-        change(self._test_seed, info)
-        return obs, reward, terminated, truncated, info
+        returned = step(self, action)
+        self._last = dataclasses.replace(self._last, **change(self._test_seed))
+        return returned
 
     def remembering_reset(self, *, seed=None, options=None):
         self._test_seed = seed
@@ -290,9 +292,8 @@ def _patch_env(monkeypatch, change):
 def test_interactions_the_env_marks_failed_are_reported_never_written(reference, tmp_path, monkeypatch):
     failing = {interaction_seed(5, 1), interaction_seed(5, 4)}
 
-    def fail(seed, info):
-        if seed in failing:
-            info["failure"] = "tap: the hand never touched the object"
+    def fail(seed):
+        return {"failure": "tap: the hand never touched the object"} if seed in failing else {}
 
     _patch_env(monkeypatch, fail)
     out = tmp_path / "failing"
@@ -309,9 +310,10 @@ def test_interactions_the_env_marks_failed_are_reported_never_written(reference,
 
 def test_a_bug_stops_the_collection_with_its_traceback_and_keeps_what_was_written(reference, tmp_path,
                                                                                    monkeypatch):
-    def blow_up(seed, info):
+    def blow_up(seed):
         if seed == interaction_seed(5, 5):
             raise RuntimeError("the simulation blew up")
+        return {}
 
     _patch_env(monkeypatch, blow_up)
     out = tmp_path / "bug"
@@ -329,9 +331,8 @@ def test_a_bug_stops_the_collection_with_its_traceback_and_keeps_what_was_writte
 
 
 def test_non_finite_numbers_in_an_interaction_not_marked_failed_are_a_bug(tmp_path, monkeypatch):
-    def poison(seed, info):
-        if seed == interaction_seed(5, 2):
-            info["effect"] = np.full_like(info["effect"], np.nan)
+    def poison(seed):
+        return {"effect": np.full(49, np.nan, np.float32)} if seed == interaction_seed(5, 2) else {}
 
     _patch_env(monkeypatch, poison)
     with pytest.raises(RuntimeError, match="interaction 2 .* non-finite value"):
@@ -339,9 +340,10 @@ def test_non_finite_numbers_in_an_interaction_not_marked_failed_are_a_bug(tmp_pa
 
 
 def test_collection_stops_above_the_failure_share_and_lists_the_reasons(tmp_path, monkeypatch):
-    def fail_most(seed, info):
+    def fail_most(seed):
         if seed != interaction_seed(5, 0):
-            info["failure"] = "reach: the arm moved the object by 4.0 mm before the stroke"
+            return {"failure": "reach: the arm moved the object by 4.0 mm before the stroke"}
+        return {}
 
     _patch_env(monkeypatch, fail_most)
     out = tmp_path / "unreachable"

@@ -8,7 +8,8 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import affordance_env
-import affordance_env.tap_env as tap_env_module
+import affordance_env.world as world_module
+from affordance_env.behaviors import stroke
 from affordance_env.features import FEATURE_NAMES, effect_features
 from affordance_env.options import EnvOptions
 from affordance_env.range_noise import kinect_axial_sigma
@@ -113,7 +114,7 @@ def test_bad_options_get_clear_errors(kwargs, match, monkeypatch):
         TapAffordanceEnv(**kwargs)
     # the data options alone are refused the same way, without building a model (as a collection checks them)
     if "render_mode" not in kwargs:
-        monkeypatch.setattr(tap_env_module, "build_model", lambda *a: pytest.fail("the check built a model"))
+        monkeypatch.setattr(world_module, "build_model", lambda *a: pytest.fail("the check built a model"))
         with pytest.raises(ValueError, match=match):
             EnvOptions.checked(**kwargs)
         EnvOptions.checked(**{"behavior": "push", "camera_width": 32, "camera_height": 24})
@@ -317,7 +318,7 @@ def test_a_stroke_started_off_its_pose_is_reported(monkeypatch):
     env = TapAffordanceEnv(camera_width=32, camera_height=32)
     env.reset(seed=0)
     assert env.step(np.zeros(3))[4]["failure"] is None
-    env.interaction = dataclasses.replace(env.interaction, max_start_error=1e-5)
+    monkeypatch.setattr(stroke, "MAX_START_ERROR", 1e-5)
     env.reset(seed=0)
     info = env.step(np.zeros(3))[4]
     assert info["failure"].startswith("reach: the stroke started"), info["failure"]
@@ -500,8 +501,8 @@ def test_feasible_tells_from_the_kinematics_whether_the_step_will_reach():
         assert env.physics.data.time == time  # no physics step
         _, _, _, _, info = env.step(np.zeros(3, np.float32))
         assert info["ik"]["success"] is reachable
-    with pytest.raises(ValueError, match="not prepared"):
-        env.feasible(np.zeros(3), behavior="grasp")
+    with pytest.raises(ValueError, match="behavior 'grasp' is not one of this world's: push"):
+        env.world.feasible("grasp", np.zeros(3))
 
 
 def test_feasible_refuses_a_stroke_whose_reach_sweeps_the_arm_into_the_object():

@@ -3,6 +3,7 @@ does not see the object (truncated, with its reason); the head searches the far 
 
 import importlib
 import json
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -25,6 +26,7 @@ class StubEnv:
         self.asked, self.run = [], []
 
     def reset(self, seed):
+        self.seen = self.visible_at_reset
         return {}, {"visible": self.visible_at_reset}
 
     def feasible(self, behavior, params):
@@ -34,16 +36,20 @@ class StubEnv:
 
     def step(self, action):
         self.run.append((action["behavior"], tuple(action["params"])))
-        info = {"failure": None, "visible": True, "observation_visible": self.seen_after(len(self.run) - 1)}
-        return {}, -1.0, False, False, info
+        # the interaction starts from what the head saw before it
+        self.last_result = SimpleNamespace(failure=None, initial=SimpleNamespace(visible=self.seen))
+        self.seen = self.seen_after(len(self.run) - 1)
+        info = {"failure": None, "visible": True, "observation_visible": self.seen, "distance": 0.1,
+                "is_success": False}
+        return {"desired_goal": np.zeros(2), "achieved_goal": np.ones(2)}, -1.0, False, False, info
 
 
 @pytest.fixture
 def rows_as_steps(monkeypatch):
     """``interaction_row`` gives each interaction's step and the visibility it started from."""
     monkeypatch.setattr(importlib.import_module("affordance_env.dataset.collect"), "interaction_row",
-                        lambda episode, seed, action, before, after, images, goal_step: {
-                            "step": goal_step, "visible_initial": before[1]["visible"]})
+                        lambda episode, seed, result, images, goal: {
+                            "step": goal.step, "visible_initial": result.initial.visible})
 
 
 def test_a_goal_episode_runs_only_actions_that_feasible_accepts(rows_as_steps):
@@ -104,9 +110,9 @@ def test_the_head_finds_an_object_on_the_far_part_of_the_table():
     env = TapAffordanceGoalEnv(**SMALL)
     for start in ((-0.20, -0.15), (-0.20, 0.0)):
         env.reset(seed=0, options={"position": start, "object_type": "sphere", "size": 0.06})
-        arm = env.arms["right"]
-        pose = arm.physics.object_pose().copy()
+        physics = env.world.physics
+        pose = physics.object_pose()
         pose[:2] = (-0.715, -0.154)
-        arm.physics.set_object_pose(pose)
-        _, seen = arm.observe()
-        assert seen["visible"] and seen["attention"]["success"], start
+        physics.set_object_pose(pose)
+        seen = env.world.observe(env.np_random)
+        assert seen.visible and seen.attention.success, start

@@ -176,7 +176,7 @@ def test_any_resting_pose_can_be_placed_and_plans_read_it(object_type):
     _, info = env.reset(seed=0, options={"object_type": object_type, "size": 0.06,
                                          "object_pose": (-0.3, 0.02, env.physics.table_top + 0.03, *lying)})
     assert info["object"]["pose"][:2] == pytest.approx((-0.3, 0.02), abs=2e-3)
-    planned = env.get_state().initial.geometry  # what the plans are made from
+    planned = env.world.seen.geometry  # what the plans are made from
     expected = "horizontal_cylinder" if object_type == "vertical_cylinder" else "box"
     assert planned.object_type == expected and as_resting(g, lying)[0].object_type == expected
     with pytest.raises(ValueError, match="object_pose must be"):

@@ -5,14 +5,17 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-from affordance_env.behaviors import (
+from affordance_env.behaviors import get_behavior
+from affordance_env.behaviors.grasp import (
     CLOSE_SPEED_CANONICAL,
+    CLOSING_TORQUE,
     CLOSE_SPEED_RANGE,
     GRASP_CENTRE_HAND,
     GRASP_FINGERS_YAW,
     GRASP_GAP,
     GRASP_GUARD_CLEARANCE,
     GRASP_RETREAT_HEIGHT,
+    GUARDED_SPEED,
     HAND_CLOSED,
     HAND_RELEASE,
     HOLD_TIME,
@@ -20,11 +23,9 @@ from affordance_env.behaviors import (
     OPEN_HAND_DEPTH,
     PLACE_SHIFT,
     GraspBehavior,
-    get_behavior,
     grasp_orientation,
     plan_grasp,
 )
-from affordance_env.grasping import CLOSING_TORQUE, GUARDED_SPEED
 from affordance_env.kinematics import Kinematics
 from affordance_env.objects import object_geometry
 from affordance_env.robot_model import HAND_COUPLINGS, HAND_OPEN, coupled_position

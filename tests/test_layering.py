@@ -48,6 +48,32 @@ def test_motion_imports_no_behaviour():
     # The motion executor takes neutral targets (a palm position, a HandTarget, joint targets) and the posture per
     # call: the behaviours (their plans, strokes, grasps) build on it, not the other way round.
     motion = Path(affordance_env.__file__).parent / "motion.py"
-    behaviours = {"affordance_env.behaviors", "affordance_env.stroke", "affordance_env.grasping",
-                  "affordance_env.interactions"}
-    assert not _imported_modules(motion) & behaviours
+    assert not {m for m in _imported_modules(motion) if m.startswith("affordance_env.behaviors")}
+
+
+def test_the_envs_touch_no_private_attribute_of_another_object():
+    # The envs adapt the world to Gymnasium through its public API only: no ``other._name`` in them.
+    package = Path(affordance_env.__file__).parent
+    for name in ("tap_env.py", "goal_env.py"):
+        offenders = [f"{name}:{node.lineno} {ast.unparse(node)}" for node in ast.walk(ast.parse((package / name)
+                                                                                                .read_text()))
+                     if isinstance(node, ast.Attribute) and node.attr.startswith("_")
+                     and not node.attr.startswith("__")
+                     and not (isinstance(node.value, ast.Name) and node.value.id in ("self", "cls"))]
+        assert not offenders, offenders
+
+
+def test_adding_a_behaviour_is_one_module_and_one_registry_line():
+    # Every behaviour the registry names is defined, under that name, by the module it names, and every behaviour
+    # a module of affordance_env.behaviors defines is registered with that module.
+    import importlib
+    import pkgutil
+
+    from affordance_env import behaviors, registry
+
+    for info in pkgutil.iter_modules(behaviors.__path__):
+        module = importlib.import_module(f"affordance_env.behaviors.{info.name}")
+        for name, behavior in getattr(module, "BEHAVIORS", {}).items():
+            assert behavior.name == name and registry.REGISTERED[name].module == info.name
+    for name, entry in registry.REGISTERED.items():
+        assert name in importlib.import_module(f"affordance_env.behaviors.{entry.module}").BEHAVIORS

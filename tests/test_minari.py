@@ -61,7 +61,7 @@ def test_every_episode_equals_its_row(taps, minari_home):
                                       .to_numpy(np.float64))
     env = dataset.recover_environment()
     assert isinstance(env.unwrapped, TapAffordanceEnv)
-    assert env.unwrapped.camera.intrinsics.width == 40 and env.unwrapped.size_range == (0.05, 0.08)
+    assert env.unwrapped.camera.intrinsics.width == 40 and env.unwrapped.options.size_range == (0.05, 0.08)
     # the dataset's observation space is the environment's, without the joints a dataset does not store
     assert set(env.observation_space.spaces) - set(dataset.observation_space.spaces) == {"joints"}
     for key, space in dataset.observation_space.spaces.items():

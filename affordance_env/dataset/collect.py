@@ -25,7 +25,7 @@ import os
 import signal
 import threading
 import warnings
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -41,7 +41,9 @@ from affordance_env.dataset.format import (
     IMAGE_COLUMNS,
     MANIFEST,
     METADATA_KEY,
+    ChunkResult,
     DatasetError,
+    GoalStep,
     arrow_schema,
     check_chunk,
     chunk_metadata,
@@ -130,34 +132,32 @@ def _goal_episode_rows(env, settings: dict, episode: int) -> tuple[list[dict], s
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
 
     env_seed = interaction_seed(settings["seed"], episode)
-    before = env.reset(seed=env_seed)
+    visible = env.reset(seed=env_seed)[1]["visible"]
     rows: list[dict] = []
     actions = goal_episode_actions(settings["seed"], episode, settings["action"])
     for step in range(GOAL_MAX_EPISODE_STEPS):
-        if not before[1]["visible"]:  # hidden behind an arm, or out of every view of the head
+        if not visible:  # hidden behind an arm, or out of every view of the head
             return rows, None, f"lost: the head did not find the object for step {step}"
         action = next((a for a in itertools.islice(actions, GOAL_ACTION_DRAWS)
                        if env.feasible(a["behavior"], a["params"])), None)
         if action is None:
             return rows, None, (f"infeasible: none of {GOAL_ACTION_DRAWS} actions drawn for step {step} is "
                                 "feasible")
-        after = env.step(action)
-        row = interaction_row(episode, env_seed, action["params"], before, after, settings["save_images"],
-                              goal_step=step)
-        if isinstance(row, str):
-            return rows, f"{row} (at step {step})", None
-        rows.append(row)
-        if after[2]:  # terminated: the goal reached, or the object left the table
+        obs, _, terminated, _, info = env.step(action)
+        result = env.last_result
+        if result.failure is not None:
+            return rows, f"{result.failure} (at step {step})", None
+        goal = GoalStep(step, obs["desired_goal"], obs["achieved_goal"], info["distance"], info["is_success"])
+        rows.append(interaction_row(episode, env_seed, result, settings["save_images"], goal))
+        if terminated:  # the goal reached, or the object left the table
             break
         # the next interaction starts from the observation the head took after this one
-        before = (after[0], {**after[4], "visible": after[4]["observation_visible"]})
+        visible = info["observation_visible"]
     return rows, None, None
 
 
-def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict
-                   ) -> tuple[int, int, dict, str, int]:
-    """Run episodes ``start .. stop-1``, write them as chunk ``index``; returns (index, n, failures, the
-    file's SHA-256, the row count)."""
+def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) -> ChunkResult:
+    """Run episodes ``start .. stop-1``, write them as chunk ``index``, and return what it holds."""
     from affordance_env import __version__
 
     if __version__ != header["package_version"]:
@@ -187,19 +187,17 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict
         action = interaction_action(settings["seed"], episode, settings["action"])
         # An exception here is a bug, not a failed interaction (the env reports those in info["failure"]): it
         # stops the collection with its traceback; the chunks already written stay.
-        reset = env.reset(seed=env_seed)
-        step = env.step(action)
-        row = interaction_row(episode, env_seed, action, reset, step, settings["save_images"])
-        if isinstance(row, str):
-            failures[str(episode)] = row
+        env.reset(seed=env_seed)
+        env.step(action)
+        result = env.last_result
+        if result.failure is not None:
+            failures[str(episode)] = result.failure
             continue
+        row = interaction_row(episode, env_seed, result, settings["save_images"])
         for name in schema.names:
             columns[name].append(row[name])
-    n_rows = len(columns["episode"])
-    chunk = {"index": index, "start": start, "stop": stop, "failures": failures, "rows": n_rows}
-    if goal:
-        chunk["truncated"] = truncated
-    meta = {**header, "chunk": chunk}
+    chunk = ChunkResult(index, start, stop, failures, len(columns["episode"]), truncated=truncated if goal else None)
+    meta = {**header, "chunk": chunk.metadata()}
     table = pa.Table.from_pydict(columns, schema=schema.with_metadata({METADATA_KEY: json.dumps(meta)}))
     # zstd for the images (small); snappy for the numbers: zstd saves little there and reads twice as slowly
     codecs = {name: "zstd" if name in IMAGE_COLUMNS else "snappy" for name in schema.names}
@@ -210,7 +208,7 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict
         digest.append(file_sha256(tmp))  # of the bytes written, before anything else can touch them
 
     write_atomically(Path(out) / chunk_name(index), write)
-    return index, stop - start, failures, digest[0], n_rows
+    return dataclasses.replace(chunk, sha256=digest[0])
 
 
 # --- the coordinator -------------------------------------------------------------------------------------
@@ -340,24 +338,24 @@ def collect(
             found = _existing_chunk(out / chunk_name(index), header, start, stop, stored)
             if found is not None:
                 meta, digest = found
-                done[index] = (stop - start, meta["chunk"]["failures"], digest, meta["rows"])
+                done[index] = ChunkResult.from_metadata(meta["chunk"], digest)
         write_manifest(out, header, episodes, done)
         _check_failure_share(done, max_failure_share, out)
         tasks = [(str(out), i, start, stop, header)
                  for i, (start, stop) in enumerate(ranges) if i not in done]
-        n_failed = sum(len(f) for _, f, _, _ in done.values())
-        with progress_bar(progress, total=episodes, initial=sum(n for n, *_ in done.values()),
+        n_failed = sum(len(chunk.failures) for chunk in done.values())
+        with progress_bar(progress, total=episodes, initial=sum(chunk.episodes for chunk in done.values()),
                           unit="interaction", desc=out.name, smoothing=0.05) as bar:
             bar.set_postfix(failed=n_failed, refresh=False)
-            for index, n, failures, digest, rows in _run(tasks, scheduler, workers, dask_address):
-                if not (out / chunk_name(index)).exists():
-                    raise DatasetError(f"a worker wrote {chunk_name(index)} where this process cannot see "
+            for chunk in _run(tasks, scheduler, workers, dask_address):
+                if not (out / chunk_name(chunk.index)).exists():
+                    raise DatasetError(f"a worker wrote {chunk_name(chunk.index)} where this process cannot see "
                                        f"it: the Dask workers must share {out} with this machine.")
-                done[index] = (n, failures, digest, rows)
+                done[chunk.index] = chunk
                 write_manifest(out, header, episodes, done)
-                n_failed += len(failures)
+                n_failed += len(chunk.failures)
                 bar.set_postfix(failed=n_failed, refresh=False)
-                bar.update(n)
+                bar.update(chunk.episodes)
                 _check_failure_share(done, max_failure_share, out)
     return out
 
@@ -379,9 +377,9 @@ class FailureShareError(DatasetError):
     """More interactions failed than the collection was told to accept."""
 
 
-def _check_failure_share(done: dict[int, tuple[int, dict, str, int]], max_share: float, out: Path) -> None:
-    collected = sum(n for n, *_ in done.values())
-    failures = {k: v for _, chunk, _, _ in done.values() for k, v in chunk.items()}
+def _check_failure_share(done: Mapping[int, ChunkResult], max_share: float, out: Path) -> None:
+    collected = sum(chunk.episodes for chunk in done.values())
+    failures = {k: v for chunk in done.values() for k, v in chunk.failures.items()}
     if collected and len(failures) / collected > max_share:
         raise FailureShareError(
             f"{len(failures)} of the {collected} interactions collected so far failed "
@@ -428,8 +426,8 @@ def _existing_chunk(path: Path, header: dict, start: int, stop: int, stored: dic
         return None
 
 
-def _run(tasks: list[tuple], scheduler: str, workers: int, address: str | None) -> Iterator[tuple]:
-    """Run chunk tasks, yielding ``(index, n, failures)`` as each chunk is written."""
+def _run(tasks: list[tuple], scheduler: str, workers: int, address: str | None) -> Iterator[ChunkResult]:
+    """Run chunk tasks, yielding each chunk as it is written."""
     if not tasks:
         return
     if scheduler == "dask":
@@ -445,7 +443,7 @@ def _run(tasks: list[tuple], scheduler: str, workers: int, address: str | None) 
         )
 
 
-def _collect_chunk_in_worker(*task) -> tuple[int, int, dict, str, int]:
+def _collect_chunk_in_worker(*task) -> ChunkResult:
     """:func:`_collect_chunk` in a worker process of this machine, which leaves Ctrl-C to the coordinating
     process: that one stops the workers (whole chunks stay, as always) and says so once, instead of every worker
     printing a traceback."""

@@ -32,18 +32,23 @@ import hashlib
 import json
 import os
 from collections import Counter
+from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
 from affordance_env.behaviors import ACTION_DIM
-from affordance_env.exceptions import DatasetError
+from affordance_env.exceptions import DatasetError, InvalidValueError
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
 from affordance_env.fileio import write_atomically
 from affordance_env.registry import ENV_IDS, GOAL_ENV_ID
+
+if TYPE_CHECKING:  # the results are made by the simulator, which reading a dataset does not need
+    from affordance_env.results import InteractionResult
 
 #: Version of the on-disk format; :func:`~affordance_env.dataset.load_dataset` reads versions 1 up to this one.
 #: Version 4 added the ``success`` column. Version 5 named the object's pose ``true_initial_x`` ... (it was
@@ -97,51 +102,101 @@ def arrow_schema(save_images: bool = False, goal: bool = False) -> pa.Schema:
     return pa.schema(fields)
 
 
-def _record(episode: int, env_seed: int, action: np.ndarray, reset_info: dict, info: dict) -> dict[str, Any]:
-    obj = info["object"]
-    row: dict[str, Any] = {"episode": episode, "seed": env_seed, "behavior": info["behavior"],
-                           "type": obj["type"], "size": float(obj["size"])}
-    row.update({f"action_{j}": a for j, a in enumerate(action)})
-    for stage in STAGES:
-        row.update({f"{TRUE_PREFIX}{stage}_{f}": float(v)
-                    for f, v in zip(POSE_FIELDS, obj[f"{stage}_pose"], strict=True)})
-    row.update(displacement=float(info["displacement"]), rolling_distance=float(info["rolling_distance"]),
-               rolled=bool(info["rolled"]), success=bool(info["success"]), tilt=float(info["tilt"]),
-               toppled=bool(info["toppled"]), outcome=info["outcome"], outcome_time=float(info["outcome_time"]),
-               contact=bool(info["contact"]), hand_speed=float(info["hand_speed"]),
-               visible_initial=bool(reset_info["visible"]), visible_final=bool(info["visible"]),
-               ik_success=bool(info["ik"]["success"]))
-    for stage, values in (("initial", info["initial_features"]), ("final", info["final_features"]),
-                          ("effect", info["effect"])):
+@dataclass(frozen=True)
+class GoalStep:
+    """Where a TapAffordanceGoal-v0 episode stands after one of its interactions.
+
+    Attributes:
+        step: The interaction's index in its episode.
+        goal: The goal (x, y) [m].
+        achieved: The object's perceived position (x, y) [m] after the interaction.
+        distance: Its distance to the goal [m].
+        reached: Whether it is within the goal tolerance.
+    """
+
+    step: int
+    goal: np.ndarray
+    achieved: np.ndarray
+    distance: float
+    reached: bool
+
+
+def interaction_row(episode: int, env_seed: int, result: InteractionResult, save_images: bool,
+                    goal: GoalStep | None = None) -> dict[str, Any]:
+    """The row of a valid interaction (``result.failure`` is None; a failed one has no row, InvalidValueError).
+    A row with non-finite numbers raises RuntimeError: a bug, not a failed interaction. ``goal``: the interaction
+    is a step of a TapAffordanceGoal-v0 episode."""
+    if result.failure is not None:
+        raise InvalidValueError(f"interaction {episode} failed ({result.failure}): a failed interaction has no row.")
+    row: dict[str, Any] = {"episode": episode, "seed": env_seed, "behavior": result.behavior,
+                           "type": result.object_type, "size": float(result.size)}
+    row.update({f"action_{j}": a for j, a in enumerate(result.action)})
+    for stage, pose in (("initial", result.initial.pose), ("final", result.final_pose)):
+        row.update({f"{TRUE_PREFIX}{stage}_{f}": float(v) for f, v in zip(POSE_FIELDS, pose, strict=True)})
+    row.update(displacement=float(result.displacement), rolling_distance=float(result.rolling_distance),
+               rolled=bool(result.rolled), success=bool(result.success), tilt=float(result.tilt),
+               toppled=bool(result.toppled), outcome=result.outcome, outcome_time=float(result.outcome_time),
+               contact=bool(result.contact), hand_speed=float(result.hand_speed),
+               visible_initial=bool(result.initial.visible), visible_final=bool(result.visible),
+               ik_success=bool(result.ik.success))
+    for stage, values in (("initial", result.initial.features.values), ("final", result.final_features),
+                          ("effect", result.effect)):
         row.update({f"{stage}_{name}": float(v) for name, v in zip(FEATURE_NAMES, values, strict=True)})
-    return row
-
-
-def interaction_row(episode: int, env_seed: int, action: np.ndarray, reset: tuple, step: tuple, save_images: bool,
-                    goal_step: int | None = None) -> dict[str, Any] | str:
-    """The row of an interaction, from what ``env.reset`` and ``env.step`` returned, or the env's reason
-    (``info["failure"]``) why it has none. A row with non-finite numbers raises RuntimeError: a bug, not a failed
-    interaction. ``goal_step``: the interaction is step ``goal_step`` of a TapAffordanceGoal-v0 episode, whose
-    ``reset`` is the observation and info before it (its ``observation`` holds the range image)."""
-    (obs_initial, reset_info), (obs_final, *_, info) = reset, step
-    if info["failure"] is not None:
-        return info["failure"]
-    row = _record(episode, env_seed, action, reset_info, info)
-    if goal_step is not None:
-        row["step"] = int(goal_step)
-        row.update(goal_x=float(obs_final["desired_goal"][0]), goal_y=float(obs_final["desired_goal"][1]),
-                   achieved_x=float(obs_final["achieved_goal"][0]), achieved_y=float(obs_final["achieved_goal"][1]),
-                   goal_distance=float(info["distance"]), goal_reached=bool(info["is_success"]))
-        obs_initial, obs_final = obs_initial["observation"], obs_final["observation"]
+    if goal is not None:
+        row["step"] = int(goal.step)
+        row.update(goal_x=float(goal.goal[0]), goal_y=float(goal.goal[1]), achieved_x=float(goal.achieved[0]),
+                   achieved_y=float(goal.achieved[1]), goal_distance=float(goal.distance),
+                   goal_reached=bool(goal.reached))
     bad = [k for k, v in row.items() if isinstance(v, float | np.floating) and not np.isfinite(v)]
     if bad:  # the env promises finite numbers for every interaction it does not mark failed: this is a bug
         raise RuntimeError(f"interaction {episode} (env seed {env_seed}) was not marked failed but has "
                            f"{len(bad)} non-finite value(s), e.g. {bad[:3]}; nothing of it was written.")
     if save_images:
-        for stage, obs in (("initial", obs_initial), ("final", obs_final)):
-            row[f"image_{stage}_range"] = obs["range"].astype(np.float16).tobytes()
-            row[f"image_{stage}_mask"] = np.packbits(obs["mask"].astype(bool)).tobytes()
+        for stage, snapshot in (("initial", result.initial.snapshot), ("final", result.final)):
+            row[f"image_{stage}_range"] = snapshot.ranges.astype(np.float16).tobytes()
+            row[f"image_{stage}_mask"] = np.packbits(snapshot.mask.astype(bool)).tobytes()
     return row
+
+
+@dataclass(frozen=True)
+class ChunkResult:
+    """One chunk file of a dataset, as its metadata records it and the manifest lists it.
+
+    Attributes:
+        index: The chunk's index.
+        start, stop: Its episodes, ``start .. stop - 1``.
+        failures: The failed interactions' reasons, by episode (as a string).
+        rows: The rows written.
+        sha256: The file's SHA-256 ("" until it is written).
+        truncated: For goal episodes, those cut short and why, by episode; None for TapAffordance-v1.
+    """
+
+    index: int
+    start: int
+    stop: int
+    failures: Mapping[str, str]
+    rows: int
+    sha256: str = ""
+    truncated: Mapping[str, str] | None = None
+
+    @property
+    def episodes(self) -> int:
+        """How many episodes it holds."""
+        return self.stop - self.start
+
+    def metadata(self) -> dict[str, Any]:
+        """Its entry in the chunk file's metadata (``"chunk"``)."""
+        chunk = {"index": self.index, "start": self.start, "stop": self.stop, "failures": dict(self.failures),
+                 "rows": self.rows}
+        if self.truncated is not None:
+            chunk["truncated"] = dict(self.truncated)
+        return chunk
+
+    @classmethod
+    def from_metadata(cls, chunk: Mapping[str, Any], sha256: str) -> ChunkResult:
+        """The chunk its file's metadata describes (:func:`chunk_metadata`), with the file's SHA-256."""
+        return cls(chunk["index"], chunk["start"], chunk["stop"], chunk["failures"], chunk["rows"], sha256,
+                   chunk.get("truncated"))
 
 
 def chunk_name(index: int) -> str:
@@ -233,17 +288,16 @@ def collect_command(path: str | os.PathLike, manifest: dict) -> str:
     return shlex.join(words)
 
 
-def write_manifest(out: Path, header: dict, episodes: int, done: dict[int, tuple[int, dict, str, int]]) -> None:
-    """Write the manifest of the dataset ``out``; ``done`` maps the index of each finished chunk to its episode
-    count, its failures (episode -> reason), its SHA-256 and its row count."""
-    failures = {k: v for _, chunk_failures, _, _ in done.values() for k, v in chunk_failures.items()}
+def write_manifest(out: Path, header: dict, episodes: int, done: Mapping[int, ChunkResult]) -> None:
+    """Write the manifest of the dataset ``out``; ``done`` maps the index of each finished chunk to it."""
+    failures = {k: v for chunk in done.values() for k, v in chunk.failures.items()}
     kinds = Counter(reason.split(":", 1)[0] for reason in failures.values())
     n_chunks = len(chunk_ranges(episodes, header["settings"]["chunk_size"]))
     manifest = {**header, "episodes": episodes, "chunks": n_chunks, "chunks_done": len(done),
-                "complete": len(done) == n_chunks, "rows": sum(rows for *_, rows in done.values()),
+                "complete": len(done) == n_chunks, "rows": sum(chunk.rows for chunk in done.values()),
                 "failures": {"count": len(failures), "by_kind": dict(sorted(kinds.items())),
                              "episodes": {k: failures[k] for k in sorted(failures, key=int)}},
-                CHECKSUMS: {chunk_name(i): done[i][2] for i in sorted(done)}}
+                CHECKSUMS: {chunk_name(i): done[i].sha256 for i in sorted(done)}}
     write_atomically(out / MANIFEST, lambda tmp: tmp.write_text(json.dumps(manifest, indent=1)))
 
 
