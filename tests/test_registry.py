@@ -50,3 +50,23 @@ def test_collect_takes_every_env_option_as_a_flag():
     argv = ["collect", "--episodes", "1", "--out", "x"]
     assert set(names) <= set(vars(parser.parse_args(argv)))  # a flag for every option, unset by default
     assert env_options_from_args(parser.parse_args([*argv, "--camera-width", "40"])) == {"camera_width": 40}
+
+
+@pytest.mark.parametrize("env_class", ["TapAffordanceEnv", "TapAffordanceGoalEnv"])
+def test_every_env_takes_the_data_options_with_their_defaults(env_class):
+    # The constructors spell their keyword arguments out (Gymnasium's style), but each data option is one of them
+    # with EnvOptions' default: a new option, or a changed default, cannot be forgotten in an env.
+    import dataclasses
+    import inspect
+
+    from affordance_env.goal_env import TapAffordanceGoalEnv
+    from affordance_env.options import EnvOptions
+    from affordance_env.tap_env import TapAffordanceEnv
+
+    env = {"TapAffordanceEnv": TapAffordanceEnv, "TapAffordanceGoalEnv": TapAffordanceGoalEnv}[env_class]
+    parameters = inspect.signature(env).parameters
+    for field in dataclasses.fields(EnvOptions):
+        if field.name == "behavior" and env is TapAffordanceGoalEnv:  # it runs every behaviour
+            assert field.name not in parameters
+            continue
+        assert parameters[field.name].default == field.default, field.name
