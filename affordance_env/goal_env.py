@@ -18,8 +18,8 @@ from affordance_env.options import EnvOptions
 from affordance_env.placement import RESET_OPTIONS, draw_placement
 from affordance_env.registry import BEHAVIOR_ARMS, BEHAVIOR_NAMES
 from affordance_env.results import InteractionResult, Snapshot
-from affordance_env.world import World, WorldState
 from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
+from affordance_env.world import World, WorldState
 
 #: The behaviours, in the order of the action's ``behavior`` index (:mod:`affordance_env.registry`).
 BEHAVIORS: tuple[str, ...] = BEHAVIOR_NAMES

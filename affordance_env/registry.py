@@ -65,5 +65,5 @@ def check_env_id(env_id: object) -> str:
     return env_id  # type: ignore[return-value]
 
 
-__all__ = ["ARMS", "BEHAVIOR_ARMS", "REGISTERED", "Registered", "BEHAVIOR_NAMES", "ENV_ID", "ENV_IDS", "GOAL_ENV_ID", "check_behavior_name",
-           "check_env_id"]
+__all__ = ["ARMS", "BEHAVIOR_ARMS", "BEHAVIOR_NAMES", "ENV_ID", "ENV_IDS", "GOAL_ENV_ID", "REGISTERED", "Registered",
+           "check_behavior_name", "check_env_id"]

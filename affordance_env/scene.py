@@ -129,10 +129,10 @@ RANGE_CAMERA_QUAT_HEAD = (0.0, 0.0, 1.0, 0.0)
 RANGE_CAMERA_FOVY_DEG = 50.0
 
 #: The ``home`` keyframe: arm raised above the table beside the workspace, head looking down at the table; the
-#: wrist yawed as every stroke holds it (``affordance_env.behaviors.stroke.FOREARM_RAISED``), so reaching does not swing it. The
-#: forearm's lowest point is 14.8 cm above the table top, so an object of any size (at most 10 cm) that rolls under
-#: the arm waiting at home passes beneath it (at the earlier 5.8 cm, large lying cylinders tapped back towards
-#: home came to rest against the forearm).
+#: wrist yawed as every stroke holds it (``affordance_env.behaviors.stroke.FOREARM_RAISED``), so reaching does not
+#: swing it. The forearm's lowest point is 14.8 cm above the table top, so an object of any size (at most 10 cm)
+#: that rolls under the arm waiting at home passes beneath it (at the earlier 5.8 cm, large lying cylinders tapped
+#: back towards home came to rest against the forearm).
 HOME_QPOS: dict[str, float] = {
     "torso_pitch": 0.4,
     "torso_roll": 0.0,

@@ -1,6 +1,5 @@
 """TapAffordance-v1 as a user meets it: Gymnasium's checker, determinism, the paper's phenomenon, errors."""
 
-import dataclasses
 
 import gymnasium as gym
 import numpy as np

@@ -8,8 +8,8 @@ from gymnasium.utils.env_checker import check_env
 from affordance_env.behaviors import get_behavior
 from affordance_env.behaviors.grasp import (
     CLOSE_SPEED_CANONICAL,
-    CLOSING_TORQUE,
     CLOSE_SPEED_RANGE,
+    CLOSING_TORQUE,
     GRASP_CENTRE_HAND,
     GRASP_FINGERS_YAW,
     GRASP_GAP,
