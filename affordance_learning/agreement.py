@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.results import current_results
+from affordance_learning.results import Config, PerK, PerRK, Results, as_results
 
 #: Standard errors a number may move by (two-sided, about 0.3 % by chance for a normal difference).
 Z = 3.0
@@ -73,41 +73,52 @@ def _tolerance(p: float, n_a: int, n_b: int, std_a: float = 0.0, std_b: float = 
     return max(FLOOR, Z * math.sqrt(variance))
 
 
-def compare_results(reference: Mapping[str, Any], found: Mapping[str, Any]) -> list[Comparison]:
+def compare_results(reference: Results | Mapping[str, Any], found: Results | Mapping[str, Any]) -> list[Comparison]:
     """Every headline number of ``found`` beside ``reference`` (two ``results.json`` of ``affordance reproduce``
-    for one behaviour), with its tolerance. Raises ValueError when they are not the same experiment."""
-    reference, found = current_results(reference), current_results(found)
-    for which, results in (("reference", reference), ("found", found)):
-        config = results.get("config")
-        missing = [key for key in ("uniformity", "svm_accuracy") if not isinstance(results.get(key), Mapping)]
-        missing += [f"config.{key}" for key in ("n_rows", "success_fraction")
-                    if not isinstance(config, Mapping) or not isinstance(config.get(key), int | float)]
-        if missing:
-            raise InvalidValueError(f"the {which} results lack {', '.join(missing)}: compare the results.json of "
-                                    "`affordance reproduce` of this version (older ones: run it again).")
-    ca, cb = reference["config"], found["config"]
+    for one behaviour, or their :class:`~affordance_learning.results.Results`), with its tolerance. Raises
+    InvalidValueError when they are not the same experiment, or lack what is compared (naming it)."""
+    reference, found = as_results(reference), as_results(found)
+    uniformity, accuracy, n_a, share_a = _compared_parts("reference", reference)
+    found_uniformity, _, n_b, share_b = _compared_parts("found", found)
+    ca, cb = reference.config, found.config
     same = ("behavior", "seed", "episodes", "ks", "relevancies", "range_noise")
     differ = [f"{key} {cb.get(key)!r} (reference {ca.get(key)!r})" for key in same if ca.get(key) != cb.get(key)]
     if differ:
         raise InvalidValueError(f"the results are not of the same experiment: {', '.join(differ)}.")
-    trials = min(int(ca.get("n_trials") or ca.get("trials") or 1), int(cb.get("n_trials") or cb.get("trials") or 1))
-    n_a, n_b = int(ca["n_rows"]), int(cb["n_rows"])
+    trials = min(_trials(ca), _trials(cb))
 
-    def compared(name: str, a: Mapping[str, Any], b: Mapping[str, Any]) -> Comparison:
-        p = 0.5 * (a["mean"] + b["mean"])
-        std_a, std_b = float(a.get("std") or 0.0), float(b.get("std") or 0.0)
-        return Comparison(name, a["mean"], b["mean"], _tolerance(p, n_a, n_b, std_a, std_b, trials),
-                          max(std_a, std_b))
+    def compared(name: str, a: float, b: float, std_a: float | None = None, std_b: float | None = None) -> Comparison:
+        spread_a, spread_b = std_a or 0.0, std_b or 0.0
+        return Comparison(name, a, b, _tolerance(0.5 * (a + b), n_a, n_b, spread_a, spread_b, trials),
+                          max(spread_a, spread_b))
 
-    out = [compared("share of successes", {"mean": float(ca["success_fraction"])},
-                    {"mean": float(cb["success_fraction"])})]
-    for k, a in reference["uniformity"].items():
-        b = found["uniformity"].get(k, {})
-        if a.get("mean") is not None and b.get("mean") is not None:
-            out.append(compared(f"uniformity at k = {k}", a, b))
-    for r, by_k in reference["svm_accuracy"].items():
+    out = [compared("share of successes", share_a, share_b)]
+    for k, a in uniformity.items():
+        b = found_uniformity.get(k)
+        if a.mean is not None and b is not None and b.mean is not None:
+            out.append(compared(f"uniformity at k = {k}", a.mean, b.mean, a.std, b.std))
+    for r, by_k in accuracy.items():
         for k, a in by_k.items():
-            b = found["svm_accuracy"].get(r, {}).get(k, {})
-            if a.get("mean") is not None and b.get("mean") is not None:
-                out.append(compared(f"SVM accuracy at k = {k}, r = {r}", a, b))
+            b = found.accuracy(r).get(k)
+            if a.mean is not None and b is not None and b.mean is not None:
+                out.append(compared(f"SVM accuracy at k = {k}, r = {r}", a.mean, b.mean, a.std, b.std))
     return out
+
+
+def _compared_parts(which: str, results: Results) -> tuple[PerK, PerRK, int, float]:
+    """What :func:`compare_results` reads of one run: its uniformity and SVM accuracy, its interactions and its
+    share of successes; InvalidValueError naming all it lacks (``which`` run: the reference or the one found)."""
+    uniformity, accuracy = results.uniformity, results.svm_accuracy
+    n_rows, share = results.config.n_rows, results.config.success_fraction
+    if uniformity is None or accuracy is None or n_rows is None or share is None:
+        missing = [name for name, value in (("uniformity", uniformity), ("svm_accuracy", accuracy),
+                                            ("config.n_rows", n_rows), ("config.success_fraction", share))
+                   if value is None]
+        raise InvalidValueError(f"the {which} results lack {', '.join(missing)}: compare the results.json of "
+                                "`affordance reproduce` of this version (older ones: run it again).")
+    return uniformity, accuracy, n_rows, share
+
+
+def _trials(config: Config) -> int:
+    """The learning trials a run's means are over (``n_trials``, or ``trials`` of ``affordance reproduce``)."""
+    return int(config.n_trials or config.get("trials") or 1)

@@ -14,6 +14,9 @@ The paper reports two behaviours, and the claims are chosen by the behaviour of 
 - ``grasp``: its statements on grasping (average uniformity, the fall at k = 3, the critical size, the 1 x 3
   category that straddles it, size deciding the grasp) with those on the method that hold for any behaviour.
 - any other behaviour: only the statements on the method.
+
+Each claim is specified once, as a :class:`ClaimSpec` (topic, the paper's statement, the rule, the function that
+applies it and the one that says what it is judged on), and judged on :class:`~affordance_learning.results.Results`.
 """
 
 from __future__ import annotations
@@ -24,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from affordance_learning.results import current_results
+from affordance_learning.results import Cluster, PerK, PerRK, Results, as_results
 
 AGREES = "agrees"
 DISAGREES = "disagrees"
@@ -109,30 +112,27 @@ class _Missing(Exception):
     """The results lack what a rule needs."""
 
 
-def _outcome_words(results: Mapping[str, Any]) -> tuple[str, str]:
-    """How a success and a failure read, from the results' config ("success" / "fail" when it does not say)."""
-    config = results.get("config", {})
-    return config.get("success_label", "success"), config.get("fail_label", "fail")
-
-
-def _mean(per_k: Mapping[str, Mapping[str, Any]], k: int | str) -> float:
-    entry = per_k.get(str(k))
-    if entry is None or entry.get("mean") is None:
+def _mean(per_k: PerK, k: int) -> float:
+    """The mean at ``k``; missing when k was not run or no trial gave a value."""
+    entry = per_k.get(k)
+    if entry is None or entry.mean is None:
         raise _Missing(f"no value for k = {k}")
-    return float(entry["mean"])
+    return entry.mean
 
 
-def _curve(per_k: Mapping[str, Mapping[str, Any]]) -> tuple[list[int], np.ndarray]:
-    ks = sorted(int(k) for k in per_k)
+def _curve(per_k: PerK) -> tuple[list[int], np.ndarray]:
+    """k ascending and the mean at each."""
+    ks = sorted(per_k)
     if not ks:
         raise _Missing("no k")
     return ks, np.array([_mean(per_k, k) for k in ks])
 
 
-def _section(results: Mapping[str, Any], key: str) -> Any:
-    if key not in results:
+def _section(section: Any, key: str) -> Any:
+    """A section of the results (``key`` names it); missing when the results lack it."""
+    if section is None:
         raise _Missing(f"results have no {key!r}")
-    return results[key]
+    return section
 
 
 def _ranks(values: Sequence[float]) -> np.ndarray:
@@ -158,18 +158,18 @@ def _fmt(values: Sequence[float], digits: int = 1) -> str:
     return ", ".join(f"{v:.{digits}f}" for v in values)
 
 
-def _uniformity_curve(results: Mapping[str, Any]) -> tuple[list[int], np.ndarray]:
+def _uniformity_curve(results: Results) -> tuple[list[int], np.ndarray]:
     """k and the mean uniformity per k, in percent (the results hold fractions), as the paper states it."""
-    ks, u = _curve(_section(results, "uniformity"))
+    ks, u = _curve(_section(results.uniformity, "uniformity"))
     return ks, 100.0 * u
 
 
-def _uniformity_average(results: Mapping[str, Any]) -> tuple[str, bool]:
+def _uniformity_average(results: Results) -> tuple[str, bool]:
     ks, u = _uniformity_curve(results)
     return f"mean over k = {ks[0]}..{ks[-1]}: {u.mean():.1f} % (per k: {_fmt(u)})", bool(u.mean() > TAP_UNIFORMITY)
 
 
-def _uniformity_rises(results: Mapping[str, Any]) -> tuple[str, bool]:
+def _uniformity_rises(results: Results) -> tuple[str, bool]:
     ks, u = _uniformity_curve(results)
     rho = _rho(ks, u)
     if np.ptp(u) == 0:
@@ -180,21 +180,24 @@ def _uniformity_rises(results: Mapping[str, Any]) -> tuple[str, bool]:
     )
 
 
-def _uniformity_peak(results: Mapping[str, Any]) -> tuple[str, bool]:
+def _uniformity_peak(results: Results) -> tuple[str, bool]:
     ks, u = _uniformity_curve(results)
     best = int(np.argmax(u))
     return f"highest mean uniformity {u[best]:.1f} % at k = {ks[best]}", bool(u[best] >= UNIFORMITY_PEAK)
 
 
-def _by_r(results: Mapping[str, Any], key: str) -> dict[float, tuple[list[int], np.ndarray]]:
-    section = _section(results, key)
+def _by_r(section: PerRK | None, key: str) -> dict[float, tuple[list[int], np.ndarray]]:
+    """Per r, k ascending and the mean at each, of the section ``key``."""
+    section = _section(section, key)
     if not section:
         raise _Missing(f"{key!r} is empty")
-    return {float(r): _curve(per_k) for r, per_k in section.items()}
+    return {r: _curve(per_k) for r, per_k in section.items()}
 
 
-def _group_dominates(results: Mapping[str, Any], group: str) -> tuple[str, bool]:
-    curves = _by_r(results, f"{group}_fraction")
+def _group_dominates(shares: PerRK | None, group: str) -> tuple[str, bool]:
+    """Whether the features of ``group`` ("shape", "size"; ``shares``: their share of the selected ones per r and
+    k) dominate the selection at every r > 0."""
+    curves = _by_r(shares, f"{group}_fraction")
     means = {r: 100.0 * v.mean() for r, (_, v) in sorted(curves.items())}
     positive = {r: m for r, m in means.items() if r > 0}
     if not positive:
@@ -203,24 +206,24 @@ def _group_dominates(results: Mapping[str, Any], group: str) -> tuple[str, bool]
     return text, all(m > DOMINANT_SHARE for m in positive.values())
 
 
-def _shape_dominates(results: Mapping[str, Any]) -> tuple[str, bool]:
-    return _group_dominates(results, "shape")
+def _shape_dominates(results: Results) -> tuple[str, bool]:
+    return _group_dominates(results.shape_fraction, "shape")
 
 
-def _size_dominates(results: Mapping[str, Any]) -> tuple[str, bool]:
-    return _group_dominates(results, "size")
+def _size_dominates(results: Results) -> tuple[str, bool]:
+    return _group_dominates(results.size_fraction, "size")
 
 
-def _shape_share_falls_with_lower_r(results: Mapping[str, Any]) -> tuple[str, bool]:
-    curves = _by_r(results, "shape_fraction")
+def _shape_share_falls_with_lower_r(results: Results) -> tuple[str, bool]:
+    curves = _by_r(results.shape_fraction, "shape_fraction")
     rs = sorted(curves)
     means = [curves[r][1].mean() for r in rs]
     rho = _rho(rs, means)
     return f"Spearman rho(r, mean shape share) = {rho:+.2f}", rho > 0
 
 
-def _count_falls_with_r(results: Mapping[str, Any]) -> tuple[str, bool]:
-    curves = _by_r(results, "n_selected")
+def _count_falls_with_r(results: Results) -> tuple[str, bool]:
+    curves = _by_r(results.n_selected, "n_selected")
     rs = sorted(curves)
     if len(rs) < 2:
         raise _Missing("fewer than 2 relevancy values")
@@ -231,8 +234,8 @@ def _count_falls_with_r(results: Mapping[str, Any]) -> tuple[str, bool]:
     return text, monotone
 
 
-def _count_constant_in_k(results: Mapping[str, Any]) -> tuple[str, bool]:
-    curves = _by_r(results, "n_selected")
+def _count_constant_in_k(results: Results) -> tuple[str, bool]:
+    curves = _by_r(results.n_selected, "n_selected")
     parts, ok = [], True
     for r, (ks, values) in sorted(curves.items()):
         upper = np.array([v for k, v in zip(ks, values, strict=True) if k >= CONSTANT_FROM_K])
@@ -244,25 +247,26 @@ def _count_constant_in_k(results: Mapping[str, Any]) -> tuple[str, bool]:
     return f"number for k >= {CONSTANT_FROM_K} per r: " + "; ".join(parts), ok
 
 
-def _case(results: Mapping[str, Any], k: int) -> list[Mapping[str, Any]]:
-    clusters = _section(results, "case_studies").get(str(k))
+def _case(results: Results, k: int) -> tuple[Cluster, ...]:
+    """The clusters of the 1 x k map of the first trial; missing when it was not described."""
+    clusters = _section(results.case_studies, "case_studies").get(k)
     if not clusters:
         raise _Missing(f"no case study for k = {k}")
     return clusters
 
 
-def _two_cluster_types(results: Mapping[str, Any]) -> tuple[str, bool]:
+def _two_cluster_types(results: Results) -> tuple[str, bool]:
     clusters = _case(results, 2)
-    types = sorted({t for c in clusters for t in c["types"]})
+    types = sorted({t for c in clusters for t in c.types})
     if not set(_ROLLING + _RESTING) <= set(types):
         raise _Missing("the case study lacks one of the four object types")
     home, share = {}, {}
     for t in types:
-        counts = np.array([c["types"].get(t, 0) for c in clusters])
-        home[t] = int(clusters[int(np.argmax(counts))]["cluster"])
+        counts = np.array([c.types.get(t, 0) for c in clusters])
+        home[t] = clusters[int(np.argmax(counts))].index
         share[t] = counts.max() / max(counts.sum(), 1)
     table = "; ".join(
-        f"cluster {c['cluster']}: " + ", ".join(f"{t} {c['types'].get(t, 0)}" for t in types)
+        f"cluster {c.index}: " + ", ".join(f"{t} {c.types.get(t, 0)}" for t in types)
         for c in clusters
     )
     rolling = {home[t] for t in _ROLLING}
@@ -273,15 +277,15 @@ def _two_cluster_types(results: Mapping[str, Any]) -> tuple[str, bool]:
     return f"{table} (share of each type in its majority cluster: {shares})", bool(ok)
 
 
-def _two_cluster_sizes(results: Mapping[str, Any]) -> tuple[str, bool]:
-    clusters = [c for c in _case(results, 2) if c["sizes"]]
-    everything = np.concatenate([np.asarray(c["sizes"], dtype=float) for c in clusters])
+def _two_cluster_sizes(results: Results) -> tuple[str, bool]:
+    clusters = [c for c in _case(results, 2) if c.sizes]
+    everything = np.concatenate([np.asarray(c.sizes, dtype=float) for c in clusters])
     span = np.ptp(everything)
     if span == 0:
         raise _Missing("all objects have the same size")
-    cover = [np.ptp(np.asarray(c["sizes"], dtype=float)) / span for c in clusters]
+    cover = [np.ptp(np.asarray(c.sizes, dtype=float)) / span for c in clusters]
     text = "; ".join(
-        f"cluster {c['cluster']}: {100 * min(c['sizes']):.1f}-{100 * max(c['sizes']):.1f} cm "
+        f"cluster {c.index}: {100 * min(c.sizes):.1f}-{100 * max(c.sizes):.1f} cm "
         f"({100 * f:.0f} % of "
         "the size range)"
         for c, f in zip(clusters, cover, strict=True)
@@ -289,39 +293,39 @@ def _two_cluster_sizes(results: Mapping[str, Any]) -> tuple[str, bool]:
     return text, len(clusters) == 2 and all(f >= SIZE_SPAN for f in cover)
 
 
-def _four_cluster_split(results: Mapping[str, Any]) -> tuple[str, bool]:
+def _four_cluster_split(results: Results) -> tuple[str, bool]:
     clusters = _case(results, 4)
-    success_label, fail_label = _outcome_words(results)
-    success = sum(c["success"] > c["fail"] for c in clusters)
-    fail = sum(c["fail"] > c["success"] for c in clusters)
+    success_label, fail_label = results.config.success_label, results.config.fail_label
+    success = sum(c.success > c.fail for c in clusters)
+    fail = sum(c.fail > c.success for c in clusters)
     text = "; ".join(
-        f"cluster {c['cluster']}: {c['success']} {success_label} / {c['fail']} {fail_label}" for c in clusters
+        f"cluster {c.index}: {c.success} {success_label} / {c.fail} {fail_label}" for c in clusters
     )
     return f"{text} -> {success} success and {fail} fail clusters", success == 2 and fail == 2
 
 
-def _accuracy_falls(results: Mapping[str, Any]) -> tuple[str, bool]:
-    curves = _by_r(results, "svm_accuracy")
+def _accuracy_falls(results: Results) -> tuple[str, bool]:
+    curves = _by_r(results.svm_accuracy, "svm_accuracy")
     rhos = {r: _rho(ks, v) for r, (ks, v) in sorted(curves.items())}
     text = "Spearman rho(k, accuracy): " + ", ".join(f"r = {r}: {rho:+.2f}" for r, rho in rhos.items())
     return text, all(rho <= -TREND_RHO for rho in rhos.values())
 
 
-def _bump_at_four(results: Mapping[str, Any]) -> tuple[str, bool]:
-    section = _section(results, "svm_accuracy")
+def _bump_at_four(results: Results) -> tuple[str, bool]:
+    section = _section(results.svm_accuracy, "svm_accuracy")
     parts, bumps = [], 0
-    for r in sorted(section, key=float):
+    for r in sorted(section):
         a3, a4 = _mean(section[r], 3), _mean(section[r], 4)
         parts.append(f"r = {r}: {100 * a3:.1f} -> {100 * a4:.1f} %")
         bumps += a4 > a3
     return "accuracy k = 3 -> 4: " + "; ".join(parts), bumps * 2 >= len(section)
 
 
-def _accuracy_by_r(results: Mapping[str, Any]) -> dict[float, float]:
-    return {r: float(v.mean()) for r, (_, v) in _by_r(results, "svm_accuracy").items()}
+def _accuracy_by_r(results: Results) -> dict[float, float]:
+    return {r: float(v.mean()) for r, (_, v) in _by_r(results.svm_accuracy, "svm_accuracy").items()}
 
 
-def _low_r_alike(results: Mapping[str, Any]) -> tuple[str, bool]:
+def _low_r_alike(results: Results) -> tuple[str, bool]:
     accuracy = _accuracy_by_r(results)
     low = {r: a for r, a in accuracy.items() if r in (0.0, 0.2, 0.4)}
     if len(low) < 2:
@@ -331,9 +335,9 @@ def _low_r_alike(results: Mapping[str, Any]) -> tuple[str, bool]:
     return f"mean accuracy over k: {text} (spread {spread:.1f} points)", spread <= ALIKE_POINTS
 
 
-def _best_r(results: Mapping[str, Any]) -> tuple[str, bool]:
+def _best_r(results: Results) -> tuple[str, bool]:
     accuracy = _accuracy_by_r(results)
-    counts = {r: float(v.mean()) for r, (_, v) in _by_r(results, "n_selected").items()}
+    counts = {r: float(v.mean()) for r, (_, v) in _by_r(results.n_selected, "n_selected").items()}
     top = max(accuracy.values())
     near = [r for r, a in accuracy.items() if a >= top - BEST_R_POINTS / 100]
     choice = max(near)
@@ -362,73 +366,73 @@ STRADDLE_MAX_SIZE = 0.5
 CRITICAL_SIZE_CONTRAST = 0.5
 
 
-def _grasp_uniformity_average(results: Mapping[str, Any]) -> tuple[str, bool]:
+def _grasp_uniformity_average(results: Results) -> tuple[str, bool]:
     ks, u = _uniformity_curve(results)
     low, high = GRASP_UNIFORMITY
     return f"mean over k = {ks[0]}..{ks[-1]}: {u.mean():.1f} % (per k: {_fmt(u)})", bool(low < u.mean() <= high)
 
 
-def _fall_at_three(results: Mapping[str, Any]) -> tuple[str, bool]:
-    section = _section(results, "uniformity")
+def _fall_at_three(results: Results) -> tuple[str, bool]:
+    section = _section(results.uniformity, "uniformity")
     u2, u3, u4 = (100.0 * _mean(section, k) for k in (2, 3, 4))
     return f"mean uniformity at k = 2, 3, 4: {u2:.1f}, {u3:.1f}, {u4:.1f} %", u3 < u2 and u3 < u4
 
 
-def _critical_size(results: Mapping[str, Any]) -> tuple[str, bool]:
-    section = _section(results, "size_success")
-    fit, critical, test = section.get("logistic"), section.get("critical_size"), section.get("test")
+def _critical_size(results: Results) -> tuple[str, bool]:
+    section = _section(results.size_success, "size_success")
+    fit, critical, test = section.logistic, section.critical_size, section.test
     if fit is None:
         return "one outcome only: no size separates success from failure", False
-    if test is not None and not test["depends_on_size"]:
-        return (f"success does not depend on size: the fit (slope {fit['slope'] / 100:+.2f} per cm of logit) changes "
-                f"the share of successes by {100 * test['span']:+.0f} points across the sizes seen "
-                f"(likelihood-ratio test p = {test['p_value']:.2g})", False)
+    if test is not None and not test.depends_on_size:
+        return (f"success does not depend on size: the fit (slope {fit.slope / 100:+.2f} per cm of logit) changes "
+                f"the share of successes by {100 * test.span:+.0f} points across the sizes seen "
+                f"(likelihood-ratio test p = {test.p_value:.2g})", False)
     if critical is None:
-        return (f"the logistic fit (slope {fit['slope'] / 100:+.2f} per cm of logit) does not cross 50 % within "
+        return (f"the logistic fit (slope {fit.slope / 100:+.2f} per cm of logit) does not cross 50 % within "
                 "the sizes seen", False)
-    below, above = section["below"], section["above"]
-    if below["success"] is None or above["success"] is None:
+    below, above = section.below, section.above
+    if below is None or above is None or below.success is None or above.success is None:
         raise _Missing("no object on one side of the critical size")
-    contrast = below["success"] - above["success"]
-    text = (f"the fit crosses 50 % at {100 * critical:.1f} cm (slope {fit['slope'] / 100:+.2f} per cm of logit); "
-            f"successes below it {100 * below['success']:.0f} % of {below['n']}, above it "
-            f"{100 * above['success']:.0f} % of {above['n']}")
-    return text, bool(fit["slope"] < 0 and contrast >= CRITICAL_SIZE_CONTRAST)
+    contrast = below.success - above.success
+    text = (f"the fit crosses 50 % at {100 * critical:.1f} cm (slope {fit.slope / 100:+.2f} per cm of logit); "
+            f"successes below it {100 * below.success:.0f} % of {below.n}, above it "
+            f"{100 * above.success:.0f} % of {above.n}")
+    return text, bool(fit.slope < 0 and contrast >= CRITICAL_SIZE_CONTRAST)
 
 
-def _straddling_cluster(results: Mapping[str, Any]) -> tuple[str, bool]:
-    critical = _section(results, "size_success").get("critical_size")
+def _straddling_cluster(results: Results) -> tuple[str, bool]:
+    critical = _section(results.size_success, "size_success").critical_size
     if critical is None:
         raise _Missing("no critical size: success does not depend on size, or the fit of success on size does not "
                        "cross 50 % within the sizes seen")
-    success_label, fail_label = _outcome_words(results)
+    success_label, fail_label = results.config.success_label, results.config.fail_label
     clusters = _case(results, 3)
-    total = max(sum(c["success"] + c["fail"] for c in clusters), 1)
+    total = max(sum(c.n for c in clusters), 1)
     parts, straddling, why_not = [], [], []
     for c in clusters:
-        sizes = np.asarray(c["sizes"], dtype=float)
-        share = (c["success"] + c["fail"]) / total
+        sizes = np.asarray(c.sizes, dtype=float)
+        share = c.n / total
         if sizes.size == 0:
-            parts.append(f"cluster {c['cluster']}: empty")
+            parts.append(f"cluster {c.index}: empty")
             continue
         below = float(np.mean(sizes < critical))
-        minority = min(c["success"], c["fail"]) / (c["success"] + c["fail"])
-        parts.append(f"cluster {c['cluster']} ({c['success'] + c['fail']} interactions, {100 * share:.1f} %): "
+        minority = min(c.success, c.fail) / c.n
+        parts.append(f"cluster {c.index} ({c.n} interactions, {100 * share:.1f} %): "
                      f"{100 * sizes.min():.1f}-{100 * sizes.max():.1f} cm, {100 * below:.0f} % below; "
-                     f"{c['success']} {success_label} / {c['fail']} {fail_label}")
+                     f"{c.success} {success_label} / {c.fail} {fail_label}")
         if min(below, 1.0 - below) < STRADDLE_SHARE or minority < STRADDLE_SHARE:
             continue  # neither its objects nor its outcomes lie on both sides
         others = [o for o in clusters if o is not c]
-        sides = {(o["success"] > o["fail"]) - (o["fail"] > o["success"]) for o in others}  # 1: mostly successes
+        sides = {(o.success > o.fail) - (o.fail > o.success) for o in others}  # 1: mostly successes
         if not STRADDLE_MIN_SIZE <= share < STRADDLE_MAX_SIZE:
-            why_not.append(f"cluster {c['cluster']} lies on both sides but holds {100 * share:.0f} % of the "
+            why_not.append(f"cluster {c.index} lies on both sides but holds {100 * share:.0f} % of the "
                            f"interactions: a straddling category holds >= {100 * STRADDLE_MIN_SIZE:.0f} % and < "
                            f"{100 * STRADDLE_MAX_SIZE:.0f} %")
-        elif not {1, -1} <= sides or any(o["success"] + o["fail"] < STRADDLE_MIN_SIZE * total for o in others):
-            why_not.append(f"cluster {c['cluster']} lies on both sides but the others are not a success and a fail "
+        elif not {1, -1} <= sides or any(o.n < STRADDLE_MIN_SIZE * total for o in others):
+            why_not.append(f"cluster {c.index} lies on both sides but the others are not a success and a fail "
                            f"category of >= {100 * STRADDLE_MIN_SIZE:.0f} % each")
         else:
-            straddling.append(str(c["cluster"]))
+            straddling.append(str(c.index))
     text = (f"critical size {100 * critical:.1f} cm; " + "; ".join(parts)
             + f" -> straddling: {', '.join(straddling) or 'none'}"
             + ("" if straddling or not why_not else f" ({'; '.join(why_not)})"))
@@ -436,8 +440,15 @@ def _straddling_cluster(results: Mapping[str, Any]) -> tuple[str, bool]:
 
 
 @dataclass(frozen=True)
-class _Basis:
-    """What a verdict is judged on: ``n`` (None when the results do not say), as text, and whether it is enough."""
+class Basis:
+    """What a verdict is judged on.
+
+    Attributes:
+        n: How many trials or interactions (None when the results do not say).
+        text: ``n`` as text ("20 trials of 1000 interactions").
+        needed: The least data a verdict is given on, as text.
+        enough: Whether ``n`` is at least that.
+    """
 
     n: int | None
     text: str
@@ -445,69 +456,100 @@ class _Basis:
     enough: bool
 
 
-def _over_trials(results: Mapping[str, Any]) -> _Basis:
+def _over_trials(results: Results) -> Basis:
     """A claim on means over trials: n is the trials, each over all the run's interactions."""
-    config = results.get("config", {})
-    trials, rows = config.get("n_trials"), config.get("n_rows")
+    trials, rows = results.config.n_trials, results.config.n_rows
     needed = f"{MIN_TRIALS} trials of {MIN_INTERACTIONS} interactions"
     if trials is None or rows is None:
-        return _Basis(None, "unknown", needed, False)
-    return _Basis(int(trials), f"{trials} trials of {rows} interactions", needed,
-                  trials >= MIN_TRIALS and rows >= MIN_INTERACTIONS)
+        return Basis(None, "unknown", needed, False)
+    return Basis(trials, f"{trials} trials of {rows} interactions", needed,
+                 trials >= MIN_TRIALS and rows >= MIN_INTERACTIONS)
 
 
-def _in_map(k: int) -> Callable[[Mapping[str, Any]], _Basis]:
+def _in_map(k: int) -> Callable[[Results], Basis]:
     """A claim on the 1 x k map of the first trial: n is the interactions in it."""
-    def basis(results: Mapping[str, Any]) -> _Basis:
-        clusters = results.get("case_studies", {}).get(str(k)) or []
-        n = sum(c["success"] + c["fail"] for c in clusters)
-        return _Basis(n if clusters else None, f"{n} interactions in the 1 x {k} map of the first trial",
-                      f"{MIN_INTERACTIONS} interactions", n >= MIN_INTERACTIONS)
+    def basis(results: Results) -> Basis:
+        clusters = results.clusters(k)
+        n = sum(c.n for c in clusters)
+        return Basis(n if clusters else None, f"{n} interactions in the 1 x {k} map of the first trial",
+                     f"{MIN_INTERACTIONS} interactions", n >= MIN_INTERACTIONS)
     return basis
 
 
-def _over_sizes(results: Mapping[str, Any]) -> _Basis:
+def _over_sizes(results: Results) -> Basis:
     """A claim on success by object size: n is the interactions binned by size."""
-    bins = (results.get("size_success") or {}).get("bins")
-    n = sum(b["n"] for b in bins or ())
-    return _Basis(n if bins else None, f"{n} interactions", f"{MIN_INTERACTIONS} interactions",
-                  n >= MIN_INTERACTIONS)
+    bins = results.size_success.bins if results.size_success is not None else ()
+    n = sum(b.n for b in bins)
+    return Basis(n if bins else None, f"{n} interactions", f"{MIN_INTERACTIONS} interactions",
+                 n >= MIN_INTERACTIONS)
 
 
-_Judge = Callable[[Mapping[str, Any]], tuple[str, bool]]
-#: A claim before it is judged: topic, the paper's statement, the rule, the function that applies it, and the
-#: function that says what the verdict is judged on (its n).
-_Spec = tuple[str, str, str, _Judge, Callable[[Mapping[str, Any]], _Basis]]
+@dataclass(frozen=True)
+class ClaimSpec:
+    """A claim before it is judged: one statement of the paper and the numeric rule our verdict on it follows.
 
-_UNIFORMITY_RISES: _Spec = (
+    Attributes:
+        topic: Short name of the statement.
+        paper: What the paper says.
+        rule: The rule, as the report writes it beside the verdict.
+        judge: Applies the rule to the results: our numbers as text, and whether they agree; raises
+            :class:`_Missing` when the results lack what the rule needs.
+        basis: Says what the verdict is judged on (its n) and whether that is enough.
+    """
+
+    topic: str
+    paper: str
+    rule: str
+    judge: Callable[[Results], tuple[str, bool]]
+    basis: Callable[[Results], Basis]
+
+    def judged(self, results: Results) -> Claim:
+        """The claim with our numbers and its verdict on ``results`` (see :func:`evaluate_claims`)."""
+        basis = self.basis(results)
+        try:
+            ours, ok = self.judge(results)
+        except _Missing as why:
+            ours, verdict = f"({why})", NOT_COMPUTABLE
+        else:
+            if basis.n is None:
+                ours, verdict = f"{ours} (the results do not say how much data this is)", NOT_COMPUTABLE
+            elif not basis.enough:
+                verdict = TOO_FEW
+            else:
+                verdict = AGREES if ok else DISAGREES
+        return Claim(topic=self.topic, paper=self.paper, rule=self.rule, ours=ours, verdict=verdict, n=basis.n,
+                     judged_on=basis.text, needed=basis.needed)
+
+
+_UNIFORMITY_RISES = ClaimSpec(
     "Uniformity rises with k",
     "Uniformity of clusters increases with the number of clusters.",
     f"Spearman rank correlation of k and mean uniformity >= {TREND_RHO}",
     _uniformity_rises,
     _over_trials,
 )
-_UNIFORMITY_PEAK: _Spec = (
+_UNIFORMITY_PEAK = ClaimSpec(
     "Uniformity peak",
     "It can reach up to 95 %.",
     f"highest mean uniformity over k >= {UNIFORMITY_PEAK:.0f} %",
     _uniformity_peak,
     _over_trials,
 )
-_FEWER_FEATURES: _Spec = (
+_FEWER_FEATURES = ClaimSpec(
     "Fewer features as r rises",
     "The number of selected features tends to be inversely proportional to r.",
     "for every k the mean number never grows with r, and is lower at the largest r than at the smallest",
     _count_falls_with_r,
     _over_trials,
 )
-_NUMBER_CONSTANT: _Spec = (
+_NUMBER_CONSTANT = ClaimSpec(
     "Number constant in k",
     "The number of selected features remains the same above some number of clusters.",
     f"for every r, the coefficient of variation over k >= {CONSTANT_FROM_K} of the mean number <= {CONSTANT_CV}",
     _count_constant_in_k,
     _over_trials,
 )
-_ACCURACY_FALLS: _Spec = (
+_ACCURACY_FALLS = ClaimSpec(
     "SVM accuracy falls with k",
     "SVM prediction accuracy decreases as the number of effect categories grows.",
     f"for every r, Spearman rank correlation of k and mean accuracy <= {-TREND_RHO}",
@@ -516,10 +558,10 @@ _ACCURACY_FALLS: _Spec = (
 )
 
 #: The paper's statements on the method, which do not depend on the behaviour.
-METHOD_CLAIMS: tuple[_Spec, ...] = (_UNIFORMITY_RISES, _FEWER_FEATURES, _NUMBER_CONSTANT, _ACCURACY_FALLS)
+METHOD_CLAIMS: tuple[ClaimSpec, ...] = (_UNIFORMITY_RISES, _FEWER_FEATURES, _NUMBER_CONSTANT, _ACCURACY_FALLS)
 
-GRASP_CLAIMS: tuple[_Spec, ...] = (
-    (
+GRASP_CLAIMS: tuple[ClaimSpec, ...] = (
+    ClaimSpec(
         "Uniformity on average",
         "The average uniformity is above ... 70 % for grasping.",
         f"mean over k of the mean uniformity > {GRASP_UNIFORMITY[0]:.0f} % and <= {GRASP_UNIFORMITY[1]:.0f} % "
@@ -529,14 +571,14 @@ GRASP_CLAIMS: tuple[_Spec, ...] = (
     ),
     _UNIFORMITY_RISES,
     _UNIFORMITY_PEAK,
-    (
+    ClaimSpec(
         "Fall at k = 3",
         "There is a fall in the general trend of increase in the grasp behaviour for the 3 cluster case.",
         "mean uniformity at k = 3 below both k = 2 and k = 4",
         _fall_at_three,
         _over_trials,
     ),
-    (
+    ClaimSpec(
         "Critical size",
         "The grasping behaviour is affected mostly by the size of the object ... there is a critical size value "
         "determining the graspability.",
@@ -546,7 +588,7 @@ GRASP_CLAIMS: tuple[_Spec, ...] = (
         _critical_size,
         _over_sizes,
     ),
-    (
+    ClaimSpec(
         "1 x 3 map: a category straddles the critical size",
         "One of the clusters falls near this region, stealing from both and therefore decreasing uniformity.",
         f"a cluster of the 1 x 3 map (first trial) with >= {100 * STRADDLE_MIN_SIZE:.0f} % and < "
@@ -558,7 +600,7 @@ GRASP_CLAIMS: tuple[_Spec, ...] = (
         _straddling_cluster,
         _in_map(3),
     ),
-    (
+    ClaimSpec(
         "Size features dominate",
         "The grasping behaviour is affected mostly by the size of the object to be grasped.",
         f"for every r > 0, the mean over k of the size share of the selected features > {DOMINANT_SHARE:.0f} % "
@@ -571,8 +613,8 @@ GRASP_CLAIMS: tuple[_Spec, ...] = (
     _ACCURACY_FALLS,
 )
 
-TAP_CLAIMS: tuple[_Spec, ...] = (
-    (
+TAP_CLAIMS: tuple[ClaimSpec, ...] = (
+    ClaimSpec(
         "Uniformity on average",
         "The average uniformity is above 80 % for tapping.",
         f"mean over k of the mean uniformity > {TAP_UNIFORMITY:.0f} %",
@@ -581,14 +623,14 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
     ),
     _UNIFORMITY_RISES,
     _UNIFORMITY_PEAK,
-    (
+    ClaimSpec(
         "Shape features dominate",
         "Shape features dominate the selected features.",
         f"for every r > 0, the mean over k of the shape share of the selected features > {DOMINANT_SHARE:.0f} %",
         _shape_dominates,
         _over_trials,
     ),
-    (
+    ClaimSpec(
         "Shape share and r",
         "When the relevancy threshold is decreased ... the percentage of shape features decreases.",
         "Spearman rank correlation of r and the mean shape share > 0",
@@ -597,7 +639,7 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
     ),
     _FEWER_FEATURES,
     _NUMBER_CONSTANT,
-    (
+    ClaimSpec(
         "1 x 2 map: object types",
         "One cluster holds spheres and horizontal cylinders (rollable), the other boxes and "
         "vertical cylinders.",
@@ -606,14 +648,14 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
         _two_cluster_types,
         _in_map(2),
     ),
-    (
+    ClaimSpec(
         "1 x 2 map: sizes",
         "Both clusters have instances from the whole size range.",
         f"each of the 2 clusters spans >= {100 * SIZE_SPAN:.0f} % of the range of object sizes (first trial)",
         _two_cluster_sizes,
         _in_map(2),
     ),
-    (
+    ClaimSpec(
         "1 x 4 map: success/fail",
         "Two of the four clusters are success clusters, the other two fail clusters.",
         "exactly 2 clusters with more successes (rolled) than failures and 2 with more failures (first trial)",
@@ -621,21 +663,21 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
         _in_map(4),
     ),
     _ACCURACY_FALLS,
-    (
+    ClaimSpec(
         "Bump at k = 4",
         "Accuracy increases at 4 clusters against the decreasing trend (four object types).",
         "mean accuracy at k = 4 above that at k = 3 for at least half of the r values",
         _bump_at_four,
         _over_trials,
     ),
-    (
+    ClaimSpec(
         "r = 0, 0.2, 0.4 alike",
         "Accuracy is almost the same for relevancy values of 0 %, 20 % and 40 %.",
         f"mean accuracy over k of these r within {ALIKE_POINTS:g} percentage points",
         _low_r_alike,
         _over_trials,
     ),
-    (
+    ClaimSpec(
         "r = 0.4 best",
         "40 % is the best relevancy: maximum accuracy with the highest perceptual economy.",
         f"the largest r whose mean accuracy over k is within {BEST_R_POINTS:g} point of the best r's is {BEST_R}",
@@ -646,13 +688,13 @@ TAP_CLAIMS: tuple[_Spec, ...] = (
 
 
 #: The claims of each behaviour the paper reports on; any other behaviour gets :data:`METHOD_CLAIMS`.
-CLAIM_SETS: dict[str, tuple[_Spec, ...]] = {"tap": TAP_CLAIMS, "grasp": GRASP_CLAIMS}
+CLAIM_SETS: dict[str, tuple[ClaimSpec, ...]] = {"tap": TAP_CLAIMS, "grasp": GRASP_CLAIMS}
 
 
-def results_behavior(results: Mapping[str, Any]) -> str:
-    """The behaviour of a results dict (``config["behavior"]``); results without it, written before the
-    behaviour was recorded, are the tap's."""
-    return str(results.get("config", {}).get("behavior", "tap"))
+def results_behavior(results: Results | Mapping[str, Any]) -> str:
+    """The behaviour of results (``config["behavior"]``); results without it, written before the behaviour was
+    recorded, are the tap's."""
+    return as_results(results).behavior
 
 
 def claims_scope(behavior: str) -> str:
@@ -666,13 +708,12 @@ def claims_scope(behavior: str) -> str:
             "which hold for any behaviour, are checked (sections V.B, V.C, V.E).")
 
 
-def claims_for(behavior: str) -> tuple[_Spec, ...]:
-    """The claims (topic, the paper, rule, judge, basis) checked for ``behavior``: its own set in
-    :data:`CLAIM_SETS`, else :data:`METHOD_CLAIMS`."""
+def claims_for(behavior: str) -> tuple[ClaimSpec, ...]:
+    """The claims checked for ``behavior``: its own set in :data:`CLAIM_SETS`, else :data:`METHOD_CLAIMS`."""
     return CLAIM_SETS.get(behavior, METHOD_CLAIMS)
 
 
-def evaluate_claims(results: Mapping[str, Any], behavior: str | None = None) -> list[Claim]:
+def evaluate_claims(results: Results | Mapping[str, Any], behavior: str | None = None) -> list[Claim]:
     """The paper's claims on a behaviour with our numbers and a verdict computed from them.
 
     A verdict is "agrees" or "disagrees" only on enough data (:data:`MIN_TRIALS` trials of
@@ -681,24 +722,12 @@ def evaluate_claims(results: Mapping[str, Any], behavior: str | None = None) -> 
     or do not say how much data they hold.
 
     Args:
-        results: The dict of :func:`affordance_learning.protocol.run_protocol` (or its JSON), or part of it.
+        results: :class:`~affordance_learning.results.Results`, or the dict of
+            :func:`affordance_learning.protocol.run_protocol` (or its JSON), or part of it.
         behavior: Whose claims to check; by default the results' own (:func:`results_behavior`).
+
+    Raises:
+        InvalidValueError: The results are of a newer format, or hold a section that is not of the format.
     """
-    results = current_results(results)
-    claims = []
-    for topic, paper, rule, judge, basis_of in claims_for(results_behavior(results) if behavior is None else behavior):
-        basis = basis_of(results)
-        try:
-            ours, ok = judge(results)
-        except _Missing as why:
-            ours, verdict = f"({why})", NOT_COMPUTABLE
-        else:
-            if basis.n is None:
-                ours, verdict = f"{ours} (the results do not say how much data this is)", NOT_COMPUTABLE
-            elif not basis.enough:
-                verdict = TOO_FEW
-            else:
-                verdict = AGREES if ok else DISAGREES
-        claims.append(Claim(topic=topic, paper=paper, rule=rule, ours=ours, verdict=verdict, n=basis.n,
-                            judged_on=basis.text, needed=basis.needed))
-    return claims
+    results = as_results(results)
+    return [spec.judged(results) for spec in claims_for(results.behavior if behavior is None else behavior)]

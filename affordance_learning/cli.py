@@ -13,7 +13,7 @@ import sys
 import time
 import warnings
 from pathlib import Path
-from typing import NoReturn
+from typing import TYPE_CHECKING, NoReturn
 
 from affordance_env.collect_cli import (
     add_collect_parser,
@@ -25,13 +25,17 @@ from affordance_env.collect_cli import (
 from affordance_env.exceptions import AffordanceEnvError
 from affordance_env.registry import ENV_ID
 from affordance_learning.exceptions import AffordanceLearningError, InvalidValueError
+from affordance_learning.plan_results import PLAN_RESULTS_FORMAT
+
+if TYPE_CHECKING:
+    from affordance_learning.results import Results
 
 #: The sizes of ``affordance plan`` (:class:`~affordance_learning.plan_experiment.PlanSettings`' defaults), for its
 #: help; an option not given keeps PlanSettings' own default.
 PLAN_DEFAULTS = {"episodes": 1000, "goals": 160, "multi_episodes": 40}
 #: What ``affordance plan`` writes into its ``--out``: its goal episodes in this directory, and its results
-#: (of this format), report and figures beside it.
-PLAN_DATASET, PLAN_RESULTS_FORMAT = "dataset", "tap-affordance-plan-results"
+#: (of the format :data:`~affordance_learning.plan_results.PLAN_RESULTS_FORMAT`), report and figures beside it.
+PLAN_DATASET = "dataset"
 
 
 class _Parser(argparse.ArgumentParser):
@@ -163,11 +167,14 @@ def _compare(args: argparse.Namespace) -> int:
     return 1 if outside else 0
 
 
-def _results_of(where: Path) -> dict:
+def _results_of(where: Path) -> Results:
+    """The learning results in ``where`` (a reproduction's directory, or its ``results.json``)."""
+    from affordance_learning.results import Results
+
     results = _read_json(where / "results.json" if where.is_dir() else where)
     if not isinstance(results, dict) or "config" not in results:
         raise InvalidValueError(f"{where} holds no results.json of `affordance reproduce`.")
-    return results
+    return Results.from_dict(results)
 
 
 def _read_json(path: Path) -> object:
@@ -250,18 +257,20 @@ def _plan(args: argparse.Namespace) -> int:
         write_plan_figures,
         write_plan_report,
     )
+    from affordance_learning.plan_results import PlanResults
 
     settings = PlanSettings(**{name: getattr(args, name) for name in PLAN_DEFAULTS
                                if getattr(args, name) is not None})
     results = run_plan(args.out, seed=args.seed, workers=args.workers, settings=settings)
     frames = record_episode(args.out, results, seed=args.seed)
-    write_plan_figures(results, args.out, frames)
-    report = write_plan_report(results, args.out)
-    verdicts = [target_verdict(name, value) for name, value in measured_targets(results).items()]
+    plan = PlanResults.from_dict(results)
+    write_plan_figures(plan, args.out, frames)
+    report = write_plan_report(plan, args.out)
+    verdicts = [target_verdict(name, value) for name, value in measured_targets(plan).items()]
     counts = ", ".join(f"{verdicts.count(v)} {v}" for v in dict.fromkeys(verdicts))
     print(f"{len(verdicts)} targets: {counts} (a verdict only on enough data); {report} gives each with its n and "
           f"why a missed one is missed; {args.out / 'results.json'} holds every number "
-          f"({results['timings_s']['total'] / 60:.1f} min)")
+          f"({plan.total_time_s / 60:.1f} min)")
     return 0
 
 

@@ -26,14 +26,14 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.results import current_results
+from affordance_learning.results import Cluster, PerK, PerRK, Results, as_results
 
 _REQUIRED = ("uniformity", "svm_accuracy", "shape_fraction", "size_fraction", "n_selected", "case_studies")
 _TYPE_COLOURS = {
@@ -47,19 +47,27 @@ _DPI = 120
 _PAPER_UNIFORMITY = {"tap": (80.0, 95.0), "grasp": (70.0, 95.0)}
 
 
-def _words(results: Mapping[str, Any]) -> tuple[str, str, str]:
+_Section = TypeVar("_Section")
+
+
+def _held(section: _Section | None, name: str) -> _Section:
+    """A section of the results that :func:`write_figures` made sure they hold (``name`` names it)."""
+    if section is None:
+        raise InvalidValueError(f"results lack [{name!r}]; expected the dict returned by run_protocol.")
+    return section
+
+
+def _words(results: Results) -> tuple[str, str, str]:
     """The behaviour and how its success and failure read, from the results' config."""
-    config = results.get("config", {})
-    return (config.get("behavior", "tap"), config.get("success_label", "success"),
-            config.get("fail_label", "fail"))
+    return results.behavior, results.config.success_label, results.config.fail_label
 
 
-def _series(per_k: Mapping[str, Mapping[str, float | None]]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _series(per_k: PerK) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """k, mean and std arrays (NaN where a value is None), sorted by k."""
-    ks = sorted(per_k, key=int)
-    mean = np.array([np.nan if per_k[k]["mean"] is None else per_k[k]["mean"] for k in ks], dtype=float)
-    std = np.array([np.nan if per_k[k]["std"] is None else per_k[k]["std"] for k in ks], dtype=float)
-    return np.array([int(k) for k in ks]), mean, std
+    ks = sorted(per_k)
+    mean = np.array([np.nan if per_k[k].mean is None else per_k[k].mean for k in ks], dtype=float)
+    std = np.array([np.nan if per_k[k].std is None else per_k[k].std for k in ks], dtype=float)
+    return np.array(ks, dtype=int), mean, std
 
 
 def _new_figure(width: float, height: float, ncols: int = 1, nrows: int = 1) -> tuple[Figure, np.ndarray]:
@@ -74,10 +82,10 @@ def _save(fig: Figure, path: Path) -> Path:
     return path
 
 
-def _uniformity(results: Mapping[str, Any], path: Path) -> Path:
+def _uniformity(results: Results, path: Path) -> Path:
     fig, (ax,) = _new_figure(5.5, 3.8)
     behavior, success, fail = _words(results)
-    k, mean, std = _series(results["uniformity"])
+    k, mean, std = _series(_held(results.uniformity, "uniformity"))
     ax.errorbar(k, 100.0 * mean, yerr=100.0 * std, marker="o", capsize=3, label="ours (mean ± std over trials)")
     if behavior in _PAPER_UNIFORMITY:
         average, peak = _PAPER_UNIFORMITY[behavior]
@@ -96,24 +104,24 @@ def _uniformity(results: Mapping[str, Any], path: Path) -> Path:
     return _save(fig, path)
 
 
-def _per_r(ax: Any, per_rk: Mapping[str, Mapping[str, Any]], scale: float = 1.0) -> None:
-    for r in sorted(per_rk, key=float):
+def _per_r(ax: Any, per_rk: PerRK, scale: float = 1.0) -> None:
+    for r in sorted(per_rk):
         k, mean, std = _series(per_rk[r])
         ax.errorbar(k, mean * scale, yerr=std * scale, marker="o", markersize=3, capsize=2, label=f"r = {r}")
         ax.set_xticks(k)
     ax.grid(alpha=0.3)
 
 
-def _selected_features(results: Mapping[str, Any], path: Path) -> Path:
+def _selected_features(results: Results, path: Path) -> Path:
     fig, (top, middle, bottom) = _new_figure(6.0, 9.0, nrows=3)
-    _per_r(top, results["shape_fraction"], 100.0)
+    _per_r(top, _held(results.shape_fraction, "shape_fraction"), 100.0)
     top.set(
         ylabel="shape features [%]", ylim=(0, 102), title="Shape share of the selected features (cf. Fig. 8a)"
     )
     top.legend(fontsize="small", ncols=3)
-    _per_r(middle, results["size_fraction"], 100.0)
+    _per_r(middle, _held(results.size_fraction, "size_fraction"), 100.0)
     middle.set(ylabel="size features [%]", ylim=(0, 102), title="Size share of the selected features")
-    _per_r(bottom, results["n_selected"])
+    _per_r(bottom, _held(results.n_selected, "n_selected"))
     bottom.set(
         xlabel="number of clusters k",
         ylabel="selected features",
@@ -123,22 +131,22 @@ def _selected_features(results: Mapping[str, Any], path: Path) -> Path:
     return _save(fig, path)
 
 
-def _case_study(results: Mapping[str, Any], k: str, path: Path) -> Path:
-    clusters = results["case_studies"][k]
+def _case_study(results: Results, k: int, path: Path) -> Path:
+    clusters = results.clusters(k)
     behavior, success_label, fail_label = _words(results)
     fig, (ax_label, ax_type, ax_size) = _new_figure(12.0, 3.8, ncols=3)
-    index = np.array([c["cluster"] for c in clusters])
-    success = np.array([c["success"] for c in clusters])
-    fail = np.array([c["fail"] for c in clusters])
+    index = np.array([c.index for c in clusters])
+    success = np.array([c.success for c in clusters])
+    fail = np.array([c.fail for c in clusters])
     ax_label.bar(index, success, color="tab:green", label=f"{success_label} (success)")
     ax_label.bar(index, fail, bottom=success, color="tab:gray", label=f"{fail_label} (fail)")
     ax_label.set(xlabel="cluster", ylabel="interactions", title="(a) outcomes measured by the simulator")
     ax_label.legend(fontsize="small")
 
-    types = list(dict.fromkeys(t for c in clusters for t in c["types"]))
+    types = list(dict.fromkeys(t for c in clusters for t in c.types))
     width = 0.8 / max(len(types), 1)
     for i, t in enumerate(types):
-        counts = [c["types"].get(t, 0) for c in clusters]
+        counts = [c.types.get(t, 0) for c in clusters]
         ax_type.bar(
             index - 0.4 + width * (i + 0.5),
             counts,
@@ -149,11 +157,11 @@ def _case_study(results: Mapping[str, Any], k: str, path: Path) -> Path:
     ax_type.set(xlabel="cluster", ylabel="interactions", title="(b) object types")
     ax_type.legend(fontsize="small")
 
-    sizes = [np.asarray(c["sizes"], dtype=float) * 100.0 for c in clusters]
+    sizes = [np.asarray(c.sizes, dtype=float) * 100.0 for c in clusters]
     filled = [i for i, s in enumerate(sizes) if s.size]
     if filled:
         ax_size.boxplot([sizes[i] for i in filled], positions=index[filled], widths=0.6)
-    critical = results.get("size_success", {}).get("critical_size")
+    critical = None if results.size_success is None else results.size_success.critical_size
     if critical is not None:
         ax_size.axhline(100.0 * critical, color="tab:red", linestyle="--", linewidth=1,
                         label=f"critical size {100.0 * critical:.1f} cm")
@@ -166,23 +174,23 @@ def _case_study(results: Mapping[str, Any], k: str, path: Path) -> Path:
     return _save(fig, path)
 
 
-def _size_success(results: Mapping[str, Any], path: Path) -> Path:
-    section = results["size_success"]
+def _size_success(results: Results, path: Path) -> Path:
+    section = _held(results.size_success, "size_success")
     behavior, success_label, _ = _words(results)
     fig, (ax,) = _new_figure(5.5, 3.8)
-    bins = [b for b in section["bins"] if b["success"] is not None]
-    centres = np.array([50.0 * (b["low"] + b["high"]) for b in bins])
-    widths = np.array([100.0 * (b["high"] - b["low"]) for b in bins])
-    ax.bar(centres, [100.0 * b["success"] for b in bins], width=0.9 * widths if widths.size else 0.8,
+    bins = [b for b in section.bins if b.success is not None]
+    centres = np.array([50.0 * (b.low + b.high) for b in bins])
+    widths = np.array([100.0 * (b.high - b.low) for b in bins])
+    ax.bar(centres, [100.0 * (b.success or 0.0) for b in bins], width=0.9 * widths if widths.size else 0.8,
            color="tab:green", alpha=0.5, label="share per size bin")
-    if section.get("logistic") and bins:
-        fit = section["logistic"]
-        sizes = np.linspace(section["bins"][0]["low"], section["bins"][-1]["high"], 200)
-        ax.plot(100.0 * sizes, 100.0 / (1.0 + np.exp(-(fit["intercept"] + fit["slope"] * sizes))),
+    if section.logistic is not None and bins:
+        fit = section.logistic
+        sizes = np.linspace(section.bins[0].low, section.bins[-1].high, 200)
+        ax.plot(100.0 * sizes, 100.0 / (1.0 + np.exp(-(fit.intercept + fit.slope * sizes))),
                 color="black", label="logistic fit")
-    if section.get("critical_size") is not None:
-        ax.axvline(100.0 * section["critical_size"], color="tab:red", linestyle="--", linewidth=1,
-                   label=f"crosses 50 % at {100.0 * section['critical_size']:.1f} cm")
+    if section.critical_size is not None:
+        ax.axvline(100.0 * section.critical_size, color="tab:red", linestyle="--", linewidth=1,
+                   label=f"crosses 50 % at {100.0 * section.critical_size:.1f} cm")
     ax.set(xlabel="object size [cm]", ylabel=f"{success_label} [%]", ylim=(0, 102),
            title=f"{behavior}: success by object size")
     ax.legend(fontsize="small")
@@ -190,11 +198,11 @@ def _size_success(results: Mapping[str, Any], path: Path) -> Path:
     return _save(fig, path)
 
 
-def _svm_accuracy(results: Mapping[str, Any], path: Path) -> Path:
+def _svm_accuracy(results: Results, path: Path) -> Path:
     fig, (ax,) = _new_figure(6.0, 4.0)
-    _per_r(ax, results["svm_accuracy"], 100.0)
-    if "svm_baseline" in results:
-        k, mean, _ = _series(results["svm_baseline"])
+    _per_r(ax, _held(results.svm_accuracy, "svm_accuracy"), 100.0)
+    if results.svm_baseline is not None:
+        k, mean, _ = _series(results.svm_baseline)
         ax.plot(k, mean * 100.0, color="black", linestyle="--", linewidth=1, label="most common category")
     ax.set(
         xlabel="number of clusters k",
@@ -206,10 +214,10 @@ def _svm_accuracy(results: Mapping[str, Any], path: Path) -> Path:
     return _save(fig, path)
 
 
-def _clusters_vs_type(results: Mapping[str, Any], path: Path) -> Path:
+def _clusters_vs_type(results: Results, path: Path) -> Path:
     fig, (ax,) = _new_figure(5.5, 3.8)
-    for key, label in (("purity", "purity"), ("adjusted_rand", "adjusted Rand index")):
-        k, mean, std = _series(results[key])
+    for section, label in ((results.purity, "purity"), (results.adjusted_rand, "adjusted Rand index")):
+        k, mean, std = _series(_held(section, label))
         ax.errorbar(k, mean, yerr=std, marker="o", capsize=3, label=label)
         ax.set_xticks(k)
     ax.set(xlabel="number of clusters k", ylabel="agreement with object type", ylim=(-0.05, 1.05))
@@ -223,9 +231,9 @@ def _clusters_vs_type(results: Mapping[str, Any], path: Path) -> Path:
 LEFT_VIEW_SHARE = 0.5
 
 
-def _prototypes(results: Mapping[str, Any], path: Path) -> Path:
-    maps = sorted(results["prototypes"].items(), key=lambda item: int(item[0]))
-    names = list(results["feature_names"])
+def _prototypes(results: Results, path: Path) -> Path:
+    maps = sorted(_held(results.prototypes, "prototypes").items())
+    names = list(_held(results.feature_names, "feature_names"))
     _, success, fail = _words(results)
     fig, axes = _new_figure(14.0, 3.2 * len(maps), ncols=4, nrows=len(maps))
     axes = axes.reshape(len(maps), 4)
@@ -235,7 +243,7 @@ def _prototypes(results: Mapping[str, Any], path: Path) -> Path:
     xyz = [index.get(n) for n in ("mean_x", "mean_y", "mean_z")]
     for row, (k, prototypes) in enumerate(maps):
         P = np.asarray(prototypes, dtype=float)
-        clusters = results.get("case_studies", {}).get(k, [])
+        clusters = results.clusters(k)
         gone = np.zeros(len(P), dtype=bool)  # categories whose objects mostly left the view
         labels = []
         for c in range(len(P)):
@@ -243,10 +251,9 @@ def _prototypes(results: Mapping[str, Any], path: Path) -> Path:
             if cl is None:
                 labels.append(str(c))
                 continue
-            n = cl["success"] + cl["fail"]
-            gone[c] = n > 0 and cl.get("left_view", 0) > LEFT_VIEW_SHARE * n
-            labels.append(f"{c} ({cl['success']} {success} / {cl['fail']} {fail})"
-                          + (f", {cl['left_view']} left the view" if gone[c] else ""))
+            gone[c] = cl.n > 0 and (cl.left_view or 0) > LEFT_VIEW_SHARE * cl.n
+            labels.append(f"{c} ({cl.success} {success} / {cl.fail} {fail})"
+                          + (f", {cl.left_view} left the view" if gone[c] else ""))
         ax_move, ax_pix, ax_lat, ax_lon = axes[row]
         if None not in xyz:
             width = 0.8 / 3
@@ -280,37 +287,40 @@ def _prototypes(results: Mapping[str, Any], path: Path) -> Path:
     return _save(fig, path)
 
 
-def _cluster(clusters: list[Mapping[str, Any]], c: int) -> Mapping[str, Any] | None:
-    return next((cl for cl in clusters if cl.get("cluster") == c), None)
+def _cluster(clusters: tuple[Cluster, ...], c: int) -> Cluster | None:
+    """The cluster of index ``c``; None when the map does not describe it."""
+    return next((cl for cl in clusters if cl.index == c), None)
 
 
-def write_figures(results: Mapping[str, Any], out_dir: str | Path, progress: bool | None = False) -> list[Path]:
+def write_figures(results: Results | Mapping[str, Any], out_dir: str | Path,
+                  progress: bool | None = False) -> list[Path]:
     """Write the figures of a results dict into ``out_dir`` (created if needed); returns their paths.
 
     Args:
-        results: The dict returned by :func:`affordance_learning.protocol.run_protocol` (or read back from
-            its JSON).
+        results: :class:`~affordance_learning.results.Results`, or the dict returned by
+            :func:`affordance_learning.protocol.run_protocol` (or read back from its JSON).
         out_dir: Directory for the PNG files.
         progress: Draw a progress bar over the figures; None: a bar on a terminal, else a line every 10 s.
+
+    Raises:
+        InvalidValueError: The results lack a section the figures need (naming every one), or hold one that is
+            not of the format.
     """
-    results = current_results(results)
-    missing = [key for key in _REQUIRED if key not in results]
-    if missing:
-        raise InvalidValueError(f"results lack {missing}; expected the dict returned by run_protocol.")
+    results = as_results(results, required=_REQUIRED)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     drawings = [
         (_uniformity, results, out / "uniformity.png"),
         (_selected_features, results, out / "selected_features.png"),
     ]
-    for k in sorted(results["case_studies"], key=int):
+    for k in sorted(_held(results.case_studies, "case_studies")):
         drawings.append((lambda r, p, k=k: _case_study(r, k, p), results, out / f"case_study_k{k}.png"))
     drawings.append((_svm_accuracy, results, out / "svm_accuracy.png"))
-    if results.get("size_success"):
+    if results.size_success is not None:
         drawings.append((_size_success, results, out / "size_success.png"))
-    if "purity" in results and "adjusted_rand" in results:
+    if results.purity is not None and results.adjusted_rand is not None:
         drawings.append((_clusters_vs_type, results, out / "clusters_vs_type.png"))
-    if results.get("prototypes") and "feature_names" in results:
+    if results.prototypes and results.feature_names is not None:
         drawings.append((_prototypes, results, out / "prototypes.png"))
     from affordance_env.progress import progress_bar
 

@@ -2,7 +2,7 @@
 
 :data:`TARGETS` holds each target once; the check and the report's text both read it. A target is judged "met" or
 "missed" only on enough data (:data:`MIN_N`); below that it is "too few (n=...)", and a share of nothing is "not
-measured", never 0 %.
+measured", never 0 %. The results are read through :class:`~affordance_learning.plan_results.PlanResults`.
 """
 
 from __future__ import annotations
@@ -14,7 +14,9 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.plan_experiment import GOAL_KINDS, MULTI_POLICIES, POLICIES, SHAPES, share_text, wilson
+from affordance_learning.plan_results import NOTHING, PlanResults, Share
 
 #: The targets of the planner, each a (direction, value): ">=" or "<=".
 TARGETS: dict[str, tuple[str, float]] = {
@@ -77,27 +79,17 @@ class Measured(NamedTuple):
     detail: str | None = None
 
 
-def _share(entry: Mapping[str, Any], key: str = "success", n: str = "n", unit: str = "") -> str:
-    """A policy's share in the report: value, Wilson 95 % interval and n (:func:`share_text`)."""
-    return share_text(entry.get(key), entry.get(n, 0), entry.get(f"{key}_ci"), unit, digits=1)
+def _share(share: Share, unit: str = "") -> str:
+    """A share in the report: value, Wilson 95 % interval and n (:func:`share_text`)."""
+    return share_text(share.value, share.n, share.ci, unit, digits=1)
 
 
-def _placements(results: Mapping[str, Any]) -> int:
-    """How many place goals the planner acted on (the n of the median placement error); counted from the goals
-    for results written before ``placement_error_n``."""
-    if "placement_error_n" in results:
-        return int(results["placement_error_n"])
-    return sum(g["kind"] == "place" and bool(g.get("planner_behavior")) for g in results.get("goals", []))
-
-
-def _worst_shape(results: Mapping[str, Any]) -> Measured:
+def _worst_shape(results: PlanResults) -> Measured:
     """The shape target: the worst share among the shapes judged on enough feasible goals if one misses the
     bound (one such shape misses the target, whatever the others); else the worst share measured, with the
     smallest n of the shapes (every shape must be measured on enough goals for the target to be met)."""
-    loso = results["leave_one_shape_out"]
-    shapes = {s: Measured(r["planner"]["success_feasible"], int(r["planner"]["n_feasible"]),
-                          f"feasible goals of {s}", tuple(r["planner"]["success_feasible_ci"]))
-              for s, r in loso.items()}
+    shapes = {s: _measured(r["planner"].feasible, f"feasible goals of {s}")
+              for s, r in results.leave_one_shape_out.items()}
     name = "each left-out shape, success on its feasible goals"
     _, bound = TARGETS[name]
     detail = "; ".join(f"{s} {share_text(m.value, m.n, m.ci, digits=1)}" for s, m in shapes.items())
@@ -111,27 +103,43 @@ def _worst_shape(results: Mapping[str, Any]) -> Measured:
     return worst._replace(n=fewest.n, unit=fewest.unit, ci=None, detail=detail)
 
 
-def measured_targets(results: Mapping[str, Any]) -> dict[str, Measured]:
-    """The value of every target in ``results`` with its n (for the shape target see :func:`_worst_shape`)."""
-    single = results["single_step"]["planner"]
-    multi = results["multi_step"]["planner"]
-    failures = round(multi["reach_failures"] * multi["interactions"])
-    calibration = results["calibration"]
+def _measured(share: Share, unit: str) -> Measured:
+    """A target's share, with its n and interval."""
+    return Measured(share.value, share.n, unit, share.ci)
+
+
+def _policy(outcomes: Mapping[str, Any], name: str, where: str) -> Any:
+    """The outcome of policy ``name`` in ``outcomes`` (``where`` names them); InvalidValueError when it was not
+    run."""
+    if name not in outcomes:
+        raise InvalidValueError(f"the plan results hold no {where} outcome of policy {name!r}, only of "
+                                f"{', '.join(outcomes)}.")
+    return outcomes[name]
+
+
+def measured_targets(results: PlanResults | Mapping[str, Any]) -> dict[str, Measured]:
+    """The value of every target in ``results`` with its n (for the shape target see :func:`_worst_shape`).
+
+    Raises:
+        InvalidValueError: ``results`` are not those of ``affordance plan`` (naming what they lack).
+    """
+    results = PlanResults.from_dict(results)
+    single = _policy(results.single_step, "planner", "single-step")
+    multi = results.multi_step.policy("planner")
+    calibration = results.calibration
     return {
-        "single-step success on feasible goals": Measured(single["success_feasible"], int(single["n_feasible"]),
-                                                          "feasible goals", tuple(single["success_feasible_ci"])),
-        "single-step success over the oracle's": Measured(results["planner_over_oracle"], int(single["n_feasible"]),
+        "single-step success on feasible goals": _measured(single.feasible, "feasible goals"),
+        "single-step success over the oracle's": Measured(results.planner_over_oracle, single.feasible.n,
                                                           "feasible goals"),
-        "median placement error [m]": Measured(results["placement_error_median_m"], _placements(results),
+        "median placement error [m]": Measured(results.placement_error_median_m, results.placement_error_n,
                                                "place goals acted on"),
         "each left-out shape, success on its feasible goals": _worst_shape(results),
-        "calibration ECE": Measured(calibration["ece"], int(calibration["n"]), "actions"),
-        "calibration AUROC": Measured(calibration["auroc"], int(calibration["n"]), "actions"),
-        "multi-step targets reached": Measured(multi["success"], int(multi["n"]), "episodes",
-                                               tuple(multi["success_ci"])),
+        "calibration ECE": Measured(calibration.ece, calibration.n, "actions"),
+        "calibration AUROC": Measured(calibration.auroc, calibration.n, "actions"),
+        "multi-step targets reached": _measured(multi.reached, "episodes"),
         "multi-step reach failures per interaction": Measured(
-            multi["reach_failures"] if multi["interactions"] else None, int(multi["n"]),
-            f"episodes, {multi['interactions']} interactions", wilson(failures, multi["interactions"])),
+            multi.reach_failures if multi.interactions else None, multi.reached.n,
+            f"episodes, {multi.interactions} interactions", wilson(multi.reach_failure_count, multi.interactions)),
     }
 
 
@@ -175,38 +183,44 @@ def _value_text(name: str, measured: Measured) -> str:
     return share_text(measured.value, measured.n, measured.ci, measured.unit, digits=1)
 
 
-def _why(name: str, results: Mapping[str, Any]) -> str:
+def _reached(outcomes: Mapping[str, Any], policy: str) -> Share:
+    """How often ``policy`` reached its goals among ``outcomes``; :data:`NOTHING` when it was not run."""
+    outcome = outcomes.get(policy)
+    return NOTHING if outcome is None else outcome.reached
+
+
+def _why(name: str, results: PlanResults) -> str:
     """Why a target is missed, from the data."""
-    single = results["single_step_by_goal"]
+    single = results.single_step_by_goal
     if name.startswith("single-step"):
-        gaps = sorted(((single[k]["oracle"]["success"] or 0) - (single[k]["planner"]["success"] or 0), k)
+        gaps = sorted(((single[k]["oracle"].reached.value or 0) - (single[k]["planner"].reached.value or 0), k)
                       for k in GOAL_KINDS if single.get(k))
-        worst = ", ".join(f"{k}: planner {_share(single[k]['planner'])} vs oracle {_share(single[k]['oracle'])}"
-                          for _, k in reversed(gaps[-2:]))
+        worst = ", ".join(f"{k}: planner {_share(single[k]['planner'].reached)} vs oracle "
+                          f"{_share(single[k]['oracle'].reached)}" for _, k in reversed(gaps[-2:]))
         return f"the gap to the oracle is largest for {worst}"
     if name.startswith("median placement"):
-        place = single.get("place", {})
-        return (f"place goals are reached in {_share(place.get('oracle', {}))} of cases even by the oracle: most "
+        place = _reached(single.get("place", {}), "oracle")
+        return (f"place goals are reached in {_share(place)} of cases even by the oracle: most "
                 "targets 5-15 cm away are beyond what one interaction does to the object")
     if name.startswith("each left-out"):
-        loso = results["leave_one_shape_out"]
-        parts = [f"{s}: {_share(loso[s]['planner'], 'success_feasible', 'n_feasible', 'feasible')} (best fixed "
-                 f"{_share(loso[s]['best_fixed'], 'success_feasible', 'n_feasible', 'feasible')})" for s in loso]
+        loso = results.leave_one_shape_out
+        parts = [f"{s}: {_share(loso[s]['planner'].feasible, 'feasible')} (best fixed "
+                 f"{_share(loso[s]['best_fixed'].feasible, 'feasible')})" for s in loso]
         return "; ".join(parts)
     if name.startswith("calibration"):
-        curve = results["calibration"]["curve"]
-        off = max(curve, key=lambda c: abs(c["p"] - c["observed"]) * c["n"]) if curve else None
-        return ("" if off is None else f"the largest miscalibration is at P = {off['p']:.2f}: observed "
-                f"{off['observed']:.2f} over {off['n']} actions")
-    multi = results["multi_step"]["planner"]
+        curve = results.calibration.curve
+        off = max(curve, key=lambda c: abs(c.p - c.observed) * c.n) if curve else None
+        return ("" if off is None else f"the largest miscalibration is at P = {off.p:.2f}: observed "
+                f"{off.observed:.2f} over {off.n} actions")
+    multi = results.multi_step.policy("planner")
     if name.startswith("multi-step reach"):
         kinds: dict[str, int] = {}
-        for e in multi.get("episodes", []):
-            for failure in e.get("failures", []):
+        for e in multi.episodes:
+            for failure in e.failures:
                 kind = _FAILURE_KINDS.get(failure.split(" by ")[0].split(" (")[0], failure.split(":")[0])
                 kinds[kind] = kinds.get(kind, 0) + 1
         listed = ", ".join(f"{n} {kind}" for kind, n in sorted(kinds.items(), key=lambda item: -item[1]))
-        return (f"{round(multi['reach_failures'] * multi['interactions'])} of {multi['interactions']} "
+        return (f"{multi.reach_failure_count} of {multi.interactions} "
                 f"interactions failed to reach although the kinematics said they would: {listed}")
     return multi_step_why(results)
 
@@ -220,41 +234,45 @@ _FAILURE_KINDS = {
 }
 
 
-def multi_step_why(results: Mapping[str, Any]) -> str:
+def multi_step_why(results: PlanResults | Mapping[str, Any]) -> str:
     """Why multi-step episodes miss their targets: per object type, success and how far one interaction moves it;
     how many missed targets lay beyond what the episode's interactions can do (:func:`within_reach`), and the
     planner's success on the others."""
-    multi = results["multi_step"]["planner"]
-    reach = results["multi_step"].get("step_reach_p90_m", {})
-    most = results["multi_step"]["max_interactions"]
-    missed = [e for e in multi.get("episodes", []) if not e["success"]]
-    beyond = [e for e in missed if not e["within_reach"]]
+    results = PlanResults.from_dict(results)
+    multi = results.multi_step.policy("planner")
+    reach = results.multi_step.step_reach_p90_m
+    most = results.multi_step.max_interactions
+    missed = [e for e in multi.episodes if not e.success]
+    beyond = [e for e in missed if not e.within_reach]
     per_type = "; ".join(
-        f"{t}: {share_text(r['success'], r['n'], digits=1)} (9 in 10 interactions move it at most "
+        f"{t}: {share_text(r.value, r.n, digits=1)} (9 in 10 interactions move it at most "
         + ", ".join(f"{100 * v:.1f}" for v in reach.get(t, {}).values()) + " cm along +x, -x, +y, -y)"
-        for t, r in multi.get("by_type", {}).items())
-    towards = sum(e["target_xy"][0] - e["start_xy"][0] > reach.get(e["type"], {}).get("+x", 0.0) * most
-                  for e in beyond)
-    inside = multi.get("within_reach", {})
-    gave_up = sum(e["gave_up"] for e in missed)
-    return (f"{_share(multi, unit='episodes')} reach the target (median final distance "
-            f"{100 * multi['median_final_distance_m']:.1f} cm). By type: {per_type}. {len(beyond)} of the "
+        for t, r in multi.by_type.items())
+    towards = sum(e.target_xy[0] - e.start_xy[0] > reach.get(e.type, {}).get("+x", 0.0) * most for e in beyond)
+    inside = multi.within_reach
+    gave_up = sum(e.gave_up for e in missed)
+    return (f"{_share(multi.reached, unit='episodes')} reach the target (median final distance "
+            f"{100 * multi.median_final_distance_m:.1f} cm). By type: {per_type}. {len(beyond)} of the "
             f"{len(missed)} missed targets lay further along an axis than {most} such interactions take the object "
             f"({towards} of them towards the robot, where only rolling brings an object); on the "
-            f"{inside.get('n', 0)} targets within that reach the planner reached "
-            f"{share_text(inside.get('success'), inside.get('n', 0), digits=1)}. In "
+            f"{inside.n} targets within that reach the planner reached "
+            f"{share_text(inside.value, inside.n, digits=1)}. In "
             f"{gave_up} missed episodes the object ended where no candidate action was reachable")
 
 
-def write_plan_report(results: Mapping[str, Any], out: str | os.PathLike) -> Path:
-    """Write ``REPORT.md`` into ``out``."""
+def write_plan_report(results: PlanResults | Mapping[str, Any], out: str | os.PathLike) -> Path:
+    """Write ``REPORT.md`` into ``out``.
+
+    Raises:
+        InvalidValueError: ``results`` are not those of ``affordance plan`` (naming what they lack).
+    """
+    results = PlanResults.from_dict(results)
     out = Path(out)
     lines = ["# Using the affordances: planning with action-conditioned effect models", ""]
-    s = results["settings"]
-    lines += [f"Seed {results['seed']}; training interactions per behaviour: "
-              + ", ".join(f"{b} {n}" for b, n in results["training"].items())
-              + f" (random actions from {s['episodes']} goal episodes, objects over the workspaces). "
-              f"Total time {results['timings_s']['total'] / 60:.1f} min.", ""]
+    lines += [f"Seed {results.seed}; training interactions per behaviour: "
+              + ", ".join(f"{b} {n}" for b, n in results.training.items())
+              + f" (random actions from {results.episodes} goal episodes, objects over the workspaces). "
+              f"Total time {results.total_time_s / 60:.1f} min.", ""]
     lines += ["## Targets", "",
               "A target is judged only on enough data, else it is *too few* (a share of nothing is *not measured*): "
               f"at least {MIN_FEASIBLE_GOALS} feasible single-step goals, {MIN_FEASIBLE_PER_SHAPE} feasible goals "
@@ -269,44 +287,43 @@ def write_plan_report(results: Mapping[str, Any], out: str | os.PathLike) -> Pat
                                                                      else f"{100 * bound:.0f} %")
         lines.append(f"| {name} | {direction} {bound_text} | {_value_text(name, measured)} | "
                      f"**{verdict_text(name, measured)}** | {_why(name, results) if verdict == MISSED else ''} |")
-    single = results["single_step"]
-    lines += ["", f"## Single step ({single['planner']['n']} held-out objects, one goal each; "
-              f"{single['oracle']['n_feasible']} feasible)", "",
+    single = results.single_step
+    lines += ["", f"## Single step ({_policy(single, 'planner', 'single-step').reached.n} held-out objects, one goal "
+              f"each; {_policy(single, 'oracle', 'single-step').feasible.n} feasible)", "",
               "| policy | success [95 % CI] | on feasible goals [95 % CI] |", "|---|---|---|"]
     for p in POLICIES:
-        r = single[p]
-        lines.append(f"| {p} | {_share(r)} | {_share(r, 'success_feasible', 'n_feasible')} |")
+        r = _policy(single, p, "single-step")
+        lines.append(f"| {p} | {_share(r.reached)} | {_share(r.feasible)} |")
     lines += ["", "Per goal kind (success [95 % CI]):", "", "| goal | " + " | ".join(POLICIES) + " |",
               "|---|" + "---|" * len(POLICIES)]
-    for kind, by in results["single_step_by_goal"].items():
-        lines.append(f"| {kind} | " + " | ".join(_share(by[p]) for p in POLICIES) + " |")
-    lines += ["", f"Best fixed behaviour per goal kind: {results['best_fixed_behavior']}.", ""]
+    for kind, by in results.single_step_by_goal.items():
+        lines.append(f"| {kind} | " + " | ".join(_share(_policy(by, p, kind).reached) for p in POLICIES) + " |")
+    lines += ["", f"Best fixed behaviour per goal kind: {dict(results.best_fixed_behavior)}.", ""]
     lines += ["## Leaving each shape out", "", "Models refitted without the shape, judged on goals for it only.", "",
               "| shape | planner on feasible [95 % CI] | best fixed on feasible [95 % CI] | random [95 % CI] |",
               "|---|---|---|---|"]
-    for shape, r in results["leave_one_shape_out"].items():
-        lines.append(f"| {shape} | {_share(r['planner'], 'success_feasible', 'n_feasible')} | "
-                     f"{_share(r['best_fixed'], 'success_feasible', 'n_feasible')} | {_share(r['random'])} |")
+    for shape, r in results.leave_one_shape_out.items():
+        lines.append(f"| {shape} | {_share(r['planner'].feasible)} | "
+                     f"{_share(r['best_fixed'].feasible)} | {_share(r['random'].reached)} |")
     lines += ["", "## Multi-step", "", "| policy | targets reached [95 % CI] | reach failures per interaction "
               "[95 % CI] | median final distance |", "|---|---|---|---|"]
     for p in MULTI_POLICIES:
-        r = results["multi_step"][p]
-        failures = round(r["reach_failures"] * r["interactions"])
-        lines.append(f"| {p} | {_share(r, unit='episodes')} | "
-                     + share_text(r["reach_failures"], r["interactions"], wilson(failures, r["interactions"]),
+        r = results.multi_step.policy(p)
+        lines.append(f"| {p} | {_share(r.reached, unit='episodes')} | "
+                     + share_text(r.reach_failures, r.interactions, wilson(r.reach_failure_count, r.interactions),
                                   "interactions", digits=1)
-                     + f" | {100 * r['median_final_distance_m']:.1f} cm (n={r['n']} episodes) |")
-    cal = results["calibration"]
-    auroc = "-" if cal["auroc"] is None else f"{cal['auroc']:.3f}"
+                     + f" | {100 * r.median_final_distance_m:.1f} cm (n={r.reached.n} episodes) |")
+    cal = results.calibration
+    auroc = "-" if cal.auroc is None else f"{cal.auroc:.3f}"
     lines += ["", "## Calibration", "",
-              f"Over the {cal['n']} actions executed in the single-step evaluation: ECE {cal['ece']:.3f}, AUROC "
+              f"Over the {cal.n} actions executed in the single-step evaluation: ECE {cal.ece:.3f}, AUROC "
               f"{auroc}.", "",
               "![success](success.png)", "![reliability](reliability.png)", "![episode](episode.png)", ""]
     (out / "REPORT.md").write_text("\n".join(lines))
     return out / "REPORT.md"
 
 
-def write_plan_figures(results: Mapping[str, Any], out: str | os.PathLike,
+def write_plan_figures(results: PlanResults | Mapping[str, Any], out: str | os.PathLike,
                        episode_frames: list[tuple[str, np.ndarray]] | None = None) -> list[Path]:
     """``success.png`` (success per goal kind and policy, Wilson 95 % intervals), ``reliability.png`` and, given
     the frames of an episode, ``episode.png``."""
@@ -315,16 +332,17 @@ def write_plan_figures(results: Mapping[str, Any], out: str | os.PathLike,
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
+    results = PlanResults.from_dict(results)
     out = Path(out)
     written = []
     fig, ax = plt.subplots(figsize=(10, 4))
     width = 0.8 / len(POLICIES)
     for j, p in enumerate(POLICIES):
-        values = [results["single_step_by_goal"][k][p] for k in GOAL_KINDS]
+        values = [_policy(_goal_kind(results, k), p, k).reached for k in GOAL_KINDS]
         x = np.arange(len(GOAL_KINDS)) + (j - len(POLICIES) / 2 + 0.5) * width
-        y = np.array([np.nan if v["success"] is None else v["success"] for v in values])  # nothing measured: no bar
-        lo = y - np.array([v["success_ci"][0] for v in values])
-        hi = np.array([v["success_ci"][1] for v in values]) - y
+        y = np.array([np.nan if v.value is None else v.value for v in values])  # nothing measured: no bar
+        lo = y - np.array([_interval(v)[0] for v in values])
+        hi = np.array([_interval(v)[1] for v in values]) - y
         ax.bar(x, 100 * y, width, yerr=100 * np.vstack([lo, hi]), capsize=2, label=p)
     ax.set_xticks(np.arange(len(GOAL_KINDS)), GOAL_KINDS)
     ax.set_ylabel("goals reached [%]")
@@ -336,12 +354,12 @@ def write_plan_figures(results: Mapping[str, Any], out: str | os.PathLike,
     written.append(out / "success.png")
 
     fig, ax = plt.subplots(figsize=(4.5, 4.5))
-    curve = results["calibration"]["curve"]
+    curve = results.calibration.curve
     ax.plot([0, 1], [0, 1], "k--", lw=1)
-    ax.scatter([c["p"] for c in curve], [c["observed"] for c in curve], s=[10 + c["n"] / 2 for c in curve])
+    ax.scatter([c.p for c in curve], [c.observed for c in curve], s=[10 + c.n / 2 for c in curve])
     ax.set_xlabel("predicted P(goal)")
     ax.set_ylabel("observed share reached")
-    ax.set_title(f"Reliability (ECE {results['calibration']['ece']:.3f})")
+    ax.set_title(f"Reliability (ECE {results.calibration.ece:.3f})")
     fig.tight_layout()
     fig.savefig(out / "reliability.png", dpi=100)
     plt.close(fig)
@@ -358,6 +376,21 @@ def write_plan_figures(results: Mapping[str, Any], out: str | os.PathLike,
         plt.close(fig)
         written.append(out / "episode.png")
     return written
+
+
+def _goal_kind(results: PlanResults, kind: str) -> Mapping[str, Any]:
+    """Each policy's single-step outcome on goals of ``kind``; InvalidValueError when the results hold none."""
+    if kind not in results.single_step_by_goal:
+        raise InvalidValueError(f"the plan results hold no single-step outcomes of goal kind {kind!r}, only of "
+                                f"{', '.join(results.single_step_by_goal)}.")
+    return results.single_step_by_goal[kind]
+
+
+def _interval(share: Share) -> tuple[float, float]:
+    """The Wilson 95 % interval of a share; InvalidValueError when the results hold none."""
+    if share.ci is None:
+        raise InvalidValueError(f"a share of {share.n} in the plan results has no Wilson interval (success_ci).")
+    return share.ci
 
 
 __all__ = ["TARGETS", "MIN_N", "Measured", "measured_targets", "target_verdict", "target_met", "verdict_text",

@@ -55,7 +55,7 @@ from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
 from affordance_learning.model import _check_int, select_features
 from affordance_learning.relieff import MULTICLASS_THRESHOLD, ReliefFScorer
-from affordance_learning.results import RESULTS_FORMAT, UNITS
+from affordance_learning.results import RESULTS_FORMAT, UNITS, k_key, r_key
 from affordance_learning.schema import OBJECT_TYPES, feature_groups, feature_names, frame_behavior, label_column
 from affordance_learning.som import SOMClustering
 from affordance_learning.validation import first_non_finite
@@ -255,7 +255,7 @@ def _check_protocol_args(
         isinstance(r, bool) or not isinstance(r, numbers.Real) or not 0.0 <= r <= 1.0 for r in relevancies
     ):
         raise InvalidValueError(f"relevancies must be numbers in [0, 1], got {relevancies!r}.")
-    if len({str(float(r)) for r in relevancies}) != len(relevancies):
+    if len({r_key(r) for r in relevancies}) != len(relevancies):
         raise InvalidValueError(f"relevancies must not repeat a value, got {relevancies!r}.")
     if isinstance(n_trials, bool) or not isinstance(n_trials, numbers.Integral) or n_trials < 1:
         raise InvalidValueError(f"n_trials must be an integer >= 1, got {n_trials!r}.")
@@ -322,7 +322,9 @@ def run_protocol(
         accuracy), all ``{"<k>": {"mean", "std"}}``, ``"feature_weights": {"<k>": {name: mean ReliefF
         weight}}``, and ``"config"``, which names the ``behavior``, the ``label`` column and how a success and
         a failure read (``success_label``, ``fail_label``). r is written as ``str(float(r))`` ("0.0", "0.2",
-        ...), k as ``str(k)``. The schema is the same for every behaviour. A mean over no finite value is None.
+        ..., :func:`~affordance_learning.results.r_key`), k as ``str(k)`` (:func:`~affordance_learning.results.k_key`).
+        The schema is the same for every behaviour. A mean over no finite value is None.
+        :meth:`affordance_learning.results.Results.from_dict` reads it.
     """
     ks, relevancies = _check_protocol_args(
         ks, relevancies, n_trials, random_state, test_size, n_neighbors, som_iterations
@@ -383,11 +385,11 @@ def run_protocol(
             bar.update()
 
     def per_k(key: str) -> dict[str, dict[str, float | None]]:
-        return {str(k): _stats(trial[key][k] for trial in trials) for k in ks}
+        return {k_key(k): _stats(trial[key][k] for trial in trials) for k in ks}
 
     def per_rk(key: str) -> dict[str, dict[str, dict[str, float | None]]]:
         return {
-            str(r): {str(k): _stats(trial[key][r, k] for trial in trials) for k in ks} for r in relevancies
+            r_key(r): {k_key(k): _stats(trial[key][r, k] for trial in trials) for k in ks} for r in relevancies
         }
 
     groups = feature_groups(data.names)
@@ -398,8 +400,8 @@ def run_protocol(
         "shape_fraction": per_rk("shape_fraction"),
         "size_fraction": per_rk("size_fraction"),
         "n_selected": per_rk("n_selected"),
-        "case_studies": {str(k): trials[0]["cases"][k] for k in case_study_ks},
-        "prototypes": {str(k): trials[0]["prototypes"][k] for k in case_study_ks},
+        "case_studies": {k_key(k): trials[0]["cases"][k] for k in case_study_ks},
+        "prototypes": {k_key(k): trials[0]["prototypes"][k] for k in case_study_ks},
         "feature_names": list(data.names),
         "effects": effect_summary(df),
         "size_success": size_success(data.sizes, data.success),
@@ -408,7 +410,7 @@ def run_protocol(
         "n_categories": per_k("n_categories"),
         "svm_baseline": per_k("baseline"),
         "feature_weights": {
-            str(k): dict(
+            k_key(k): dict(
                 zip(
                     data.names,
                     np.mean([trial["weights"][k] for trial in trials], axis=0).tolist(),

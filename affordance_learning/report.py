@@ -1,7 +1,7 @@
 """REPORT.md: our numbers beside the paper's statements, with a verdict per claim computed from the numbers.
 
 The claims, their rules and verdicts are :mod:`affordance_learning.claims`; this module sets them out with
-the tables of the numbers they are computed from.
+the tables of the numbers they are computed from, read through :class:`~affordance_learning.results.Results`.
 """
 
 from __future__ import annotations
@@ -21,59 +21,73 @@ from affordance_learning.claims import (  # noqa: F401  (AGREES ... Claim: re-ex
     TOO_FEW,
     VERDICTS,
     Claim,
-    _outcome_words,
     claims_scope,
     evaluate_claims,
-    results_behavior,
 )
 from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.results import UNIFORMITY_DEFINITION, UNITS, current_results
+from affordance_learning.results import (
+    UNIFORMITY_DEFINITION,
+    UNITS,
+    PerK,
+    PerRK,
+    Results,
+    SizeSuccess,
+    Stat,
+    as_results,
+)
+
+#: The relevancy threshold whose SVM accuracy the overview shows: the paper's best.
+HEADLINE_R = 0.4
 
 
-def _cell(entry: Mapping[str, Any] | None, scale: float, digits: int) -> str:
-    if entry is None or entry.get("mean") is None:
+def _cell(entry: Stat | None, scale: float, digits: int) -> str:
+    """A mean over trials and its standard deviation, times ``scale``; "-" when there is none."""
+    if entry is None or entry.mean is None or entry.std is None:
         return "-"
-    return f"{scale * entry['mean']:.{digits}f} ± {scale * entry['std']:.{digits}f}"
+    return f"{scale * entry.mean:.{digits}f} ± {scale * entry.std:.{digits}f}"
 
 
-def _table_k(results: Mapping[str, Any], rows: Sequence[tuple[str, str, float, int]]) -> list[str]:
-    ks = sorted({int(k) for key, *_ in rows if key in results for k in results[key]})
+def _table_k(rows: Sequence[tuple[PerK | None, str, float, int]]) -> list[str]:
+    """A table of numbers per k, a row for each (section, label, scale, digits) the results hold."""
+    held = [(section, label, scale, digits) for section, label, scale, digits in rows if section is not None]
+    ks = sorted({k for section, *_ in held for k in section})
     lines = ["| | " + " | ".join(f"k = {k}" for k in ks) + " |", "|---" * (len(ks) + 1) + "|"]
-    for key, label, scale, digits in rows:
-        if key in results:
-            cells = [_cell(results[key].get(str(k)), scale, digits) for k in ks]
-            lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    for section, label, scale, digits in held:
+        cells = [_cell(section.get(k), scale, digits) for k in ks]
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
     return lines
 
 
-def _table_rk(section: Mapping[str, Mapping[str, Any]], scale: float, digits: int) -> list[str]:
-    ks = sorted({int(k) for per_k in section.values() for k in per_k})
+def _table_rk(section: PerRK, scale: float, digits: int) -> list[str]:
+    """A table of numbers per r (rows) and k (columns)."""
+    ks = sorted({k for per_k in section.values() for k in per_k})
     lines = ["| r | " + " | ".join(f"k = {k}" for k in ks) + " |", "|---" * (len(ks) + 1) + "|"]
-    for r in sorted(section, key=float):
+    for r in sorted(section):
         lines.append(
-            f"| {r} | " + " | ".join(_cell(section[r].get(str(k)), scale, digits) for k in ks) + " |"
+            f"| {r} | " + " | ".join(_cell(section[r].get(k), scale, digits) for k in ks) + " |"
         )
     return lines
 
 
-def _case_tables(results: Mapping[str, Any]) -> list[str]:
+def _case_tables(results: Results) -> list[str]:
+    """Per 1 x k map of the first trial, its clusters: outcomes, object types, sizes [cm], objects that left."""
     lines: list[str] = []
-    success_label, fail_label = _outcome_words(results)
-    for k, clusters in sorted(results.get("case_studies", {}).items(), key=lambda item: int(item[0])):
-        types = list(dict.fromkeys(t for c in clusters for t in c["types"]))
-        left = all("left_view" in c for c in clusters)  # results of format 1 did not count them
+    success_label, fail_label = results.config.success_label, results.config.fail_label
+    for k, clusters in sorted((results.case_studies or {}).items()):
+        types = list(dict.fromkeys(t for c in clusters for t in c.types))
+        left = all(c.left_view is not None for c in clusters)  # results of format 1 did not count them
         lines += [f"### 1 x {k} map (first trial)", ""]
         lines.append(f"| cluster | {success_label} | {fail_label} | " + " | ".join(types) + " | sizes [cm] |"
                      + (" object left the view |" if left else ""))
         lines.append("|---" * (4 + len(types) + left) + "|")
         for c in clusters:
-            sizes = np.asarray(c["sizes"], dtype=float) * 100
+            sizes = np.asarray(c.sizes, dtype=float) * 100
             spread = (
                 f"{sizes.min():.1f}-{sizes.max():.1f} (median {np.median(sizes):.1f})" if sizes.size else "-"
             )
-            counts = " | ".join(str(c["types"].get(t, 0)) for t in types)
-            lines.append(f"| {c['cluster']} | {c['success']} | {c['fail']} | {counts} | {spread} |"
-                         + (f" {c['left_view']} |" if left else ""))
+            counts = " | ".join(str(c.types.get(t, 0)) for t in types)
+            lines.append(f"| {c.index} | {c.success} | {c.fail} | {counts} | {spread} |"
+                         + (f" {c.left_view} |" if left else ""))
         lines.append("")
     return lines
 
@@ -103,12 +117,12 @@ def _num(value: float | None, scale: float = 1.0, digits: int = 1) -> str:
     return "-" if value is None else f"{scale * value:.{digits}f}"
 
 
-def _effects_section(results: Mapping[str, Any], figures: Sequence[str]) -> list[str]:
+def _effects_section(results: Results) -> list[str]:
     """What the effects contain: the numbers a reviewer asks for before any verdict."""
-    effects = results.get("effects")
-    if not effects:
+    effects = results.effects
+    if effects is None:
         return []
-    success_label, _ = _outcome_words(results)
+    success_label = results.config.success_label
     lines = [
         "## What the effects contain",
         "",
@@ -117,70 +131,70 @@ def _effects_section(results: Mapping[str, Any], figures: Sequence[str]) -> list
         "features (zeros), so its effect is just minus its initial features.",
         "",
         f"- Successes ({success_label}) whose object is seen in the final snapshot: "
-        f"**{_pct(effects.get('success_visible'))}** (at rest and seen: "
-        f"{_pct(effects.get('success_rest_visible'))}); successes whose effect is minus their initial features "
-        f"(the object vanished): {_pct(effects.get('success_effect_is_minus_initial'))}.",
+        f"**{_pct(effects.success_visible)}** (at rest and seen: "
+        f"{_pct(effects.success_rest_visible)}); successes whose effect is minus their initial features "
+        f"(the object vanished): {_pct(effects.success_effect_is_minus_initial)}.",
         f"- Spearman correlation of the true travel with the 3-D motion seen (norm of the effect on mean_x, "
         f"mean_y, mean_z), over the objects seen at the end: "
-        f"**{_num(effects.get('travel_vs_seen_motion'), digits=2)}**.",
+        f"**{_num(effects.travel_vs_seen_motion, digits=2)}**.",
         "",
         f"| type | n | {success_label} | at rest | seen at the end | left the table | travel [cm] | motion seen [cm] | "
         "pixel count change | normal histogram change |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
-    for t, row in effects.get("by_type", {}).items():
+    for t, row in effects.by_type.items():
         lines.append(
-            f"| {t.replace('_', ' ')} | {row['n']} | {_pct(row['success'])} | {_pct(row['rest'])} | "
-            f"{_pct(row['visible_final'])} | {_pct(row['off_table'])} | {_num(row['displacement'], 100)} | "
-            f"{_num(row['seen_motion'], 100)} | {_num(row['pixel_count_change'], 1, 0)} | "
-            f"{_num(row['shape_change'], 1, 3)} |"
+            f"| {t.replace('_', ' ')} | {row.n} | {_pct(row.success)} | {_pct(row.rest)} | "
+            f"{_pct(row.visible_final)} | {_pct(row.off_table)} | {_num(row.displacement, 100)} | "
+            f"{_num(row.seen_motion, 100)} | {_num(row.pixel_count_change, 1, 0)} | "
+            f"{_num(row.shape_change, 1, 3)} |"
         )
     lines += ["", "Medians per type; the normal histogram change is the sum of |effect| over the 24 shape "
               "features (each histogram sums to 1).", ""]
-    if results.get("prototypes") and "feature_names" in results:  # drawn by write_figures from the same results
+    if results.prototypes and results.feature_names is not None:  # drawn by write_figures from the same results
         lines += ["What each effect category is, as its map prototype in feature units:", "",
                   "![prototypes](prototypes.png)", ""]
     return lines
 
 
-def _size_section(results: Mapping[str, Any]) -> list[str]:
+def _size_section(results: Results) -> list[str]:
     """How success depends on object size, and the critical size where a logistic fit crosses 50 %."""
-    section = results.get("size_success")
-    if not section:
+    section = results.size_success
+    if section is None:
         return []
-    success_label, _ = _outcome_words(results)
-    fit, critical, test = section.get("logistic"), section.get("critical_size"), section.get("test")
+    success_label = results.config.success_label
+    fit, critical, test = section.logistic, section.critical_size, section.test
     if fit is None:
         found = "Only one outcome: no logistic fit, no critical size."
-    elif test is not None and not test["depends_on_size"]:
+    elif test is not None and not test.depends_on_size:
         found = (f"Success does not depend on object size: the logistic fit of success on size (slope "
-                 f"{fit['slope'] / 100:+.2f} per cm of logit) changes the share of successes by "
-                 f"{100 * test['span']:+.0f} points across the sizes seen (likelihood-ratio test p = "
-                 f"{test['p_value']:.2g}). A critical size is reported only where success depends on size "
-                 f"({test['rule']}): none here.")
+                 f"{fit.slope / 100:+.2f} per cm of logit) changes the share of successes by "
+                 f"{100 * test.span:+.0f} points across the sizes seen (likelihood-ratio test p = "
+                 f"{test.p_value:.2g}). A critical size is reported only where success depends on size "
+                 f"({test.rule}): none here.")
     elif critical is None:
-        found = (f"A logistic fit of success on size (slope {fit['slope'] / 100:+.2f} per cm of logit) does not "
+        found = (f"A logistic fit of success on size (slope {fit.slope / 100:+.2f} per cm of logit) does not "
                  "cross 50 % within the sizes seen: no critical size.")
     else:
         found = (f"A logistic fit of success on size crosses 50 % at **{100 * critical:.1f} cm** (slope "
-                 f"{fit['slope'] / 100:+.2f} per cm of logit: success "
-                 f"{'falls' if fit['slope'] < 0 else 'rises'} with size).")
+                 f"{fit.slope / 100:+.2f} per cm of logit: success "
+                 f"{'falls' if fit.slope < 0 else 'rises'} with size).")
     lines = ["## Success by object size", "", found, "",
-             "| size [cm] | " + " | ".join(f"{100 * b['low']:.1f}-{100 * b['high']:.1f}" for b in section["bins"])
-             + " |", "|---" * (len(section["bins"]) + 1) + "|",
-             "| interactions | " + " | ".join(str(b["n"]) for b in section["bins"]) + " |",
-             f"| {success_label} | " + " | ".join(_pct(b["success"]) for b in section["bins"]) + " |", "",
+             "| size [cm] | " + " | ".join(f"{100 * b.low:.1f}-{100 * b.high:.1f}" for b in section.bins)
+             + " |", "|---" * (len(section.bins) + 1) + "|",
+             "| interactions | " + " | ".join(str(b.n) for b in section.bins) + " |",
+             f"| {success_label} | " + " | ".join(_pct(b.success) for b in section.bins) + " |", "",
              "![size_success](size_success.png)", ""]  # drawn by write_figures from the same results
     return lines
 
 
-def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> str:
+def render_report(results: Results | Mapping[str, Any], figures: Sequence[str] = ()) -> str:
     """The Markdown text of the report (see :func:`write_report`)."""
-    results = current_results(results)
+    results = as_results(results)
     claims = evaluate_claims(results)
-    config = results.get("config", {})
-    behavior = results_behavior(results)
-    success_label, fail_label = _outcome_words(results)
+    config = results.config
+    behavior = results.behavior
+    success_label, fail_label = config.success_label, config.fail_label
     lines = [
         f"# Reproduction of Akgun et al. 2009, {behavior}: our numbers beside the paper's",
         "",
@@ -188,7 +202,7 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
         f"k = {config.get('ks', '?')}, r = {config.get('relevancies', '?')}, "
         f"seed {config.get('random_state', '?')}. Success/fail labels: {success_label} / {fail_label} "
         f"(the {config.get('label', 'success')!r} column, measured by the simulator); "
-        f"{_pct(config.get('success_fraction'))} of the interactions succeeded.",
+        f"{_pct(results.success_share)} of the interactions succeeded.",
         "",
         f"{UNIFORMITY_DEFINITION} Shares are shown in percent here; `results.json` holds them as fractions "
         f"({UNITS}).",
@@ -198,50 +212,57 @@ def render_report(results: Mapping[str, Any], figures: Sequence[str] = ()) -> st
         "",
         *_claim_rows(claims),
     ]
-    lines += [""] + _effects_section(results, figures) + _size_section(results)
+    lines += [""] + _effects_section(results) + _size_section(results)
     lines += ["## Effect clusters", ""]
     lines += _table_k(
-        results,
         [
-            ("uniformity", "uniformity [%]", 100.0, 1),
-            ("purity", "purity vs object type", 1.0, 2),
-            ("adjusted_rand", "adjusted Rand vs object type", 1.0, 2),
-            ("n_categories", "non-empty clusters", 1.0, 1),
+            (results.uniformity, "uniformity [%]", 100.0, 1),
+            (results.purity, "purity vs object type", 1.0, 2),
+            (results.adjusted_rand, "adjusted Rand vs object type", 1.0, 2),
+            (results.n_categories, "non-empty clusters", 1.0, 1),
         ],
     )
     lines += [""] + _case_tables(results)
-    for key, title, scale, digits in (
-        ("shape_fraction", "Shape share of the selected features [%]", 100.0, 0),
-        ("size_fraction", "Size share of the selected features [%]", 100.0, 0),
-        ("n_selected", "Number of selected features", 1.0, 1),
-        ("svm_accuracy", "SVM accuracy on held-out interactions [%]", 100.0, 1),
+    for section, title, scale, digits in (
+        (results.shape_fraction, "Shape share of the selected features [%]", 100.0, 0),
+        (results.size_fraction, "Size share of the selected features [%]", 100.0, 0),
+        (results.n_selected, "Number of selected features", 1.0, 1),
+        (results.svm_accuracy, "SVM accuracy on held-out interactions [%]", 100.0, 1),
     ):
-        if key in results:
-            lines += [f"## {title}", ""] + _table_rk(results[key], scale, digits) + [""]
-    if "svm_baseline" in results:
+        if section is not None:
+            lines += [f"## {title}", ""] + _table_rk(section, scale, digits) + [""]
+    if results.svm_baseline is not None:
         lines += ["Always answering the most common training category:", ""]
-        lines += _table_k(results, [("svm_baseline", "baseline accuracy [%]", 100.0, 1)]) + [""]
-    above = {"prototypes.png"} if "effects" in results else set()
-    above |= {"size_success.png"} if results.get("size_success") else set()
+        lines += _table_k([(results.svm_baseline, "baseline accuracy [%]", 100.0, 1)]) + [""]
+    above = {"prototypes.png"} if results.effects is not None else set()
+    above |= {"size_success.png"} if results.size_success is not None else set()
     shown = [f for f in figures if Path(f).name not in above]  # shown above
     if shown:
         lines += ["## Figures", ""] + [f"![{Path(f).stem}]({Path(f).name})" for f in shown] + [""]
-    if config:
-        lines += ["## Configuration", ""] + [f"- {key}: {value}" for key, value in config.items()] + [""]
+    settings = list(config.items())
+    if settings:
+        lines += ["## Configuration", ""] + [f"- {key}: {value}" for key, value in settings] + [""]
     return "\n".join(lines)
 
 
-def write_report(results: Mapping[str, Any], out_dir: str | Path) -> Path:
+def write_report(results: Results | Mapping[str, Any], out_dir: str | Path) -> Path:
     """Write ``REPORT.md`` into ``out_dir`` (created if needed), linking the PNG figures found there.
 
     Args:
-        results: The dict returned by :func:`affordance_learning.protocol.run_protocol` (or its JSON).
+        results: :class:`~affordance_learning.results.Results`, or the dict returned by
+            :func:`affordance_learning.protocol.run_protocol` (or its JSON).
         out_dir: Output directory.
 
     Returns:
         The path of ``REPORT.md``.
+
+    Raises:
+        InvalidValueError: ``results`` are not the protocol's: no uniformity, or a section not of the format.
     """
-    if not isinstance(results, Mapping) or "uniformity" not in results:
+    if not isinstance(results, Results | Mapping):
+        raise InvalidValueError(f"results must be the dict returned by run_protocol, got {type(results).__name__}.")
+    results = as_results(results)
+    if results.uniformity is None:
         raise InvalidValueError("results must be the dict returned by run_protocol (it has no 'uniformity').")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -251,36 +272,44 @@ def write_report(results: Mapping[str, Any], out_dir: str | Path) -> Path:
     return path
 
 
-def _headline(results: Mapping[str, Any]) -> dict[str, str]:
+def headline_accuracy(results: Results) -> PerK:
+    """The SVM accuracy per k that headlines a run [fraction]: at r = :data:`HEADLINE_R`, or at the first r the
+    results hold when that was not run."""
+    return results.accuracy(HEADLINE_R) or next(iter((results.svm_accuracy or {}).values()), {})
+
+
+def _headline(results: Results) -> dict[str, str]:
     """One behaviour's headline numbers as short texts, for the overview."""
-    results = current_results(results)
-    config = results.get("config", {})
-    success_label, _ = _outcome_words(results)
-    uniformity = {int(k): 100.0 * v["mean"] for k, v in results.get("uniformity", {}).items()
-                  if v.get("mean") is not None}
-    section = results.get("svm_accuracy", {})
-    accuracy = section.get("0.4") or next(iter(section.values()), {})
-    acc = {int(k): v["mean"] for k, v in accuracy.items() if v.get("mean") is not None}
+    config = results.config
+    uniformity = {k: 100.0 * v.mean for k, v in (results.uniformity or {}).items() if v.mean is not None}
+    acc = {k: v.mean for k, v in headline_accuracy(results).items() if v.mean is not None}
     best = max(uniformity, key=uniformity.get) if uniformity else None
-    sizes = results.get("size_success", {})
-    critical = sizes.get("critical_size")
     return {
         "interactions": str(config.get("n_rows", "?")),
-        "success": f"{_pct(config.get('success_fraction'))} {success_label}",
+        "success": f"{_pct(results.success_share)} {config.success_label}",
         "uniformity": f"{np.mean(list(uniformity.values())):.1f} %" if uniformity else "-",
         "peak": f"{uniformity[best]:.1f} % (k = {best})" if best is not None else "-",
         "accuracy": (f"{100 * acc[min(acc)]:.1f} % (k = {min(acc)}) to {100 * acc[max(acc)]:.1f} % "
                      f"(k = {max(acc)})" if acc else "-"),
-        "critical": "-" if critical is None else (f"{100 * critical:.1f} cm ({_pct(sizes['below']['success'])} "
-                                                  f"below, {_pct(sizes['above']['success'])} above)"),
+        "critical": _critical_text(results.size_success),
     }
 
 
-def render_overview(runs: Mapping[str, Mapping[str, Any]],
+def _critical_text(sizes: SizeSuccess | None) -> str:
+    """The critical size [cm] and the shares of successes below and above it, for the overview; "-" without
+    one."""
+    if sizes is None or sizes.critical_size is None:
+        return "-"
+    below, above = (None if side is None else side.success for side in (sizes.below, sizes.above))
+    return f"{100 * sizes.critical_size:.1f} cm ({_pct(below)} below, {_pct(above)} above)"
+
+
+def render_overview(runs: Mapping[str, Results | Mapping[str, Any]],
                     figures: Mapping[str, Sequence[str]] | None = None) -> str:
     """The Markdown text of the overview over behaviours (see :func:`write_overview`); ``figures``: the PNG
     file names in each behaviour's directory."""
-    names, figures = list(runs), figures or {}
+    read = {behavior: as_results(results) for behavior, results in runs.items()}
+    names, figures = list(read), figures or {}
     lines = [
         f"# Reproduction of Akgun et al. 2009: {', '.join(names)}",
         "",
@@ -293,11 +322,11 @@ def render_overview(runs: Mapping[str, Mapping[str, Any]],
         "size (a test on the logistic fit of success on size, in each report).",
         "",
         "| behaviour | interactions | successes | uniformity, mean over k | highest uniformity | "
-        "SVM accuracy at r = 0.4 | critical size (success crosses 50 %) | claims that agree |",
+        f"SVM accuracy at r = {HEADLINE_R} | critical size (success crosses 50 %) | claims that agree |",
         "|---|---|---|---|---|---|---|---|",
     ]
-    claims = {b: evaluate_claims(results) for b, results in runs.items()}
-    for behavior, results in runs.items():
+    claims = {b: evaluate_claims(results) for b, results in read.items()}
+    for behavior, results in read.items():
         h = _headline(results)
         agree = sum(c.verdict == AGREES for c in claims[behavior])
         few = sum(c.verdict == TOO_FEW for c in claims[behavior])
@@ -313,7 +342,7 @@ def render_overview(runs: Mapping[str, Mapping[str, Any]],
     return "\n".join(lines)
 
 
-def write_overview(runs: Mapping[str, Mapping[str, Any]], out_dir: str | Path) -> Path:
+def write_overview(runs: Mapping[str, Results | Mapping[str, Any]], out_dir: str | Path) -> Path:
     """Write ``REPORT.md`` into ``out_dir`` over several behaviours: for each, its headline numbers, its claims
     with their verdicts, and links to its report and figures in ``out_dir/<behavior>/``.
 
@@ -325,11 +354,14 @@ def write_overview(runs: Mapping[str, Mapping[str, Any]], out_dir: str | Path) -
     Returns:
         The path of ``REPORT.md``.
     """
-    if not runs or not all(isinstance(r, Mapping) and "uniformity" in r for r in runs.values()):
+    if not runs or not all(isinstance(r, Results | Mapping) for r in runs.values()):
+        raise InvalidValueError("runs must map each behaviour to the dict returned by run_protocol.")
+    read = {behavior: as_results(results) for behavior, results in runs.items()}
+    if not all(results.uniformity is not None for results in read.values()):
         raise InvalidValueError("runs must map each behaviour to the dict returned by run_protocol.")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    figures = {b: sorted(p.name for p in (out / b).glob("*.png")) for b in runs}
+    figures = {b: sorted(p.name for p in (out / b).glob("*.png")) for b in read}
     path = out / "REPORT.md"
-    path.write_text(render_overview(runs, figures))
+    path.write_text(render_overview(read, figures))
     return path

@@ -35,6 +35,7 @@ from affordance_learning.exceptions import InvalidValueError
 
 if TYPE_CHECKING:
     from affordance_env.dataset.fingerprint import FingerprintCheck
+    from affordance_learning.results import Results
 
 #: The behaviours the paper reports on, run by default.
 DEFAULT_BEHAVIORS = ("tap", "grasp")
@@ -115,7 +116,7 @@ def reproduce(
             out, behavior, datasets.get(behavior), episodes=episodes, trials=trials, seed=seed, workers=workers,
             progress=progress, range_noise=range_noise,
         )
-    found = {**_earlier_runs(out, behaviors), **runs}
+    found: dict[str, Results | dict[str, Any]] = {**_earlier_runs(out, behaviors), **runs}
     order = [b for b in BEHAVIORS if b in found] + sorted(set(found) - set(BEHAVIORS))
     overview = write_overview({b: found[b] for b in order}, out)
     print(f"total {time.perf_counter() - start:.1f} s")
@@ -229,53 +230,54 @@ def check_fingerprint(where: str | Path, workers: int = 1) -> FingerprintCheck:
     return compare_fingerprints(expected, _collect_reference(where, workers))
 
 
-def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, dict[str, Any]]:
+def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, Results]:
     """Results an earlier run left in ``out/<behavior>/results.json`` for behaviours not run now; only those of
     the current schema (whose config names the behaviour of their directory)."""
+    from affordance_learning.results import Results
+
     found = {}
     for path in sorted(out.glob("*/results.json")):
         behavior = path.parent.name
         if behavior in skip:
             continue
         try:
-            results = json.loads(path.read_text())
-        except (OSError, ValueError):
+            results = Results.from_dict(json.loads(path.read_text()))
+        except (OSError, ValueError):  # unreadable, not JSON, or not results of a format this version reads
             continue
-        if isinstance(results, dict) and results.get("config", {}).get("behavior") == behavior:
+        if results.config.get("behavior") == behavior:
             found[behavior] = results
     return found
 
 
-def summary(results: dict, report: Path) -> str:
+def summary(results: Results | Mapping[str, Any], report: Path) -> str:
     """The headline numbers of one behaviour's reproduction, and where its report is, in a few lines."""
-    from affordance_learning.claims import AGREES, claims_scope, evaluate_claims, results_behavior
-    from affordance_learning.results import current_results
+    from affordance_learning.claims import AGREES, claims_scope, evaluate_claims
+    from affordance_learning.report import HEADLINE_R, headline_accuracy
+    from affordance_learning.results import as_results
 
-    results = current_results(results)
-    behavior = results_behavior(results)
-    config = results.get("config", {})
-    effects = results.get("effects", {})
-    uniformity = {int(k): 100.0 * v["mean"] for k, v in results["uniformity"].items() if v["mean"] is not None}
-    accuracy = results["svm_accuracy"].get("0.4") or next(iter(results["svm_accuracy"].values()))
-    acc = {int(k): v["mean"] for k, v in accuracy.items() if v["mean"] is not None}
+    results = as_results(results, required=("uniformity", "svm_accuracy"))
+    behavior = results.behavior
+    effects = results.effects
+    uniformity = {k: 100.0 * v.mean for k, v in (results.uniformity or {}).items() if v.mean is not None}
+    acc = {k: v.mean for k, v in headline_accuracy(results).items() if v.mean is not None}
     claims = evaluate_claims(results)
     ks = sorted(uniformity)
     lines = [f"{behavior}: {report} (figures and results.json beside it)"]
-    if effects.get("success_visible") is not None:
-        label = config.get("success_label", "success")
-        correlation = effects.get("travel_vs_seen_motion")
-        lines.append(f"  successes ({label}) whose object is seen where it stopped: "
-                     f"{100 * effects['success_visible']:.0f} %"
+    if effects is not None and effects.success_visible is not None:
+        correlation = effects.travel_vs_seen_motion
+        lines.append(f"  successes ({results.config.success_label}) whose object is seen where it stopped: "
+                     f"{100 * effects.success_visible:.0f} %"
                      + ("" if correlation is None else f"; true travel vs motion seen, Spearman {correlation:.2f}"))
     paper = {"tap": " (paper: above 80 %)", "grasp": " (paper: above 70 %, and a fall at k = 3)"}.get(behavior, "")
     lines.append(f"  uniformity: {uniformity[ks[0]]:.1f} % (k = {ks[0]}) to {uniformity[ks[-1]]:.1f} % "
                  f"(k = {ks[-1]}), mean {np.mean(list(uniformity.values())):.1f} %{paper}")
-    sizes = results.get("size_success", {})
-    if sizes.get("critical_size") is not None:
-        lines.append(f"  success by object size crosses 50 % at {100 * sizes['critical_size']:.1f} cm (logistic "
-                     f"fit): {100 * sizes['below']['success']:.0f} % below, {100 * sizes['above']['success']:.0f} % "
+    split = None if results.size_success is None else results.size_success.critical_split
+    if split is not None:
+        critical, below, above = split
+        lines.append(f"  success by object size crosses 50 % at {100 * critical:.1f} cm (logistic "
+                     f"fit): {100 * below:.0f} % below, {100 * above:.0f} % "
                      "above")
-    lines.append(f"  SVM accuracy at r = 0.4: {100 * acc[min(acc)]:.1f} % (k = {min(acc)}) to "
+    lines.append(f"  SVM accuracy at r = {HEADLINE_R}: {100 * acc[min(acc)]:.1f} % (k = {min(acc)}) to "
                  f"{100 * acc[max(acc)]:.1f} % (k = {max(acc)})")
     lines.append(f"  the paper's claims: {sum(c.verdict == AGREES for c in claims)} of {len(claims)} agree "
                  f"(each verdict and its rule in the report). {claims_scope(behavior)}")

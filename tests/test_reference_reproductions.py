@@ -1,4 +1,5 @@
-"""The shipped reproductions stay what the code gives: their first interactions, collected again, bit for bit."""
+"""The shipped reproductions stay what the code gives: their first interactions, collected again, bit for bit, and
+their reports, drawn again from their results.json."""
 
 import copy
 import json
@@ -10,6 +11,7 @@ from affordance_env import load_dataset
 from affordance_env.dataset import collect
 from affordance_env.dataset.fingerprint import fingerprint, fingerprint_differences
 from affordance_learning.cli import main
+from affordance_learning.report import render_overview, render_report
 from affordance_learning.reproduce import FINGERPRINT, check_fingerprint
 
 REPRODUCTIONS = sorted(p.parent for p in (Path(__file__).resolve().parent.parent / "docs" / "reproduction")
@@ -25,6 +27,22 @@ def test_every_shipped_reproduction_has_a_fingerprint_of_its_settings():
         assert options["behavior"] == config["behavior"] and pinned["settings"]["seed"] == config["seed"], where
         assert (options["range_noise"] or "none") == config["range_noise"], where
         assert pinned["episodes"] == 30 and len(pinned["interactions"]) + len(pinned["failures"]) == 30, where
+
+
+@pytest.mark.parametrize("where", REPRODUCTIONS, ids=[p.name for p in REPRODUCTIONS])
+def test_each_shipped_report_is_what_its_results_give(where):
+    # Fails when the reading of results.json, a claim's rule or verdict, or the report's text changed: regenerate the
+    # reports with the reproductions (docs/reproduction/README.md says how), or undo the change.
+    figures = sorted(p.name for p in where.glob("*.png"))
+    results = json.loads((where / "results.json").read_text())
+    assert render_report(results, figures) == (where / "REPORT.md").read_text()
+
+
+def test_the_shipped_overview_is_what_the_results_give():
+    root = REPRODUCTIONS[0].parent
+    runs = {b: json.loads((root / b / "results.json").read_text()) for b in ("tap", "grasp")}
+    figures = {b: sorted(p.name for p in (root / b).glob("*.png")) for b in runs}
+    assert render_overview(runs, figures) == (root / "REPORT.md").read_text()
 
 
 @pytest.mark.slow
