@@ -27,6 +27,9 @@ from affordance_env.robot_model import (
     icub_urdf,
 )
 
+#: At most this many distinct joint ranges (and dampings) are kept by a :class:`Kinematics` between IK calls.
+MAX_CACHED_RANGES = 32
+
 
 @dataclass(frozen=True)
 class IKResult:
@@ -101,6 +104,10 @@ class Kinematics:
         self._reach_pin = np.array([names.index(name) for name in self.variant.reach_joints])
         #: Indices of the reach joints in active-joint order.
         self.reach_dofs = np.array([self.joint_names.index(name) for name in self.variant.reach_joints])
+        #: What :meth:`solve_ik` derives from its arguments alone, kept across calls (a line of the palm asks for
+        #: the same joint ranges and damping at every waypoint): limits by joint ranges, regularisers by damping.
+        self._limits: dict[tuple, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
+        self._regularisers: dict[tuple[float, int], np.ndarray] = {}
 
     @property
     def nq(self) -> int:
@@ -109,7 +116,7 @@ class Kinematics:
 
     def _check_q(self, q: np.ndarray) -> np.ndarray:
         q = np.asarray(q, dtype=float)
-        if q.shape != (self.nq,) or not np.all(np.isfinite(q)):
+        if q.shape != (self.model.nq,) or not np.isfinite(q).all():
             raise InvalidValueError(f"q must be {self.nq} finite joint angles in the {self.variant.name!r} variant's "
                              f"active-joint order, got {q!r}.")
         return q
@@ -151,6 +158,38 @@ class Kinematics:
                                  f"({self.lower[j]:.3f}, {self.upper[j]:.3f}) rad.")
         return lower, upper
 
+    def _ik_limits(self, joint_ranges: Mapping[str, tuple[float, float]] | None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """(lower, upper) of :meth:`joint_limits` in Pinocchio's order, and of its reach joints: read-only arrays,
+        computed once per distinct ``joint_ranges`` (by value)."""
+        key = tuple(joint_ranges.items()) if joint_ranges else ()
+        try:
+            limits = self._limits.get(key)
+            cacheable = True
+        except TypeError:  # ranges that cannot be a key (lists): derived at every call
+            limits, cacheable = None, False
+        if limits is None:
+            lower, upper = self.joint_limits(joint_ranges)
+            lower, upper = lower[self._to_pin], upper[self._to_pin]
+            limits = (lower, upper, lower[self._reach_pin], upper[self._reach_pin])
+            for array in limits:
+                array.flags.writeable = False
+            if cacheable:
+                if len(self._limits) >= MAX_CACHED_RANGES:
+                    self._limits.clear()
+                self._limits[key] = limits
+        return limits
+
+    def _regulariser(self, damping: float, n: int) -> np.ndarray:
+        """``damping`` times the ``n`` x ``n`` identity, read-only, made once per (damping, n)."""
+        regulariser = self._regularisers.get((damping, n))
+        if regulariser is None:
+            if len(self._regularisers) >= MAX_CACHED_RANGES:
+                self._regularisers.clear()
+            regulariser = self._regularisers[(damping, n)] = damping * np.eye(n)
+            regulariser.flags.writeable = False
+        return regulariser
+
     def solve_ik(
         self,
         p_world_target: np.ndarray,
@@ -183,40 +222,44 @@ class Kinematics:
                 a posture the solution must keep, e.g. a wrist angle that holds the forearm off the table.
         """
         p_target = np.asarray(p_world_target, dtype=float)
-        if p_target.shape != (3,) or not np.all(np.isfinite(p_target)):
+        if p_target.shape != (3,) or not np.isfinite(p_target).all():
             raise InvalidValueError(f"p_world_target must be 3 finite coordinates [m], got {p_world_target!r}.")
         if R_world_target is not None:
             R_world_target = np.asarray(R_world_target, dtype=float)
             # a stroke asks for one orientation many times: the last one checked need not be checked again
-            if not (R_world_target.shape == (3, 3) and np.array_equal(R_world_target, self._last_rotation)):
+            # (elementwise equality of two 3x3 arrays: np.array_equal's answer, without its checks)
+            if not (R_world_target.shape == (3, 3) and (R_world_target == self._last_rotation).all()):
                 if (R_world_target.shape != (3, 3)
                         or np.abs(matmul(R_world_target, R_world_target.T) - np.eye(3)).max() > 1e-6):
                     raise InvalidValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
                 self._last_rotation = R_world_target.copy()
-        lower, upper = self.joint_limits(joint_ranges)
-        lower, upper = lower[self._to_pin], upper[self._to_pin]  # in Pinocchio's order from here on
-        q = np.minimum(np.maximum(self._check_q(q_init)[self._to_pin], lower), upper)
+        # In Pinocchio's order from here on; the reach joints' limits apart.
+        lower_all, upper_all, lower, upper = self._ik_limits(joint_ranges)
+        q = np.minimum(np.maximum(self._check_q(q_init)[self._to_pin], lower_all), upper_all)
         dofs = self._reach_pin
-        lower, upper = lower[dofs], upper[dofs]
         model, data, frame = self.model, self.data, self.hand_frame_id
         n_error = 3 if R_world_target is None else 6
-        regulariser = damping * np.eye(n_error)
+        regulariser = self._regulariser(damping, n_error)
         error = np.empty(n_error)
+        error_position, error_rotation = error[:3], error[3:]  # views, made once
         pos_err = rot_err = np.inf
         iteration = 0
+        # Pinocchio's functions and the frames' placements bound once: the loop below runs a few times per call.
+        jacobian, log3, placements = pin.computeFrameJacobian, pin.log3, data.oMf
+        world_aligned = pin.LOCAL_WORLD_ALIGNED
         for iteration in range(1, max_iterations + 1):  # noqa: B007 (the count is returned)
             # computeFrameJacobian runs the forward kinematics and places the hand frame (data.oMf[frame]).
-            J = pin.computeFrameJacobian(model, data, q, frame, pin.LOCAL_WORLD_ALIGNED)
-            T_world_hand = data.oMf[frame]
-            error[:3] = p_target - T_world_hand.translation
-            pos_err = norm(error[:3])
-            jac = J[:n_error, dofs]
+            J = jacobian(model, data, q, frame, world_aligned)
+            T_world_hand = placements[frame]
+            np.subtract(p_target, T_world_hand.translation, out=error_position)
+            pos_err = norm(error_position)
+            jac = J[:n_error, dofs]  # (its memory order, Fortran, decides einsum's loops below: kept as it is)
             if R_world_target is None:
                 rot_err = 0.0
             else:
-                e_rot = pin.log3(matmul(R_world_target, T_world_hand.rotation.T))
+                e_rot = log3(matmul(R_world_target, T_world_hand.rotation.T))
                 rot_err = norm(e_rot)
-                error[3:] = orientation_weight * e_rot
+                np.multiply(orientation_weight, e_rot, out=error_rotation)
                 jac[3:] *= orientation_weight
             if pos_err <= position_tolerance and rot_err <= orientation_tolerance * 0.5:
                 break

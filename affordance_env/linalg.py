@@ -19,47 +19,67 @@ transcendental functions (``**``, ``np.arccos``, ``np.exp``, ...) do not: numpy 
 
 from __future__ import annotations
 
+import importlib
 import math
+from collections.abc import Callable
+from typing import Any
 
 import eigenpy
 import numpy as np
 
 from affordance_env.exceptions import InvalidValueError
 
+
+def _c_einsum() -> Callable[..., Any]:
+    """What ``np.einsum`` runs when it is not asked to optimise (``optimize=False``, its default), without the
+    Python layer around it: the same loops, so the same bits, for less per call (a control tick calls these)."""
+    for name in ("numpy._core.multiarray", "numpy.core.multiarray"):  # numpy 2, numpy 1
+        try:
+            return importlib.import_module(name).c_einsum
+        except (ImportError, AttributeError):
+            continue
+    return np.einsum  # pragma: no cover (a numpy without it)
+
+
+_einsum = _c_einsum()
+
 _SUBSCRIPTS = {(1, 1): "i,i->", (1, 2): "i,ij->j", (2, 1): "...ij,j->...i", (2, 2): "...ij,jk->...ik"}
+_FLOAT = np.float64
+_SUCCESS = eigenpy.ComputationInfo.Success
 
 
 def matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``a @ b`` for ``b`` a vector or a matrix and ``a`` a vector or a stack of matrices, in the same bits on
     every CPU."""
-    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
-    key = (min(a.ndim, 2), b.ndim)
-    if key not in _SUBSCRIPTS or a.ndim == 0:
+    a, b = np.asarray(a, dtype=_FLOAT), np.asarray(b, dtype=_FLOAT)
+    subscripts = _SUBSCRIPTS.get((min(a.ndim, 2), b.ndim)) if a.ndim else None
+    if subscripts is None:
         raise InvalidValueError(
             f"matmul takes a vector or (a stack of) matrices times a vector or a matrix, got shapes "
                          f"{a.shape} and {b.shape}.")
-    return np.einsum(_SUBSCRIPTS[key], a, b)
+    return _einsum(subscripts, a, b)
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> float:
     """The dot product of two vectors, as a float."""
-    return float(matmul(np.ravel(a), np.ravel(b)))
+    # As matmul of the two raveled: the same contiguous float64 vectors, whichever of the two conversions comes first.
+    return float(_einsum("i,i->", np.asarray(a, dtype=_FLOAT).ravel(), np.asarray(b, dtype=_FLOAT).ravel()))
 
 
 def norm(v: np.ndarray) -> float:
     """The Euclidean norm of a vector (``np.linalg.norm`` of a 1-D array goes through BLAS)."""
-    v = np.ravel(np.asarray(v, dtype=np.float64))
-    return math.sqrt(float(np.einsum("i,i->", v, v)))
+    v = np.asarray(v, dtype=_FLOAT).ravel()
+    return math.sqrt(_einsum("i,i->", v, v))
 
 
 def solve_spd(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``x`` with ``A x = b`` for a symmetric positive definite ``A`` (Cholesky, Eigen's ``LLT``)."""
-    A = np.asarray(A, dtype=np.float64)
+    A = np.asarray(A, dtype=_FLOAT)
     decomposition = eigenpy.LLT(A)
-    if decomposition.info() != eigenpy.ComputationInfo.Success or not np.all(np.isfinite(A)):
+    if decomposition.info() != _SUCCESS or not np.isfinite(A).all():
         # a numerical failure inside the simulation, not a user's value: numpy's own type for it
         raise np.linalg.LinAlgError(f"solve_spd needs a finite symmetric positive definite matrix, got {A!r}.")
-    return np.asarray(decomposition.solve(np.asarray(b, dtype=np.float64)), dtype=np.float64)
+    return np.asarray(decomposition.solve(np.asarray(b, dtype=_FLOAT)), dtype=_FLOAT)
 
 
 def lstsq(A: np.ndarray, b: np.ndarray) -> np.ndarray:

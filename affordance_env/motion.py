@@ -173,15 +173,18 @@ class LinePath:
         #: IK results of the waypoints solved so far, in order along the line (the start is given).
         self.results: list[IKResult] = []
         spans = len(self._s_ik) - 1 if check_waypoints is None else min(check_waypoints, len(self._s_ik) - 1)
-        rates = [np.abs(self._waypoint(k) - self._waypoint(k - 1)) / (self._s_ik[k] - self._s_ik[k - 1])
-                 for k in range(1, spans + 1)]  # joint rates per metre of the palm [rad/m]
-        limit = executor.planned_speed
-        cap = min(float(np.min(limit / np.maximum(rate, 1e-12))) for rate in rates)
+        self._waypoint(spans)  # solves the waypoints up to the last checked one, in order
+        q_ik = np.array(self._q_ik[: spans + 1])
+        # Joint rates per metre of the palm [rad/m] over each span, all spans at once (elementwise, the same
+        # numbers as span by span; the smallest of the spans' minima is the minimum over all of them).
+        rates = np.abs(q_ik[1:] - q_ik[:-1]) / (self._s_ik[1 : spans + 1] - self._s_ik[:spans])[:, None]
+        cap = float(np.min(executor.planned_speed / np.maximum(rates, 1e-12)))
         #: Cruise speed of the palm [m/s]: the one asked for, or the most the joints allow.
         self.speed = min(float(speed), cap)
         profile = line_profile(length, self.speed, CONTROL_DT, ramp=ramp, to_rest=to_rest)
         self._s, self._v = profile[:, 0], profile[:, 1]
         self._a = np.diff(self._v, prepend=0.0) / CONTROL_DT  # the palm's acceleration along the line [m/s^2]
+        self._trajectory: JointTrajectory | None = None
 
     def __len__(self) -> int:
         return len(self._s)
@@ -194,6 +197,20 @@ class LinePath:
             self.results.append(result)
             self._q_ik.append(result.q)
         return self._q_ik[k]
+
+    def trajectory(self) -> JointTrajectory | None:
+        """The :meth:`target` of every tick at once, bit for bit, once every waypoint is solved (None before: a
+        line that checks only its first spans solves the others when the hand gets there, and may stop first)."""
+        if self._trajectory is None and len(self._q_ik) == len(self._s_ik):
+            # target(i) for every i, vectorised: the same elementwise operations in the same order.
+            s, s_ik = self._s, self._s_ik
+            k = np.minimum(np.maximum(np.searchsorted(s_ik, s), 1), len(s_ik) - 1)
+            q_ik = np.array(self._q_ik)
+            q0, s0 = q_ik[k - 1], s_ik[k - 1]
+            rate = (q_ik[k] - q0) / (s_ik[k] - s0)[:, None]
+            self._trajectory = JointTrajectory(q0 + (s - s0)[:, None] * rate, rate * self._v[:, None],
+                                               rate * self._a[:, None], CONTROL_DT)
+        return self._trajectory
 
     def target(self, i: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Joint targets [rad], velocities [rad/s] and accelerations [rad/s^2] of tick ``i``."""
@@ -259,10 +276,13 @@ class MotionExecutor:
         """Play ``trajectory`` on the servos, one control tick per sample, with velocity and inertial
         feedforward. ``until``, if given, is asked after every tick; the move stops (the targets stay where the
         joints are) as soon as it answers True. Returns whether it did."""
-        step_toward, n_steps = self.physics.step_toward, self.steps_per_tick
-        led = trajectory.q + self.physics.servo_lead * trajectory.qd  # the velocity feedforward of every tick
+        physics = self.physics
+        # physics.step_toward's two calls, bound once: this loop runs every control tick of every move
+        aim, step, n_steps = physics.set_targets_toward, physics.step, self.steps_per_tick
+        led = trajectory.q + physics.servo_lead * trajectory.qd  # the velocity feedforward of every tick
         for q_tick, qdd_tick in zip(led, trajectory.qdd, strict=True):
-            step_toward(q_tick, qdd_tick, n_steps)  # and the inertial feedforward of the tick's configuration
+            aim(q_tick, qdd_tick)  # and the inertial feedforward of the tick's configuration
+            step(n_steps)
             if until is not None and until():
                 self.stop()
                 return True
@@ -304,7 +324,7 @@ class MotionExecutor:
 
         def still() -> bool:
             nonlocal still_ticks
-            slow = np.max(np.abs(physics.joint_velocities())) <= HOLD_SPEED_TOLERANCE
+            slow = physics.max_joint_speed() <= HOLD_SPEED_TOLERANCE
             still_ticks = still_ticks + 1 if slow else 0
             return still_ticks >= HOLD_STILL_TICKS and (also is None or also(physics))
 
@@ -355,28 +375,23 @@ class MotionExecutor:
         """
         physics = self.physics
         palm = self.palm  # a view: the palm position after each step
-        lead = physics.servo_lead
+        p_start = palm.copy()
+        trajectory = path.trajectory()
+        if touched is None and trajectory is not None:  # nothing to watch: the one servo loop
+            self.follow(trajectory)
+            return LineResult(False, float("nan"), 0.0, p_start)
         n_steps = self.steps_per_tick
         dt = physics.model.opt.timestep
         direction = path.direction
-        p_touch, time, speed = palm.copy(), float("nan"), 0.0
-        touched_yet = done = False
-        for i in range(len(path)):
-            q, qd, qdd = path.target(i)
-            q_led = q + lead * qd  # velocity feedforward, and the inertial feedforward of the line's acceleration
+        p_touch, time, speed = p_start, float("nan"), 0.0
+        touched_yet = False
+        for q_led, qdd in self._line_ticks(path):
             if touched is None:
                 physics.step_toward(q_led, qdd, n_steps)
                 continue
-            physics.set_joint_targets(q_led + physics.inertial_lead(qdd))
-            fine = per_step and (touched_yet or physics.hand_object_distance(CONTACT_WATCH_DISTANCE)
-                                 < CONTACT_WATCH_DISTANCE)
-            if not fine:  # whole ticks: the touch to the tick
-                p_before = palm.copy()
-                physics.step(n_steps)
-                if not touched_yet and touched():
-                    touched_yet, time, p_touch = True, float(physics.data.time), palm.copy()
-                    speed = norm(palm - p_before) / (n_steps * dt)
-            else:  # step by step: the touch, and the follow-through after it, to the step
+            physics.set_targets_toward(q_led, qdd)
+            if per_step and (touched_yet or physics.hand_object_distance(CONTACT_WATCH_DISTANCE)
+                             < CONTACT_WATCH_DISTANCE):  # step by step: the touch and the follow-through, to the step
                 for _ in range(n_steps):
                     if not touched_yet:
                         p_before = palm.copy()
@@ -385,12 +400,30 @@ class MotionExecutor:
                         touched_yet, time, p_touch = True, float(physics.data.time), palm.copy()
                         speed = norm(palm - p_before) / dt
                     if touched_yet and dot(palm - p_touch, direction) >= follow_through:
-                        done = True
-                        break
-            if touched_yet and (done or dot(palm - p_touch, direction) >= follow_through):
+                        self.stop()
+                        return LineResult(True, time, speed, p_touch)
+                continue  # past the touch, the last step's follow-through was just measured: short of it
+            p_before = palm.copy()  # whole ticks: the touch to the tick
+            physics.step(n_steps)
+            if not touched_yet and touched():
+                touched_yet, time, p_touch = True, float(physics.data.time), palm.copy()
+                speed = norm(palm - p_before) / (n_steps * dt)
+            if touched_yet and dot(palm - p_touch, direction) >= follow_through:
                 self.stop()
                 break
         return LineResult(touched_yet, time, speed, p_touch)
+
+    def _line_ticks(self, path: LinePath) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """The servo targets led by the velocity feedforward [rad] and the accelerations [rad/s^2] of every tick of
+        ``path``: all at once when its waypoints are solved, else tick by tick as the hand gets there."""
+        lead = self.physics.servo_lead
+        trajectory = path.trajectory()
+        if trajectory is not None:
+            yield from zip(trajectory.q + lead * trajectory.qd, trajectory.qdd, strict=True)
+            return
+        for i in range(len(path)):
+            q, qd, qdd = path.target(i)
+            yield q + lead * qd, qdd
 
     def line(self, p_from: np.ndarray, p_to: np.ndarray, hand: HandTarget, speed: float,
              q_start: np.ndarray | None = None, **kwargs) -> LinePath:
@@ -416,12 +449,12 @@ class MotionExecutor:
 
         def watch(stop_near: bool) -> Callable[[], bool]:
             def near() -> bool:
-                distance = physics.arm_object_distance(HOME_CLEARANCE)
                 if not state["clear"]:
-                    state["clear"] = distance >= HOME_CLEARANCE
+                    state["clear"] = physics.arm_object_distance(HOME_CLEARANCE) >= HOME_CLEARANCE
                     return False
                 state["touched"] = state["touched"] or physics.hand_touches_object()
-                return stop_near and distance < HOME_CLEARANCE
+                # once clear, only whether the arm is that near counts, and only if it stops the move
+                return stop_near and physics.arm_near_object(HOME_CLEARANCE)
             return near
 
         waited = self.move_through([q_home] if via is None else [via, q_home], until=watch(True))

@@ -105,12 +105,14 @@ class ObjectMonitor:
             v: Linear velocity of the centre in the world frame [m/s], 3 numbers.
             w: Angular velocity in the world frame [rad/s], 3 numbers.
         """
+        # Called at every control tick of an interaction: plain float arithmetic, names bound locally.
+        sqrt = math.sqrt
         dt = time - self._time
         self._time = time
         vx, vy, vz = v
         wx, wy, wz = w
-        speed = math.sqrt(vx * vx + vy * vy + vz * vz)
-        if speed < REST_SPEED and math.sqrt(wx * wx + wy * wy + wz * wz) < REST_ANGULAR_SPEED:
+        speed = sqrt(vx * vx + vy * vy + vz * vz)
+        if speed < REST_SPEED and sqrt(wx * wx + wy * wy + wz * wz) < REST_ANGULAR_SPEED:
             if self.still_since is None:
                 self.still_since = time
         else:
@@ -122,13 +124,15 @@ class ObjectMonitor:
             self.exit_time = time
             self.exit_position = np.array([x, y, z], dtype=np.float64)
             return
-        self.max_rise = max(self.max_rise, z - self.z_start)
-        speed_xy = math.sqrt(vx * vx + vy * vy)
+        rise = z - self.z_start
+        if rise > self.max_rise:  # max(self.max_rise, rise), as max() picks it
+            self.max_rise = rise
+        speed_xy = sqrt(vx * vx + vy * vy)
         if speed_xy < MIN_MOTION_SPEED or dt <= 0.0:
             return
         self.path_length += speed_xy * dt
         h = z - self.table_top
-        slip = math.sqrt((vx - h * wy) ** 2 + (vy + h * wx) ** 2 + vz * vz)
+        slip = sqrt((vx - h * wy) ** 2 + (vy + h * wx) ** 2 + vz * vz)
         if slip <= ROLL_SLIP_RATIO * speed_xy and abs(vz) <= ROLL_VERTICAL_RATIO * speed_xy:
             self.rolling_distance += speed_xy * dt
 

@@ -8,6 +8,7 @@ indexing ``MjData`` itself.
 from __future__ import annotations
 
 import copy
+import math
 from collections.abc import Callable
 
 import mujoco
@@ -27,6 +28,9 @@ OBJECT_RGBA = np.array([0.85, 0.2, 0.15, 1.0])
 MONITOR_PERIOD = 0.01
 #: Collision bits of the active object (assets/scene.xml): type 1, takes surfaces (1) and the hand (2).
 OBJECT_CONTYPE, OBJECT_CONAFFINITY = 1, 3
+#: MuJoCo's warnings that mean the simulation has failed (:meth:`TapPhysics.unstable`), in the order checked.
+FAULT_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQVEL, mujoco.mjtWarning.mjWARN_BADQPOS,
+                  mujoco.mjtWarning.mjWARN_CONTACTFULL, mujoco.mjtWarning.mjWARN_CNSTRFULL)
 
 
 def _id(model: mujoco.MjModel, kind: mujoco.mjtObj, name: str) -> int:
@@ -94,7 +98,11 @@ class TapPhysics:
         self._is_hand_geom = np.zeros(model.ngeom, dtype=bool)
         self._is_hand_geom[self.hand_geoms] = True
         self._hand_geom_list = self.hand_geoms.tolist()
-        self._hand_rbound = model.geom_rbound[self.hand_geoms].copy()
+        self._hand_geom_set = frozenset(self._hand_geom_list)
+        self._hand_rows = _as_slice(self.hand_geoms)  # their rows of geom_xpos: a view where consecutive
+        #: Bounding-sphere radius of each of them [m], as Python floats: the distance checks of every control
+        #: tick run in plain Python over a handful of geoms, cheaper than numpy's per-call overhead.
+        self._hand_rbound = model.geom_rbound[self.hand_geoms].tolist()
         #: Torque limit of each active joint's motor [N m] (inf for a joint without a motor of its own).
         ids = self._joint_ids
         self.torque_limit = np.where(model.jnt_actfrclimited[ids], model.jnt_actfrcrange[ids, 1], np.inf)
@@ -114,6 +122,12 @@ class TapPhysics:
         # Views into the data, made once: a control tick reads and writes them without building new arrays.
         data = self.data
         self._ctrl_view = data.ctrl[self._act] if isinstance(self._act, slice) else None
+        #: Where every active joint has a servo and every index runs in order (the tap robot), the robot's parts of
+        #: qacc and of M qacc and its controls as views: a control tick is then a few numpy calls on them
+        #: (:meth:`set_targets_toward`). None otherwise.
+        self._tick_views: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        if self._actuated is None and self._ctrl_view is not None and isinstance(self._qvel, slice):
+            self._tick_views = (self._qacc[self._qvel], self._torque[self._qvel], self._ctrl_view)
         self._object_p = data.qpos[self.object_qpos : self.object_qpos + 3]
         self._object_v = data.qvel[self.object_qvel : self.object_qvel + 3]
         self._object_w = data.cvel[self.object_body, :3]
@@ -156,6 +170,10 @@ class TapPhysics:
         """Robot joint velocities in active-joint order [rad/s]."""
         return self.data.qvel[self._qvel].copy()
 
+    def max_joint_speed(self) -> float:
+        """Largest speed of the robot's joints [rad/s] (of :meth:`joint_velocities`, without copying them)."""
+        return float(np.abs(self.data.qvel[self._qvel]).max())
+
     def joint_torques(self) -> np.ndarray:
         """Motor torques at the robot's joints in active-joint order [N m], gravity compensation included (the
         actuators carry it)."""
@@ -190,12 +208,28 @@ class TapPhysics:
         mujoco.mj_mulM(self.model, self.data, self._torque, self._qacc)
         return np.divide(self._torque[self._qvel], self.servo_kp, out=out)
 
-    def step_toward(self, q: np.ndarray, qdd: np.ndarray, n: int) -> None:
-        """One control tick: :meth:`set_joint_targets` to ``q`` plus :meth:`inertial_lead` of ``qdd``, then
-        :meth:`step` ``n`` times (the same as those three calls, with less Python between the steps)."""
-        lead = self.inertial_lead(qdd, out=self._lead)
+    def set_targets_toward(self, q: np.ndarray, qdd: np.ndarray) -> None:
+        """Servo targets ``q`` [rad] plus the :meth:`inertial_lead` of ``qdd`` [rad/s^2] (active-joint order),
+        clipped to the joint ranges: the same as ``set_joint_targets(q + inertial_lead(qdd))``, with less Python."""
+        lead, views = self._lead, self._tick_views
+        if views is None:
+            self.inertial_lead(qdd, out=lead)
+            np.add(q, lead, out=lead)
+            self.set_joint_targets(lead)
+            return
+        # The same arithmetic as those calls, in the same order, on views made once: M qdd / kp, plus q, clipped
+        # to the control range, into the data's ctrl. This runs at every control tick.
+        qacc_robot, torque_robot, ctrl = views
+        qacc_robot[:] = qdd
+        mujoco.mj_mulM(self.model, self.data, self._torque, self._qacc)
+        np.divide(torque_robot, self.servo_kp, out=lead)
         np.add(q, lead, out=lead)
-        self.set_joint_targets(lead)
+        np.minimum(np.maximum(lead, self.ctrl_low, out=lead), self.ctrl_high, out=ctrl)
+
+    def step_toward(self, q: np.ndarray, qdd: np.ndarray, n: int) -> None:
+        """One control tick: :meth:`set_targets_toward` ``q`` with the inertial lead of ``qdd``, then :meth:`step`
+        ``n`` times."""
+        self.set_targets_toward(q, qdd)
         self.step(n)
 
     def joint_targets(self) -> np.ndarray:
@@ -226,16 +260,19 @@ class TapPhysics:
 
     def hand_touches_table(self) -> bool:
         """Whether any contact joins the hand (or wrist, forearm, fingers) and the table top."""
-        table, hand = self.table_geom, self._is_hand_geom
-        for g1, g2 in self.data.contact.geom[: self.data.ncon].tolist():
-            if (g1 == table and hand[g2]) or (g2 == table and hand[g1]):
+        table, hand = self.table_geom, self._hand_geom_set
+        for g1, g2 in self.data.contact.geom.tolist():  # data.contact holds the ncon contacts
+            if (g1 == table and g2 in hand) or (g2 == table and g1 in hand):
                 return True
         return False
 
     def object_touches_table(self) -> bool:
         """Whether any contact joins the object and the table top."""
-        pair = {self.active_geom, self.table_geom}
-        return any({g1, g2} == pair for g1, g2 in self.data.contact.geom[: self.data.ncon].tolist())
+        obj, table = self.active_geom, self.table_geom  # two different geoms
+        for g1, g2 in self.data.contact.geom.tolist():  # asked at every control tick of a grasp's put-down
+            if (g1 == obj and g2 == table) or (g1 == table and g2 == obj):
+                return True
+        return False
 
     def hand_object_distance(self, max_distance: float) -> float:
         """Smallest distance between the hand (wrist, forearm) and the object [m], from the kinematics of the last
@@ -248,14 +285,46 @@ class TapPhysics:
         the object [m] (in ``data``, by default the simulated state); ``max_distance`` if they are at least that far
         apart. Geoms whose bounding spheres are that far from the object's are not measured further."""
         data = self.data if data is None else data
-        obj = self.active_geom
-        gap = (np.linalg.norm(data.geom_xpos[self.hand_geoms] - data.geom_xpos[obj], axis=1)
-               - self._hand_rbound - self.model.geom_rbound[obj])
-        near = self.hand_geoms[gap < max_distance]
-        if near.size == 0:
+        near = self._hand_geoms_near(data, max_distance)
+        if not near:
             return max_distance
-        model = self.model
-        return min(mujoco.mj_geomDistance(model, data, int(g), obj, max_distance, None) for g in near)
+        model, obj = self.model, self.active_geom
+        return min(mujoco.mj_geomDistance(model, data, g, obj, max_distance, None) for g in near)
+
+    def arm_near_object(self, max_distance: float) -> bool:
+        """Whether :meth:`arm_object_distance` (of the simulated state) is below ``max_distance`` [m]: the same
+        answer, measuring only until a geom is found that near."""
+        model, data, obj = self.model, self.data, self.active_geom
+        nearest = None
+        for g in self._hand_geoms_near(data, max_distance):
+            distance = mujoco.mj_geomDistance(model, data, g, obj, max_distance, None)
+            # min()'s running minimum: the first distance, then any smaller one
+            if nearest is None or distance < nearest:
+                nearest = distance
+            if nearest < max_distance:  # later distances can only lower it
+                return True
+            if nearest != nearest:  # a NaN first: min() keeps it to the end, and NaN < max_distance is False
+                return False
+        return False
+
+    def _hand_geoms_near(self, data: mujoco.MjData, max_distance: float) -> list[int]:
+        """The robot's geoms that touch the world whose bounding spheres are nearer the object's than
+        ``max_distance`` [m] in ``data``, in increasing id order.
+
+        Plain Python floats, for the few geoms of an arm: the same operations in the same order as numpy's
+        ``norm(p_geoms - p_object, axis=1) - rbound_geoms - rbound_object`` (each row's squares summed left to right,
+        then the correctly rounded square root), so the same bits, at a fraction of numpy's per-call cost."""
+        obj = self.active_geom
+        xpos = data.geom_xpos
+        ox, oy, oz = xpos[obj].tolist()
+        r_object = float(self.model.geom_rbound[obj])
+        near = []
+        for g, (x, y, z), r_geom in zip(self._hand_geom_list, xpos[self._hand_rows].tolist(), self._hand_rbound,
+                                        strict=True):
+            dx, dy, dz = x - ox, y - oy, z - oz
+            if math.sqrt(dx * dx + dy * dy + dz * dz) - r_geom - r_object < max_distance:
+                near.append(g)
+        return near
 
     def sweep_clearance(self, path: np.ndarray, max_distance: float) -> float:
         """Smallest distance [m] between the robot's geoms that touch the world and the object over the joint
@@ -272,12 +341,14 @@ class TapPhysics:
 
     def hand_touches_object(self) -> bool:
         """Whether any contact joins the hand (or wrist, forearm) and the object."""
-        ncon = self.data.ncon
-        if ncon == 0:
+        data = self.data
+        if data.ncon == 0:
             return False
-        obj, hand = self.active_geom, self._is_hand_geom
-        for g1, g2 in self.data.contact.geom[:ncon].tolist():  # a few contacts: plain Python is fastest
-            if (g1 == obj and hand[g2]) or (g2 == obj and hand[g1]):
+        obj, hand = self.active_geom, self._hand_geom_set
+        # a few contacts (data.contact holds the ncon of them): plain Python and a set are fastest, asked at every
+        # physics step of a stroke near the object
+        for g1, g2 in data.contact.geom.tolist():
+            if (g1 == obj and g2 in hand) or (g2 == obj and g1 in hand):
                 return True
         return False
 
@@ -402,32 +473,29 @@ class TapPhysics:
         self._next_sample = self.data.time
         return self.monitor
 
-    def _sample_monitor(self) -> None:
-        # qvel's linear part is the centre's world velocity (the body origin is its centre of mass); cvel's
-        # rotational part is the angular velocity in world axes (computed at the start of the last step).
-        self.monitor.sample(self.data.time, self._object_p.tolist(), self._object_v.tolist(),
-                            self._object_w.tolist())
-
     # --- stepping --------------------------------------------------------------------------------------------
     def step(self, n: int = 1) -> None:
         """Advance the simulation by ``n`` timesteps."""
         data = self.data
         mujoco.mj_step(self.model, data, n)
-        if self.monitor is not None:
+        monitor = self.monitor
+        if monitor is not None:
             time = data.time
             if time >= self._next_sample - 1e-9:  # every 10 ms at least
-                self._sample_monitor()
+                # qvel's linear part is the centre's world velocity (the body origin is its centre of mass); cvel's
+                # rotational part is the angular velocity in world axes (computed at the start of the last step).
+                # Sampled here rather than in a method of its own: this runs at every control tick.
+                monitor.sample(time, self._object_p.tolist(), self._object_v.tolist(), self._object_w.tolist())
                 self._next_sample = time + MONITOR_PERIOD
         if self.on_step is not None:
             self.on_step(self)
 
     def unstable(self) -> str | None:
         """A description of a simulation fault (MuJoCo warning, non-finite state), or None if healthy."""
-        for kind in (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQVEL,
-                     mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_CONTACTFULL,
-                     mujoco.mjtWarning.mjWARN_CNSTRFULL):
-            if self.data.warning[kind].number > 0:
+        counts = self.data.warning.number  # every kind's count at once
+        for kind in FAULT_WARNINGS:
+            if counts[kind] > 0:
                 return f"MuJoCo warning {kind.name}"
-        if not (np.all(np.isfinite(self.data.qpos)) and np.all(np.isfinite(self.data.qvel))):
+        if not (np.isfinite(self.data.qpos).all() and np.isfinite(self.data.qvel).all()):
             return "non-finite state"
         return None

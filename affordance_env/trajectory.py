@@ -53,8 +53,10 @@ class JointTrajectory:
 
 
 def _check_limits(velocity_limit: np.ndarray | float, n_joints: int) -> np.ndarray:
-    limit = np.broadcast_to(np.asarray(velocity_limit, dtype=np.float64), (n_joints,))
-    if not np.all(np.isfinite(limit) & (limit > 0)):
+    limit = np.asarray(velocity_limit, dtype=np.float64)
+    if limit.shape != (n_joints,):  # a scalar (or a broadcastable array): broadcast; a vector as it is
+        limit = np.broadcast_to(limit, (n_joints,))
+    if not (np.isfinite(limit) & (limit > 0)).all():
         raise InvalidValueError(f"velocity_limit must be positive and finite for every joint, got {velocity_limit!r}.")
     return limit
 
@@ -91,35 +93,44 @@ def minimum_jerk(q_from: np.ndarray, waypoints: list[np.ndarray] | np.ndarray, v
     if not dt > 0:
         raise InvalidValueError(f"dt must be positive [s], got {dt!r}.")
     limit = _check_limits(velocity_limit, q_from.size)
-    deltas = np.diff(np.vstack([q_from, points]), axis=0)
+    # np.diff(np.vstack([q_from, points]), axis=0), without the two wrappers: each row minus the one before
+    stacked = np.concatenate((q_from[None, :], points))
+    deltas = stacked[1:] - stacked[:-1]
     lengths = np.maximum(max(min_duration, 1e-9), PEAK_SPEED_FACTOR * np.max(np.abs(deltas) / limit, axis=1))
     starts = np.zeros(len(deltas))
     for k in range(1, len(deltas)):
         starts[k] = starts[k - 1] + lengths[k - 1] - blend * min(lengths[k - 1], lengths[k])
     end = float(np.max(starts + lengths))
 
-    def sample(stretch: float) -> JointTrajectory:
+    def grid(stretch: float) -> tuple[np.ndarray, float]:
+        """Each segment's progress (ticks, segments) at the samples of the move stretched ``stretch`` times, and
+        the real seconds per unstretched second."""
         n = max(1, round(stretch * end / dt))
         t = (np.arange(1, n + 1) * (end / n))[:, None]  # unstretched time of each sample
-        tau = np.clip((t - starts) / lengths, 0.0, 1.0)  # (ticks, segments)
-        position = tau ** 3 * (10.0 + tau * (6.0 * tau - 15.0))
-        rate = 30.0 * tau ** 2 * (1.0 + tau * (tau - 2.0)) / lengths
-        acceleration = 60.0 * tau * (1.0 + tau * (2.0 * tau - 3.0)) / lengths ** 2
-        time_scale = n * dt / end  # real seconds per unstretched second
-        return JointTrajectory(q_from + matmul(position, deltas), matmul(rate, deltas) / time_scale,
-                               matmul(acceleration, deltas) / time_scale ** 2, dt)
+        return ((t - starts) / lengths).clip(0.0, 1.0), n * dt / end  # np.clip's own method, without its wrapper
 
-    trajectory = sample(1.0)
+    def velocity(tau: np.ndarray, time_scale: float) -> np.ndarray:
+        rate = 30.0 * tau ** 2 * (1.0 + tau * (tau - 2.0)) / lengths
+        return matmul(rate, deltas) / time_scale
+
+    # The velocities decide how far the move must stretch: the positions and accelerations are computed once,
+    # for the samples kept.
+    tau, time_scale = grid(1.0)
+    qd = velocity(tau, time_scale)
     # Overlapping segments may add up, and rounding to whole samples shortens by up to half a sample.
-    stretch = max(1.0, float(np.max(np.abs(trajectory.qd) / limit)))
+    stretch = max(1.0, float(np.max(np.abs(qd) / limit)))
     if duration is not None:
         stretch = max(stretch, duration / end)
     if stretch > 1.0:
-        trajectory = sample(stretch)
-        over = float(np.max(np.abs(trajectory.qd) / limit))
+        tau, time_scale = grid(stretch)
+        qd = velocity(tau, time_scale)
+        over = float(np.max(np.abs(qd) / limit))
         if over > 1.0:  # the rounding to whole samples: one sample more
-            trajectory = sample(stretch * over + dt / end)
-    return trajectory
+            tau, time_scale = grid(stretch * over + dt / end)
+            qd = velocity(tau, time_scale)
+    position = tau ** 3 * (10.0 + tau * (6.0 * tau - 15.0))
+    acceleration = 60.0 * tau * (1.0 + tau * (2.0 * tau - 3.0)) / lengths ** 2
+    return JointTrajectory(q_from + matmul(position, deltas), qd, matmul(acceleration, deltas) / time_scale ** 2, dt)
 
 
 def line_profile(length: float, speed: float, dt: float, *, ramp: float = 0.0, from_rest: bool = True,

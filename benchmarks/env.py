@@ -19,7 +19,7 @@ from collections import defaultdict
 import mujoco
 import numpy as np
 
-import affordance_env.tap_env as tap_env_module
+import affordance_env.world as world_module
 from affordance_env.camera import RangeCamera
 from affordance_env.tap_env import TapAffordanceEnv
 
@@ -55,7 +55,7 @@ def main() -> None:
 
     mujoco.mj_step = timed("mj_step", counted_step)
     mujoco.mj_multiRay = timed("ray casting", original["mj_multiRay"])
-    tap_env_module.compute_features = timed("features", tap_env_module.compute_features)
+    world_module.compute_features = timed("features", world_module.compute_features)
     # Every range image: the snapshots' and the attention's (ray casting included, and the arrays around it).
     original_capture = RangeCamera.capture
     RangeCamera.capture = timed("range images", original_capture)
