@@ -52,31 +52,42 @@ class AttentionResult:
 
 
 def _centroid(camera: RangeCamera, physics: TapPhysics) -> tuple[np.ndarray, np.ndarray] | None:
-    image = camera.capture(physics.data, occluded=physics.active_geom, window=True)  # only where it may be
-    mask = image.mask_of(physics.active_geom)
-    if not mask.any():
+    """The object's pixel centroid (u, v) [pixels] and mean point in the world frame [m] in ``camera``'s image
+    now; None if it is not seen."""
+    # Only where it may be: the pixels and points of capture(occluded=geom, window=True)'s mask, without the image
+    pixels, points = camera.locate(physics.data, physics.active_geom)
+    if not pixels.size:
         return None
-    v, u = np.nonzero(mask)
-    return np.array([u.mean(), v.mean()]), image.p_world_points[mask].mean(axis=0)
+    v, u = np.divmod(pixels, camera.intrinsics.width)  # as np.nonzero(mask) gives them
+    # What u.mean(), v.mean() and points.mean(axis=0) compute (the same sums, in float64, of the same arrays,
+    # divided by the count), without np.mean's Python layers.
+    n = pixels.size
+    uv = np.array([np.add.reduce(u, dtype=np.float64) / n, np.add.reduce(v, dtype=np.float64) / n])
+    return uv, np.add.reduce(points, axis=0) / n
 
 
 def _image_jacobian(
-    camera: RangeCamera, physics: TapPhysics, p_world: np.ndarray, scratch: mujoco.MjData
+    camera: RangeCamera, physics: TapPhysics, p_world: np.ndarray, scratch: mujoco.MjData,
+    gaze: np.ndarray | None = None,
 ) -> np.ndarray:
-    """d(u, v)/d(neck_pitch, neck_yaw) of the world point ``p_world`` at the current configuration."""
+    """d(u, v)/d(neck_pitch, neck_yaw) [pixels/rad] of the world point ``p_world`` [m] at the current
+    configuration, by central differences on ``scratch``; ``gaze``: :func:`_gaze_indices` if already known."""
     K = camera.intrinsics
     scratch.qpos[:] = physics.data.qpos
     jac = np.empty((2, 2))
     eps = 1e-4
-    for j, joint in enumerate(_gaze_indices(physics)):
+    p_world = np.asarray(p_world, dtype=float)
+    for j, joint in enumerate(_gaze_indices(physics) if gaze is None else gaze):
+        address = physics.robot_qpos[joint]
+        q = physics.data.qpos[address]
         uv = []
         for sign in (1.0, -1.0):
-            scratch.qpos[physics.robot_qpos[joint]] = physics.data.qpos[physics.robot_qpos[joint]] + sign * eps
+            scratch.qpos[address] = q + sign * eps
             mujoco.mj_kinematics(physics.model, scratch)
             mujoco.mj_camlight(physics.model, scratch)
             p_cam, R_cam = scratch.cam_xpos[camera.camera_id], scratch.cam_xmat[camera.camera_id].reshape(3, 3)
             uv.append(project(p_world, p_cam, R_cam, K))
-        scratch.qpos[physics.robot_qpos[joint]] = physics.data.qpos[physics.robot_qpos[joint]]
+        scratch.qpos[address] = q
         jac[:, j] = (uv[0] - uv[1]) / (2 * eps)
     return jac
 
@@ -125,6 +136,7 @@ def attend(
     K = camera.intrinsics
     centre = np.array([K.cx, K.cy])
     scratch = physics.scratch
+    gaze = _gaze_indices(physics)  # the same joints every iteration
     seen = _centroid(camera, physics)
     if seen is None:
         seen = _search(physics, camera, move_joints, move_time, hold_time)
@@ -135,9 +147,9 @@ def attend(
         error = uv - centre
         if norm(error) <= tolerance:
             return AttentionResult(True, True, norm(error), iteration - 1)
-        jac = _image_jacobian(camera, physics, p_world, scratch)
+        jac = _image_jacobian(camera, physics, p_world, scratch, gaze)
         q = physics.joint_targets()
-        q[_gaze_indices(physics)] -= lstsq(jac, error)
+        q[gaze] -= lstsq(jac, error)
         move_joints(q, move_time)
         move_joints(q, hold_time)
         seen = _centroid(camera, physics)

@@ -61,6 +61,13 @@ MAX_ABS_PIXELS = 1e12
 AXIS_BAND_HALF_WIDTH_PX = 0.5
 #: Tangents spanning a sine of angle below this give no normal (collinear neighbours).
 _MIN_SINE_TANGENTS = 1e-6
+#: The rows of the tangents, in the order that lines up each coordinate of the cross product's two products.
+_CYCLIC_ROWS = np.array([1, 2, 0, 1])
+#: Latitude (row 0) and longitude (row 1) [rad] are shifted by these so that the lowest bin starts at 0, less the
+#: edge tolerance ...
+_BIN_SHIFT = np.array([[np.pi / 2 + EDGE_TOLERANCE_RAD], [np.pi + EDGE_TOLERANCE_RAD]])
+#: ... and scaled by these into bin widths.
+_BIN_SCALE = np.array([[N_BINS / np.pi], [N_BINS / (2.0 * np.pi)]])
 #: Relative anisotropy of the pixel covariance below which the orientation is taken as 0.
 _ISOTROPY_TOLERANCE = 1e-9
 #: A principal axis closer than this to -pi/2 [rad] is reported as +pi/2 (the same axis).
@@ -188,32 +195,31 @@ def compute_features(
     points, ranges, mask, p_world_camera, p_world_hand, uv_hand = _validated(
         p_world_points, ranges, mask, p_world_camera, p_world_hand, uv_hand
     )
-    rows = np.flatnonzero(mask.any(axis=1))
-    if rows.size == 0:
+    # object pixels, row-major, in the full image. Here and below, array methods and ufunc reductions stand for
+    # np.flatnonzero, np.take, np.stack, .sum(), .min(), .max(): the same operations without their Python layers.
+    image_index = mask.ravel().nonzero()[0]
+    if image_index.size == 0:
         return Features(NOT_VISIBLE_VALUES.copy(), visible=False, n_pixels=0)
-    cols = np.flatnonzero(mask.any(axis=0))
-    r0, r1, c0, c1 = int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
-
-    # Bounding box of the object, padded by one non-object pixel so that every neighbour index exists.
-    m_pad = np.zeros((r1 - r0 + 2, c1 - c0 + 2), dtype=bool)
-    m_pad[1:-1, 1:-1] = mask[r0:r1, c0:c1]
-    pixel_index = np.flatnonzero(m_pad)  # object pixels, row-major, in the padded crop
-    v_pad, u_pad = np.divmod(pixel_index, m_pad.shape[1])
-    v_obj, u_obj = v_pad + (r0 - 1), u_pad + (c0 - 1)
-    image_index = v_obj * mask.shape[1] + u_obj  # the same pixels in the full image
+    v_obj, u_obj = np.divmod(image_index, mask.shape[1])
+    # Bounding box of the object, padded by one non-object pixel so that every neighbour index exists: the
+    # object's pixels in that padded crop, row-major (the full image's order), found from their rows and columns
+    # instead of by copying the crop and searching it again.
+    r0, c0, c1 = int(v_obj[0]), int(np.minimum.reduce(u_obj)), int(np.maximum.reduce(u_obj)) + 1
+    grid_shape = (int(v_obj[-1]) + 1 - r0 + 2, c1 - c0 + 2)
+    pixel_index = (v_obj - (r0 - 1)) * grid_shape[1] + (u_obj - (c0 - 1))
     # (3, k), gathered along the pixel axis (contiguous when the camera hands out its (3, n) points transposed)
-    p_world_obj = np.ascontiguousarray(np.take(points.reshape(-1, 3).T, image_index, axis=1), dtype=np.float64)
-    range_obj = np.take(ranges.reshape(-1), image_index).astype(np.float64)
+    p_world_obj = np.ascontiguousarray(points.reshape(-1, 3).T.take(image_index, axis=1), dtype=np.float64)
+    range_obj = ranges.reshape(-1).take(image_index).astype(np.float64)
     _check_on_mask(p_world_obj, range_obj)
-    uv_obj = np.stack([u_obj, v_obj]).astype(np.float64)
+    uv_obj = np.array((u_obj, v_obj), dtype=np.float64)
 
-    n_obj = int(pixel_index.size)
-    uv_centroid = uv_obj.sum(axis=1) / n_obj
-    p_world_mean = p_world_obj.sum(axis=1) / n_obj
+    n_obj = int(image_index.size)
+    uv_centroid = np.add.reduce(uv_obj, axis=1) / n_obj
+    p_world_mean = np.add.reduce(p_world_obj, axis=1) / n_obj
     d_uv = (uv_centroid - uv_hand).tolist()
     d_world = (p_world_mean - p_world_hand).tolist()
     values = np.empty(N_FEATURES, dtype=np.float32)
-    values[0:24] = _normal_histograms(p_world_obj, pixel_index, m_pad.shape, p_world_camera)
+    values[0:24] = _normal_histograms(p_world_obj, pixel_index, grid_shape, p_world_camera)
     values[24:42] = _size_features(p_world_obj, range_obj, uv_obj, uv_centroid, p_world_mean)
     values[42:49] = [*d_uv, math.hypot(*d_uv), *d_world, math.hypot(*d_world)]
     return Features(values, visible=True, n_pixels=n_obj)
@@ -266,44 +272,55 @@ def _normal_histograms(
     slot = np.full(grid_shape[0] * grid_shape[1], -1, dtype=np.intp)  # grid pixel -> object point, or -1
     slot[pixel_index] = own
     width = grid_shape[1]
-    # A missing neighbour is replaced by the pixel itself: central or one-sided difference, or zero.
-    right, left, down, up = (
-        np.where(neighbour >= 0, neighbour, own)
-        for neighbour in (
-            slot[pixel_index + 1],
-            slot[pixel_index - 1],
-            slot[pixel_index + width],
-            slot[pixel_index - width],
-        )
-    )
-    t_u = np.take(p_world_obj, right, axis=1) - np.take(p_world_obj, left, axis=1)
-    t_v = np.take(p_world_obj, down, axis=1) - np.take(p_world_obj, up, axis=1)
-    n_x = t_u[1] * t_v[2] - t_u[2] * t_v[1]
-    n_y = t_u[2] * t_v[0] - t_u[0] * t_v[2]
-    n_z = t_u[0] * t_v[1] - t_u[1] * t_v[0]
-    n_sq = n_x * n_x + n_y * n_y + n_z * n_z
-    ok = n_sq > _MIN_SINE_TANGENTS**2 * (np.einsum("ij,ij->j", t_u, t_u) * np.einsum("ij,ij->j", t_v, t_v))
+    # The right, down, left and up neighbours of every pixel at once, (4, k); a missing neighbour is replaced by
+    # the pixel itself: central or one-sided difference, or zero.
+    neighbour = slot.take(pixel_index + np.array([[1], [width], [-1], [-width]]))  # take: slot[...], faster
+    neighbour = np.where(neighbour >= 0, neighbour, own)
+    # (3, 4, k) points of the neighbours; differences (3, 2, k): [:, 0] the tangent along u (right - left),
+    # [:, 1] along v (down - up). The same subtractions of the same points as one tangent at a time.
+    gathered = p_world_obj.take(neighbour, axis=1)
+    tangents = gathered[:, :2] - gathered[:, 2:]
+    # The cross product t_u x t_v, row i = t_u[i+1] t_v[i+2] - t_u[i+2] t_v[i+1] (indices mod 3): the rows of
+    # ``cyclic`` are those of ``tangents`` in the order 1, 2, 0, 1, so that cyclic[i] is index i+1, cyclic[i+1]
+    # index i+2 (views, one copy); the same products and differences as n_x, n_y, n_z written out.
+    cyclic = tangents.take(_CYCLIC_ROWS, axis=0)
+    first, second = cyclic[:3], cyclic[1:]
+    normal = first[:, 0] * second[:, 1] - second[:, 0] * first[:, 1]  # (3, k)
+    # Per pixel, n . n (its squared length) and n . (camera - point) (>= 0: it faces the camera), each as
+    # x + y, then + z, like ``n_x * n_x + n_y * n_y + n_z * n_z``: both summed from one (2, 3, k) array.
+    products = np.empty((2, 3, normal.shape[1]))
+    np.multiply(normal, normal, out=products[0])
+    np.multiply(normal, p_world_camera[:, None] - p_world_obj, out=products[1])
+    sums = products[:, 0] + products[:, 1]
+    sums += products[:, 2]
+    n_sq = sums[0]
+    # |t_u|^2 and |t_v|^2 by one einsum over both: the same sums as einsum("ij,ij->j") of each
+    lengths_sq = np.einsum("ijk,ijk->jk", tangents, tangents)
+    ok = n_sq > _MIN_SINE_TANGENTS**2 * (lengths_sq[0] * lengths_sq[1])
     n_normals = int(np.count_nonzero(ok))
     if n_normals == 0:
         return np.zeros(2 * N_BINS)
-    view = p_world_camera[:, None] - p_world_obj  # from each point to the camera [m]
-    facing = n_x * view[0] + n_y * view[1] + n_z * view[2] >= 0.0
-    n_x, n_y, n_z, n_sq, facing = n_x[ok], n_y[ok], n_z[ok], n_sq[ok], facing[ok]
-    scale = np.where(facing, 1.0, -1.0) / np.sqrt(n_sq)
-    n_x *= scale
-    n_y *= scale
-    n_z *= scale
+    if n_normals < n_sq.size:  # pixels without a normal are left out
+        normal, sums = normal[:, ok], sums[:, ok]
+    n_sq, toward = sums
+    normal *= np.where(toward >= 0.0, 1.0, -1.0) / np.sqrt(n_sq)  # unit normals, turned to face the camera
+    n_x, n_y, n_z = normal
 
     # Bin of an angle: floor((angle - lowest edge + tolerance) / bin width); the top latitude edge (pi/2) is
-    # closed, and longitude bin 12 (just below +pi, within the tolerance) wraps round to bin 0.
-    lat_shifted = np.arcsin(np.clip(n_z, -1.0, 1.0)) + (np.pi / 2 + EDGE_TOLERANCE_RAD)
-    lat_bin = np.minimum((lat_shifted * (N_BINS / np.pi)).astype(np.intp), N_BINS - 1)
-    vertical = n_x * n_x + n_y * n_y < math.sin(VERTICAL_TOLERANCE_RAD) ** 2
-    lon_shifted = np.where(vertical, 0.0, np.arctan2(n_y, n_x)) + (np.pi + EDGE_TOLERANCE_RAD)
-    lon_bin = (lon_shifted * (N_BINS / (2.0 * np.pi))).astype(np.intp)
-    lon_bin[lon_bin >= N_BINS] = 0
-    counts = np.concatenate([np.bincount(lat_bin, minlength=N_BINS), np.bincount(lon_bin, minlength=N_BINS)])
-    return counts / n_normals
+    # closed, and longitude bin 12 (just below +pi, within the tolerance) wraps round to bin 0. Latitude (row 0)
+    # and longitude (row 1) are shifted, scaled and floored together, each by its own constants.
+    angles = np.empty((2, n_normals))
+    np.arcsin(np.minimum(np.maximum(n_z, -1.0), 1.0), out=angles[0])  # np.clip to [-1, 1] without its layers
+    np.arctan2(n_y, n_x, out=angles[1])
+    squares = normal[:2] * normal[:2]
+    angles[1][squares[0] + squares[1] < math.sin(VERTICAL_TOLERANCE_RAD) ** 2] = 0.0  # vertical: longitude 0
+    angles += _BIN_SHIFT
+    angles *= _BIN_SCALE
+    bins = angles.astype(np.intp)
+    np.minimum(bins[0], N_BINS - 1, out=bins[0])
+    bins[1][bins[1] >= N_BINS] = 0
+    bins[1] += N_BINS  # the longitude histogram follows the latitude one
+    return np.bincount(bins.ravel(), minlength=2 * N_BINS) / n_normals
 
 
 def _size_features(
@@ -316,7 +333,7 @@ def _size_features(
     """The 18 size features from the object points (3, k) [m], ranges (k,) [m] and pixels (2, k) [pixels]."""
     duv = uv_obj - uv_centroid[:, None]
     scatter = matmul(duv, duv.T)  # k times the covariance [pixels^2]; the angle does not depend on the scale
-    c_uu, c_vv, c_uv = float(scatter[0, 0]), float(scatter[1, 1]), float(scatter[0, 1])
+    (c_uu, c_uv), (_, c_vv) = scatter.tolist()
     if math.hypot(c_uu - c_vv, 2.0 * c_uv) <= _ISOTROPY_TOLERANCE * (c_uu + c_vv):
         theta = 0.0
     else:
@@ -324,29 +341,38 @@ def _size_features(
     if theta <= -math.pi / 2 + _ORIENTATION_WRAP_TOLERANCE_RAD:  # same axis: report +pi/2, never -pi/2
         theta = math.pi / 2
     cos_t, sin_t = math.cos(theta), math.sin(theta)
-    along = duv[0] * cos_t + duv[1] * sin_t
-    across = duv[1] * cos_t - duv[0] * sin_t
-    i_a, i_b = _extremes_on_axis(along, across)
-    i_c, i_d = _extremes_on_axis(across, along)
+    # Each pixel's coordinates along (row 0) and across (row 1) the principal axis [pixels]:
+    # along = du cos + dv sin, across = dv cos - du sin, in two products and one sum over both rows
+    # (dv cos + du (-sin) is dv cos - du sin exactly: negation is exact, and x + (-y) is x - y).
+    axes = duv * cos_t
+    axes += duv[::-1] * np.array([[sin_t], [-sin_t]])
+    distance = np.abs(axes)  # |along|, |across|
+    nearest = np.minimum.reduce(distance, axis=1).tolist()
+    i_a, i_b = _extremes_on_axis(axes[0], distance[1], nearest[1])
+    i_c, i_d = _extremes_on_axis(axes[1], distance[0], nearest[0])
 
-    out = [*p_world_mean.tolist(), float(range_obj.sum()) / range_obj.size, float(range_obj.size), theta]
-    for i, j in ((i_a, i_b), (i_c, i_d)):
-        d_world = np.abs(p_world_obj[:, i] - p_world_obj[:, j]).tolist()
-        out += [*d_world, math.hypot(*d_world), abs(float(range_obj[i] - range_obj[j]))]
-    for i, j in ((i_a, i_b), (i_c, i_d)):
-        out.append(math.hypot(*(uv_obj[:, i] - uv_obj[:, j]).tolist()))
+    out = [*p_world_mean.tolist(), float(np.add.reduce(range_obj)) / range_obj.size, float(range_obj.size), theta]
+    # The four extremum points, ranges and pixels as Python floats: the differences and absolute values below are
+    # the same IEEE operations as numpy's on these float64 values, without an array call for each.
+    ends = [i_a, i_b, i_c, i_d]
+    points, end_ranges, pixels = p_world_obj[:, ends].T.tolist(), range_obj[ends].tolist(), uv_obj[:, ends].T.tolist()
+    for i, j in ((0, 1), (2, 3)):
+        d_world = [abs(a - b) for a, b in zip(points[i], points[j], strict=True)]
+        out += [*d_world, math.hypot(*d_world), abs(end_ranges[i] - end_ranges[j])]
+    for i, j in ((0, 1), (2, 3)):
+        out.append(math.hypot(*(a - b for a, b in zip(pixels[i], pixels[j], strict=True))))
     return out
 
 
-def _extremes_on_axis(along: np.ndarray, across: np.ndarray) -> tuple[int, int]:
+def _extremes_on_axis(along: np.ndarray, distance: np.ndarray, nearest: float) -> tuple[int, int]:
     """Indices of the pixels with the smallest and largest ``along`` among those nearest the axis.
 
-    ``along`` and ``across`` are the pixels' coordinates along and across the axis [pixels]; the candidates
-    are the pixels within :data:`AXIS_BAND_HALF_WIDTH_PX` of the axis, or the nearest ones if there are none.
+    ``along`` are the pixels' coordinates along the axis and ``distance`` their distances from it [pixels]
+    (``nearest`` the smallest); the candidates are the pixels within :data:`AXIS_BAND_HALF_WIDTH_PX` of the
+    axis, or the nearest ones if there are none.
     """
-    distance = np.abs(across)
-    band = np.flatnonzero(distance <= max(AXIS_BAND_HALF_WIDTH_PX, float(distance.min())) + 1e-9)
-    along_band = along[band]
+    band = (distance <= max(AXIS_BAND_HALF_WIDTH_PX, nearest) + 1e-9).nonzero()[0]
+    along_band = along.take(band)  # along[band]
     return int(band[np.argmin(along_band)]), int(band[np.argmax(along_band)])
 
 
@@ -384,24 +410,30 @@ def _validated(
 def _real_array(name: str, value: np.ndarray) -> np.ndarray:
     """``value`` as an array of a real dtype (integer or floating, not bool), else a ValueError naming it."""
     arr = np.asarray(value)
-    real = np.issubdtype(arr.dtype, np.floating) or np.issubdtype(arr.dtype, np.integer)
-    if arr.dtype == np.bool_ or not real:
+    # np.issubdtype(dtype, np.floating or np.integer), without its Python layers
+    real = issubclass(arr.dtype.type, np.floating | np.integer)
+    if arr.dtype.type is np.bool_ or not real:
         raise InvalidValueError(f"{name} must have a real floating or integer dtype, got dtype {arr.dtype}.")
     return arr
 
 
 def _finite_vector(name: str, value: np.ndarray, size: int, max_abs: float, unit: str) -> np.ndarray:
     """``value`` as a float (size,) vector with entries finite and within +-``max_abs``, else ValueError."""
-    vec = _real_array(name, value).astype(np.float64)
+    vec = np.asarray(_real_array(name, value), dtype=np.float64)  # no copy of a float64 vector: only read
     if vec.shape != (size,):
         raise InvalidValueError(f"{name} must have shape ({size},), got shape {vec.shape}.")
-    if not np.all(np.abs(vec) <= max_abs):
+    if not all(abs(x) <= max_abs for x in vec.tolist()):  # NaN fails the comparison as in numpy
         raise InvalidValueError(f"{name} must be finite and within +-{max_abs:g} {unit}, got {vec.tolist()}.")
     return vec
 
 
 def _check_on_mask(p_world_obj: np.ndarray, range_obj: np.ndarray) -> None:
     """Raise ValueError unless object points (3, k) and ranges (k,) [m] are finite, bounded, ranges >= 0."""
+    # The usual case in two reductions each: a NaN makes the maximum (minimum) NaN, which fails the comparison,
+    # so any bad value goes on to the pixel-by-pixel checks below, which name it.
+    if (np.maximum.reduce(np.abs(p_world_obj), axis=None) <= MAX_ABS_METRES
+            and np.minimum.reduce(range_obj) >= 0.0 and np.maximum.reduce(range_obj) <= MAX_ABS_METRES):
+        return
     bad_points = ~(np.abs(p_world_obj) <= MAX_ABS_METRES).all(axis=0)
     if bad_points.any():
         raise InvalidValueError(

@@ -1,5 +1,7 @@
 """The ray-cast range camera and attention, against analytic ground truth."""
 
+import math
+
 import mujoco
 import numpy as np
 import pytest
@@ -269,3 +271,77 @@ def test_the_rays_cast_for_a_ball_are_about_its_silhouette():
     assert set(np.flatnonzero(mask).tolist()) <= set(rays.tolist())
     ((_, u0, u1, v0, v1),) = env.camera._rectangles(np.array([geom]), data, *env.camera.pose(data))
     assert rays.size < 1.3 * mask.sum() and (u1 - u0) * (v1 - v0) > 1.6 * mask.sum()
+
+
+def _rotations(rng: np.random.Generator, n: int) -> list[np.ndarray]:
+    """``n`` rotation matrices: random ones, and signed permutations (exact zeros in every row)."""
+    rotations = []
+    for i in range(n):
+        if i % 5 == 0:
+            rotations.append(np.eye(3)[rng.permutation(3)] * rng.choice([-1.0, 1.0], 3))
+        else:
+            q = rng.normal(size=4)
+            w, x, y, z = q / np.sqrt(np.sum(q * q))
+            rotations.append(np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                                       [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                                       [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]))
+    return rotations
+
+
+def test_the_products_in_python_floats_are_linalg_s_bit_for_bit():
+    # The camera computes a box's corners, a sphere's centre and distance, and a point's projection in Python
+    # floats, in the order of einsum's sums (the loops linalg.matmul runs): the same bits as the array products,
+    # signed zeros included, or an image would differ in a pixel at the edge of a rectangle or a cone.
+    import types
+
+    from affordance_env.camera import _CORNERS, _to_camera, project
+    from affordance_env.linalg import matmul, norm
+
+    rng = np.random.default_rng(0)
+    K = Intrinsics.from_fovy(33, 25, 57.4)
+    for R, R_camera in zip(_rotations(rng, 400), _rotations(rng, 400), strict=True):
+        aabb = np.concatenate([rng.normal(size=3) * rng.choice([0.0, 0.01]), rng.uniform(0.0, 0.2, 3)])
+        x_geom, p_camera = rng.normal(size=3) * rng.choice([0.0, 0.5]), rng.normal(size=3)
+        arrays = matmul(x_geom + np.einsum("ij,cj->ci", R, aabb[:3] + aabb[3:] * _CORNERS) - p_camera, R_camera)
+        fake = types.SimpleNamespace(model=types.SimpleNamespace(geom_aabb=aabb[None]))
+        data = types.SimpleNamespace(geom_xmat=R.reshape(1, 9), geom_xpos=x_geom[None])
+        floats = RangeCamera._box_corners_camera(fake, 0, data, p_camera.tolist(), R_camera.ravel().tolist())
+        np.testing.assert_array_equal(np.array(floats).view(np.int64), arrays.view(np.int64))
+        centre = matmul(x_geom - p_camera, R_camera)
+        c = _to_camera(*x_geom.tolist(), p_camera.tolist(), R_camera.ravel().tolist())
+        np.testing.assert_array_equal(np.array(c).view(np.int64), centre.view(np.int64))
+        assert math.sqrt(((c[0] * c[0] + c[2] * c[2]) + c[1] * c[1]) + 0.0) == norm(centre)
+        depth = -centre[2]
+        expected = [np.nan, np.nan] if depth <= 1e-9 else [K.cx + K.fx * centre[0] / depth,
+                                                            K.cy - K.fy * centre[1] / depth]
+        np.testing.assert_array_equal(project(x_geom, p_camera, R_camera, K), expected)
+        # a ray's cosine to an axis, as the cone of a sphere takes it, on the rays' x, z, y planes, in windows
+        axis = centre / norm(centre)
+        rays = K.ray_directions()
+        xzy = np.ascontiguousarray(rays.transpose(2, 0, 1)[[0, 2, 1]])
+        v0, u0 = rng.integers(0, K.height), rng.integers(0, K.width)
+        v1, u1 = rng.integers(v0 + 1, K.height + 1), rng.integers(u0 + 1, K.width + 1)
+        np.testing.assert_array_equal(np.einsum("ijk,i->jk", xzy[:, v0:v1, u0:u1], axis[[0, 2, 1]]).view(np.int64),
+                                      matmul(rays[v0:v1, u0:u1], axis).view(np.int64))
+
+
+def test_locate_gives_the_window_capture_s_object_pixels_and_points():
+    # What attention looks at: the pixels and points of the object in a window capture, bit for bit, with the
+    # arm in front of the object and the object out of view.
+    env = TapAffordanceEnv(camera_width=40, camera_height=30)
+    interactions = [({"object_type": "box"}, np.zeros(3)), ({"object_type": "sphere"}, np.array([1.0, -1.0, 0.5]))]
+    states = _images_along_interactions(env, interactions, every=53)
+    data, camera = env.physics.data, env.camera  # a 40 x 30 camera like the attention's
+    seen = 0
+    for qpos, qvel in states:
+        data.qpos[:], data.qvel[:] = qpos, qvel
+        mujoco.mj_forward(env.physics.model, data)
+        geom = env.physics.active_geom
+        image = camera.capture(data, occluded=geom, window=True)
+        mask = image.mask_of(geom)
+        pixels, points = camera.locate(data, geom)
+        np.testing.assert_array_equal(pixels, np.flatnonzero(mask))
+        np.testing.assert_array_equal(points.view(np.int64), image.p_world_points[mask].view(np.int64))
+        assert points.flags.c_contiguous  # summed row after row, as p_world_points[mask] is
+        seen += pixels.size > 0
+    assert 0 < seen
