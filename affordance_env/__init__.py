@@ -1,15 +1,15 @@
 """TapAffordance environment: an iCub in MuJoCo taps objects and sees the effect through a range camera.
 
-``import affordance_env`` registers ``TapAffordance-v1`` (one interaction of one behaviour per episode) and
-``TapAffordanceGoal-v0`` (bring the object to a goal, choosing among the four behaviours) with Gymnasium::
+``import affordance_env`` registers ``TapAffordance-v2`` (one interaction of one behaviour per episode) and
+``TapAffordanceGoal-v1`` (bring the object to a goal, choosing among the four behaviours) with Gymnasium::
 
     import gymnasium as gym
     import affordance_env  # noqa: F401
 
-    env = gym.make("TapAffordance-v1")
-    goal_env = gym.make("TapAffordanceGoal-v0")
+    env = gym.make("TapAffordance-v2")
+    goal_env = gym.make("TapAffordanceGoal-v1")
 
-or, without the import, ``gym.make("affordance_env:TapAffordance-v1")``.
+or, without the import, ``gym.make("affordance_env:TapAffordance-v2")``.
 """
 
 import importlib.metadata as _metadata

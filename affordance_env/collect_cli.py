@@ -75,17 +75,17 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
                     "--episodes; other settings on an existing dataset are refused.",
     )
     parser.add_argument("--episodes", type=positive_int, required=True,
-                        help="how many to collect: interactions of TapAffordance-v1, episodes (of several "
-                        "interactions each) of TapAffordanceGoal-v0")
+                        help="how many to collect: interactions of TapAffordance-v2, episodes (of several "
+                        "interactions each) of TapAffordanceGoal-v1")
     parser.add_argument("--out", type=Path, required=True, help="dataset directory (resumed if it exists)")
     parser.add_argument("--seed", type=non_negative_int, default=0, help="dataset seed (default 0)")
     parser.add_argument("--workers", type=positive_int, default=1,
                         help="worker processes, or workers of the local Dask cluster (default 1)")
     parser.add_argument("--env", default=ENV_ID, choices=ENV_IDS,
                         dest="env_id",
-                        help="TapAffordance-v1: one interaction per episode; TapAffordanceGoal-v0: goal episodes of "
+                        help="TapAffordance-v2: one interaction per episode; TapAffordanceGoal-v1: goal episodes of "
                              "up to 5 interactions, a reachable behaviour and parameters drawn at each, one row per "
-                             "interaction with 'step' and the goal's columns (default TapAffordance-v1)")
+                             "interaction with 'step' and the goal's columns (default TapAffordance-v2)")
     parser.add_argument("--action", default="canonical", choices=("canonical", "random"),
                         help="the paper's canonical tap, or uniform random actions from (seed, i) "
                              "(default canonical)")
@@ -126,7 +126,7 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
                      help="depth noise of the range camera (default: none)")
     env.add_argument("--position-range", default=None, choices=POSITION_RANGES,
                      help="where objects are placed: within +-3 cm of the paper's spot (canonical), or uniformly "
-                          "over the behaviour's workspace (workspace; for TapAffordanceGoal-v0, the union of the "
+                          "over the behaviour's workspace (workspace; for TapAffordanceGoal-v1, the union of the "
                           "four) (default canonical)")
     parser.set_defaults(func=run_collect)
     return parser

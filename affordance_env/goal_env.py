@@ -1,4 +1,4 @@
-"""TapAffordanceGoal-v0: bring the object to a place on the table, choosing among the four behaviours."""
+"""TapAffordanceGoal-v1: bring the object to a place on the table, choosing among the four behaviours."""
 
 from __future__ import annotations
 
@@ -59,7 +59,7 @@ class TapAffordanceGoalEnv(gym.Env):
     """The iCub moves one object to a goal on the table, one interaction per step, choosing the behaviour.
 
     ## Description
-    The world of ``TapAffordance-v1`` with both arms in one scene: the right arm with the V2.5 hand taps, taps
+    The world of ``TapAffordance-v2`` with both arms in one scene: the right arm with the V2.5 hand taps, taps
     back and pushes, the left arm with the fingered ``left_hand_mk3`` hand grasps (lifts, holds and puts down 6 cm
     to the robot's left); the arm that does not act waits rigid at its home pose, where it is in every scene of
     this env, so every behaviour sees the same robot and measures the relation features to the same (right) palm.
@@ -72,7 +72,7 @@ class TapAffordanceGoalEnv(gym.Env):
     ## Action Space
     ``Dict(behavior=Discrete(4), params=Box(-1, 1, (3,), float32))``: the behaviour, named by
     ``env.unwrapped.behaviors`` (``tap``, ``tap_back``, ``push``, ``grasp``), and its parameters, those of
-    ``TapAffordance-v1``'s action for that behaviour (0 is the canonical action). :class:`FlatActionWrapper` gives a
+    ``TapAffordance-v2``'s action for that behaviour (0 is the canonical action). :class:`FlatActionWrapper` gives a
     ``Box(-1, 1, (7,))`` action (four behaviour scores, the highest chosen, then the parameters) for libraries that
     need one. Out-of-range parameters, NaN, a wrong shape or an unknown behaviour raise ``ValueError``.
 
@@ -82,7 +82,7 @@ class TapAffordanceGoalEnv(gym.Env):
     | key | shape | meaning |
     |-----|-------|---------|
     | ``observation`` | ``Dict(features (49,), range (H, W), mask (H, W))`` | the range camera's view of the object,
-      as in TapAffordance-v1, taken with the robot at home and the gaze on the object |
+      as in TapAffordance-v2, taken with the robot at home and the gaze on the object |
     | ``achieved_goal`` | (2,) | the object's perceived position on the table, root frame [m]: the centre of its
       top as the range camera sees it (the visible points within 3 mm of its highest one; every object's top lies
       over its centre); where the object is not seen, its true position (an object that left the table: the
@@ -95,7 +95,7 @@ class TapAffordanceGoalEnv(gym.Env):
     the distance [m]. ``step`` returns the same value.
 
     ## Starting State
-    As TapAffordance-v1 (object type, size, position, yaw drawn from ``self.np_random``, or given by ``reset``'s
+    As TapAffordance-v2 (object type, size, position, yaw drawn from ``self.np_random``, or given by ``reset``'s
     ``options``: ``object_type``, ``size``, ``position``, ``yaw``, ``object_pose``). The goal is drawn
     ``GOAL_DISTANCE`` (10-25 cm) from the object's perceived position, in a uniform direction, at least
     ``GOAL_TABLE_MARGIN`` inside the table's edges and inside the union of the behaviours' workspaces
@@ -108,8 +108,8 @@ class TapAffordanceGoalEnv(gym.Env):
     ``TimeLimit``).
 
     ## Info
-    After ``reset``: ``object``, ``visible``, ``attention``, ``still`` as TapAffordance-v1, and ``distance``.
-    After ``step``: every key of TapAffordance-v1's step info for the interaction (``effect``, ``object`` with
+    After ``reset``: ``object``, ``visible``, ``attention``, ``still`` as TapAffordance-v2, and ``distance``.
+    After ``step``: every key of TapAffordance-v2's step info for the interaction (``effect``, ``object`` with
     ``initial_pose`` and ``final_pose``, ``displacement``, ``success``, ``failure``, ...), and ``behavior``,
     ``distance`` [m] to the goal and ``is_success``; ``attention`` (the head turning to the object again, as after
     ``reset``; None when the episode ended without looking) and ``observation_visible``: whether the returned
@@ -118,8 +118,8 @@ class TapAffordanceGoalEnv(gym.Env):
 
     ## Arguments
     ``object_types``, ``size_range``, ``camera_width``, ``camera_height``, ``camera_fovy``, ``roll_threshold``,
-    ``settle_timeout``, ``range_noise``: as TapAffordance-v1. ``position_range``: ``"canonical"`` (as
-    TapAffordance-v1) or ``"workspace"``: objects placed uniformly over the union of the behaviours' workspaces.
+    ``settle_timeout``, ``range_noise``: as TapAffordance-v2. ``position_range``: ``"canonical"`` (as
+    TapAffordance-v2) or ``"workspace"``: objects placed uniformly over the union of the behaviours' workspaces.
     ``goal_tolerance`` (0.03 m): the goal is reached
     within it. ``reward_type``: ``"sparse"`` or ``"dense"``. ``render_mode``: ``"rgb_array"`` or None.
 
@@ -130,6 +130,10 @@ class TapAffordanceGoalEnv(gym.Env):
     where it is, from the kinematics alone (no physics step).
 
     ## Version History
+    * v1: the motors of TapAffordance-v2 (each with its torque-speed curve) and its hand's controller (a finger's
+      target kept within its servo's reach of the finger); the put-down lowers a held object at 2 cm/s, carries it
+      along a straight line to above where it goes, and stops where fingertips under it meet the table first. Data
+      of v0 are not comparable.
     * v0: initial release.
     """
 
@@ -167,7 +171,7 @@ class TapAffordanceGoalEnv(gym.Env):
                              position_range=position_range)  # checked and normalised
         #: The data options, checked (:class:`~affordance_env.options.EnvOptions`; ``behavior`` is not used).
         self.options = options
-        #: Where objects are placed: ``"canonical"`` as in TapAffordance-v1, or ``"workspace"``: uniform over the
+        #: Where objects are placed: ``"canonical"`` as in TapAffordance-v2, or ``"workspace"``: uniform over the
         #: union of the behaviours' workspaces.
         self.position_range = options.position_range
         #: The world, with both arms: every behaviour acts in it.
@@ -335,7 +339,7 @@ class TapAffordanceGoalEnv(gym.Env):
 
 
 class FlatActionWrapper(gym.ActionWrapper):
-    """``Box(-1, 1, (7,), float32)`` actions for TapAffordanceGoal-v0: four behaviour scores (the highest one's
+    """``Box(-1, 1, (7,), float32)`` actions for TapAffordanceGoal-v1: four behaviour scores (the highest one's
     behaviour is run, ties to the first) and the three parameters."""
 
     def __init__(self, env: gym.Env) -> None:

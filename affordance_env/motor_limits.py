@@ -59,6 +59,62 @@ JOINT_TORQUE_LIMITS: dict[str, float] = {
 }
 
 
+#: Each motor's torque-speed curve at its joint: the stall torque [N m] at its driver's largest voltage, falling
+#: linearly to zero at the no-load speed [rad/s] (the back-EMF line of a DC or brushless motor), as
+#: ``(stall torque, no-load speed)``. The torque a motor gives is the smaller of its current limit
+#: (:data:`JOINT_TORQUE_LIMITS`) and this line: a plateau, then the line. Sources (``assets/README.md``, "Motor
+#: limits"): the motors' data sheets and windings in robots-configuration (``motorSpecs``) and the iCub
+#: documentation, their gear ratios and couplings (``Gearbox_M2J``, ``matrixM2J`` in ``*-mec.xml``), 40 V for the
+#: brushless drivers at their 95 % PWM cap and 12 V for the DC motors, the hand's at its controller's 89 % output
+#: cap (``maxOutput`` 3000 of 3360):
+#:
+#: - shoulder (Moog C2900576, 0.664 ohm, 0.041 V s/rad, 100:1, the shoulder's cable coupling 1.625 faster):
+#:   203 N m, 327 deg/s;
+#: - elbow (the same motor at 100:1, as the iCub 3 documentation names it): 203 N m, 531 deg/s;
+#: - torso roll and pitch (two of them through the differential): 406 N m, 531 deg/s; torso yaw (one through
+#:   181.8:1): 369 N m, 292 deg/s;
+#: - neck pitch and roll (Faulhaber 2342S012CR, 85 mN m stall, 8 570 rpm, 161.68:1, two motors through the
+#:   differential): 27 N m, 318 deg/s; neck yaw: no source names its motor, taken as the same through 100:1:
+#:   8.5 N m, 514 deg/s;
+#: - wrist prosup (2342S012CR, 100:1): 8.5 N m, 514 deg/s; wrist pitch and yaw (a Faulhaber 1331T012SR through
+#:   159:1 at 60 %, the gearhead the configuration gives): 0.94 N m, 374 deg/s;
+#: - the mk3 hand's motors (1331T012SR, 9.9 mN m, 9 900 rpm, 159:1 at 60 %, at 89 % of 12 V): 0.84 N m, 333 deg/s.
+JOINT_TORQUE_SPEED: dict[str, tuple[float, float]] = {
+    **{name: (203.0, 327.0 * _DEG) for name in ("shoulder_pitch", "shoulder_roll", "shoulder_yaw")},
+    "elbow": (203.0, 531.0 * _DEG),
+    **{name: (406.0, 531.0 * _DEG) for name in ("torso_pitch", "torso_roll")},
+    "torso_yaw": (369.0, 292.0 * _DEG),
+    **{name: (27.0, 318.0 * _DEG) for name in ("neck_pitch", "neck_roll")},
+    "neck_yaw": (8.5, 514.0 * _DEG),
+    "wrist_prosup": (8.5, 514.0 * _DEG),
+    **{name: (0.94, 374.0 * _DEG) for name in ("wrist_pitch", "wrist_yaw")},
+    **{name: (0.84, 333.0 * _DEG) for name in HAND_DRIVEN_JOINTS},
+}
+
+
+def torque_speed(joints: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+    """The stall torques [N m] and no-load speeds [rad/s] of the motors of ``joints`` (:data:`JOINT_TORQUE_SPEED`),
+    in their order."""
+    curves = np.array([_lookup(JOINT_TORQUE_SPEED, name, "torque-speed") for name in joints]).reshape(-1, 2)
+    return curves[:, 0], curves[:, 1]
+
+
+def back_emf_damping(joints: Sequence[str]) -> np.ndarray:
+    """The slope of each motor's torque-speed line at its joint [N m s/rad]: stall torque over no-load speed."""
+    stall, no_load = torque_speed(joints)
+    return stall / no_load
+
+
+def available_torque(joints: Sequence[str], velocity: np.ndarray, direction: np.ndarray | float = 1.0
+                     ) -> np.ndarray:
+    """The largest torque [N m] the motors of ``joints`` give in ``direction`` (its sign, per joint) while their
+    joints turn at ``velocity`` [rad/s]: the smaller of the current limit and the torque-speed line, which falls
+    to 0 at the no-load speed turning that way and rises above the stall torque turning against it (braking)."""
+    stall, no_load = torque_speed(joints)
+    line = stall * (1.0 - np.sign(direction) * np.asarray(velocity) / no_load)
+    return np.clip(np.minimum(torque_limits(joints), line), 0.0, None)
+
+
 def _side_free(name: str) -> str:
     return name[2:] if name.startswith(("l_", "r_")) and not name.startswith("l_hand_") else name
 

@@ -1,4 +1,4 @@
-"""The options of TapAffordance-v1 that decide its data: their defaults, and their checks.
+"""The options of TapAffordance-v2 that decide its data: their defaults, and their checks.
 
 Checking them builds nothing and imports neither MuJoCo nor Pinocchio, so a collection checks its options in its
 coordinating process, in milliseconds, before it starts the workers that build the environments.
@@ -22,7 +22,7 @@ from affordance_env.registry import check_behavior_name
 
 #: Where objects are placed: ``"canonical"``, uniform within +-3 cm of the paper's spot in front of the robot;
 #: ``"workspace"``, uniform over the workspace of the behaviour (:mod:`affordance_env.workspace`; in
-#: TapAffordanceGoal-v0, the union of the four behaviours' workspaces).
+#: TapAffordanceGoal-v1, the union of the four behaviours' workspaces).
 POSITION_RANGES = ("canonical", "workspace")
 
 
@@ -87,6 +87,6 @@ class EnvOptions:
         unknown = sorted(set(options) - set(known))
         if unknown:
             raise InvalidValueError(
-                f"unknown or unsupported env options {unknown}; the data options of TapAffordance-v1 "
+                f"unknown or unsupported env options {unknown}; the data options of TapAffordance-v2 "
                              f"(what a dataset records) are {known}.")
         return cls(**options)

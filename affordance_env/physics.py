@@ -15,11 +15,11 @@ import mujoco
 import numpy as np
 
 from affordance_env.exceptions import InvalidValueError
-from affordance_env.linalg import norm
+from affordance_env.linalg import dot, norm
 from affordance_env.objects import PRIMITIVES, ObjectGeometry
 from affordance_env.outcome import ObjectMonitor
-from affordance_env.robot_model import HAND_COUPLINGS, coupled_position, get_variant
-from affordance_env.scene import ROBOT_CONAFFINITY, ROBOT_CONTYPE
+from affordance_env.robot_model import HAND_COUPLINGS, HAND_DRIVEN_JOINTS, coupled_position, get_variant
+from affordance_env.scene import BACK_EMF, ROBOT_CONAFFINITY, ROBOT_CONTYPE
 
 #: Geom group that hides the scene's inactive object primitives from the range camera and the renderer.
 HIDDEN_GEOM_GROUP = 3
@@ -113,9 +113,23 @@ class TapPhysics:
         self.servo_kp = np.full(len(joints), np.inf)
         self.servo_kp[actuated_index] = model.actuator_gainprm[self.actuators, 0]
         self.servo_lead = np.zeros(len(joints))
-        self.servo_lead[actuated_index] = -model.actuator_biasprm[self.actuators, 2] / self.servo_kp[actuated_index]
+        # The servo's damping is its own and its motor's back-EMF's, which another actuator applies (scene.BACK_EMF).
+        emf = np.array([_id(model, obj.mjOBJ_ACTUATOR, f"{n}{BACK_EMF}") for n in actuated])
+        damping = -model.actuator_biasprm[self.actuators, 2] - model.actuator_biasprm[emf, 2]
+        self.servo_lead[actuated_index] = damping / self.servo_kp[actuated_index]
         self._qacc, self._torque = np.zeros(model.nv), np.zeros(model.nv)  # only the robot's part of qacc is set
         self._lead = np.empty(len(joints))
+        #: The hand's controller keeps each finger's servo target within this distance [rad] of where the finger
+        #: is, the error at which its servo presses with its motor's full torque: a finger held back by what it
+        #: touches presses with that torque, and moves on at its servo's pace when let go, instead of racing to a
+        #: target far beyond at its motor's no-load speed (an impedance grasp). Empty without fingers.
+        fingers = [i for i, n in enumerate(actuated) if n in HAND_DRIVEN_JOINTS]
+        self._fingers = np.array(fingers) if fingers else None
+        self._finger_qpos = np.array([model.jnt_qposadr[_id(model, obj.mjOBJ_JOINT, actuated[i])] for i in fingers],
+                                     dtype=int)
+        finger_joints = [joints.index(actuated[i]) for i in fingers]
+        self.finger_reach = self.torque_limit[finger_joints] / model.actuator_gainprm[self.actuators[fingers], 0] \
+            if fingers else np.zeros(0)
         self.ctrl_low = model.actuator_ctrlrange[self.actuators, 0].copy()
         self.ctrl_high = model.actuator_ctrlrange[self.actuators, 1].copy()
         self._ctrl = np.empty(len(self.actuators))
@@ -126,7 +140,8 @@ class TapPhysics:
         #: qacc and of M qacc and its controls as views: a control tick is then a few numpy calls on them
         #: (:meth:`set_targets_toward`). None otherwise.
         self._tick_views: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        if self._actuated is None and self._ctrl_view is not None and isinstance(self._qvel, slice):
+        if self._actuated is None and self._ctrl_view is not None and isinstance(self._qvel, slice) \
+                and self._fingers is None:
             self._tick_views = (self._qacc[self._qvel], self._torque[self._qvel], self._ctrl_view)
         self._object_p = data.qpos[self.object_qpos : self.object_qpos + 3]
         self._object_v = data.qvel[self.object_qvel : self.object_qvel + 3]
@@ -190,9 +205,15 @@ class TapPhysics:
 
     def set_joint_targets(self, q: np.ndarray) -> None:
         """Command the position servos to ``q`` [rad] (active-joint order), clipped to the joint ranges; the values
-        of coupled joints, which have no servo, are ignored."""
+        of coupled joints, which have no servo, are ignored. A finger's target is kept within
+        :attr:`finger_reach` of where the finger is (the hand's controller: see there)."""
         if self._actuated is not None:
             q = np.asarray(q)[self._actuated]
+        if self._fingers is not None:
+            q = q.copy()
+            where = self.data.qpos[self._finger_qpos]
+            q[self._fingers] = np.minimum(np.maximum(q[self._fingers], where - self.finger_reach),
+                                          where + self.finger_reach)
         # np.minimum/np.maximum into the control vector: np.clip's wrapper costs more than the clipping
         if self._ctrl_view is not None:
             np.minimum(np.maximum(q, self.ctrl_low, out=self._ctrl), self.ctrl_high, out=self._ctrl_view)
@@ -265,6 +286,18 @@ class TapPhysics:
             if (g1 == table and g2 in hand) or (g2 == table and g1 in hand):
                 return True
         return False
+
+    def object_bottom(self) -> float:
+        """Height of the object's lowest point [m], from its primitive's size and its orientation now."""
+        g, geometry = self.active_geom, self.geometry
+        R = self.data.geom_xmat[g].reshape(3, 3)
+        size, z = geometry.geom_size, float(self.data.geom_xpos[g, 2])
+        if geometry.primitive == "sphere":
+            return z - float(size[0])
+        if geometry.primitive == "box":
+            return z - dot(np.abs(R[2]), size)
+        axis_z = abs(float(R[2, 2]))  # a cylinder: its axis's vertical part, and its rim's
+        return z - axis_z * float(size[1]) - float(size[0]) * float(np.sqrt(max(0.0, 1.0 - axis_z * axis_z)))
 
     def object_touches_table(self) -> bool:
         """Whether any contact joins the object and the table top."""

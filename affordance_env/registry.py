@@ -15,9 +15,9 @@ from types import MappingProxyType
 from affordance_env.exceptions import InvalidValueError
 
 #: One interaction per episode (Gymnasium's registration: :mod:`affordance_env.registration`).
-ENV_ID = "TapAffordance-v1"
+ENV_ID = "TapAffordance-v2"
 #: Goal episodes of several interactions on one object, with both arms.
-GOAL_ENV_ID = "TapAffordanceGoal-v0"
+GOAL_ENV_ID = "TapAffordanceGoal-v1"
 #: The environments, as datasets record them.
 ENV_IDS: tuple[str, ...] = (ENV_ID, GOAL_ENV_ID)
 

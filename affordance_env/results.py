@@ -104,7 +104,7 @@ class Observation:
         return self.initial.visible
 
     def info(self) -> dict[str, Any]:
-        """The ``info`` of TapAffordance-v1's ``reset``: ``object``, ``attention``, ``visible``, ``still``."""
+        """The ``info`` of TapAffordance-v2's ``reset``: ``object``, ``attention``, ``visible``, ``still``."""
         attention = self.attention
         return {
             "object": {"type": self.object_type, "size": self.size, "pose": self.initial.pose.copy()},
@@ -156,7 +156,7 @@ class InteractionResult:
         contact: The hand touched the object.
         hand_speed: Palm speed at the first touch [m/s].
         ik: How well the IK reached every pose.
-        failure: None, or why the interaction is not a valid sample (see TapAffordance-v1's Info).
+        failure: None, or why the interaction is not a valid sample (see TapAffordance-v2's Info).
         facts: The behaviour's own facts (``stroke_speed``; for the grasp also ``grasp``).
     """
 
@@ -193,7 +193,7 @@ class InteractionResult:
         return self.final is not None and self.final.visible
 
     def info(self) -> dict[str, Any]:
-        """The ``info`` of TapAffordance-v1's ``step`` (fresh arrays: a restored state steps again)."""
+        """The ``info`` of TapAffordance-v2's ``step`` (fresh arrays: a restored state steps again)."""
         return {
             "object": {"type": self.object_type, "size": self.size,
                        "initial_pose": self.initial.pose.copy(), "final_pose": self.final_pose.copy()},

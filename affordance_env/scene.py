@@ -17,7 +17,7 @@ from affordance_env.assets_path import assets_dir
 from affordance_env.exceptions import InvalidValueError
 from affordance_env.linalg import matmul
 from affordance_env.model_cache import cached_model
-from affordance_env.motor_limits import torque_limits
+from affordance_env.motor_limits import back_emf_damping, torque_limits, torque_speed
 from affordance_env.robot_model import (
     CAMERA_VISIBLE_LINKS,  # noqa: F401 (the tap variant's, named here beside the geom groups as before)
     HAND_COUPLINGS,
@@ -93,19 +93,24 @@ COLLISION_GEOM_GROUP = 3
 
 #: Position-servo stiffness per joint group [N m / rad].
 SERVO_KP: dict[str, float] = {"torso": 300.0, "neck": 50.0, "arm": 60.0, "wrist": 10.0}
+#: Name suffix of each motor's back-EMF actuator (see build_spec, step 6).
+BACK_EMF = "_back_emf"
 #: Joint armature added for a stable servo [kg m^2].
 ARMATURE = 0.02
 #: Joint damping [N m s / rad]: a small viscous friction. The servos are critically damped by their actuators;
 #: 1 N m s/rad on top overdamped the wrist (0.6 s to settle after each move).
 DAMPING = 0.1
 #: Finger joints of the mk3 hand (grasp variant). Position-servo stiffness [N m / rad]: a finger presses with at
-#: most its motor's torque (0.3 N m, ``motor_limits``), reached at a tracking error of 0.3 rad. Damping
+#: most its motor's torque (0.3 N m, ``motor_limits``), reached at a tracking error of 0.15 rad, the most the hand's
+#: controller lets a finger's target lead it (``TapPhysics.finger_reach``): a finger that loses what it pressed on
+#: then closes that gap at its servo's pace, at most 0.15 x sqrt(kp / armature) / e = 2.5 rad/s (141 deg/s,
+#: critically damped), within its 180 deg/s limit (at kp = 1, 0.3 rad would give 200 deg/s). Damping
 #: [N m s / rad] and armature [kg m^2]: the URDF's damping of 1 N m s/rad is a placeholder that, against kp = 1,
 #: makes the fingers lag 30 degrees behind a 1 s closing ramp (time constant damping / kp = 1 s); 0.03 is a small
-#: gear friction (0.03 s) and the fingers track to a fraction of a degree. The armature, the reflected inertia of
-#: the finger's motor and gearbox, keeps the light links (10-17 g, inertias of 1e-6 kg m^2) well conditioned: 1e-3
-#: kg m^2 gives a servo period of 2 pi sqrt(1e-3 / 1) = 0.2 s, forty timesteps of the grasp scene.
-HAND_KP, HAND_DAMPING, HAND_ARMATURE = 1.0, 0.03, 1e-3
+#: gear friction and the fingers track to a fraction of a degree. The armature, the reflected inertia of the
+#: finger's motor and gearbox, keeps the light links (10-17 g, inertias of 1e-6 kg m^2) well conditioned: 1e-3
+#: kg m^2 gives a servo period of 2 pi sqrt(1e-3 / 2) = 0.14 s, 28 timesteps of the grasp scene.
+HAND_KP, HAND_DAMPING, HAND_ARMATURE = 2.0, 0.03, 1e-3
 #: Timestep of the grasp variant [s]. The tap scene's 2 ms resolves the impact of a tap; a grasp has no impact,
 #: and its fastest dynamics are resolved at 5 ms with at least 2 steps per time constant (MuJoCo's stability
 #: bound): the contacts' (10 ms, CONTACT_SOLREF), the finger coupling's (10 ms, below), the finger servos'
@@ -400,19 +405,35 @@ def build_spec(variant: str = "tap") -> mujoco.MjSpec:
     #    step, and the contacts between hand and object are read from the contact list when needed.)
     #    Each motor's torque is limited (motor_limits), gravity compensation included: it is routed through the
     #    actuators, as the iCub's controllers compensate gravity with the same motors.
+    #    Each motor is a DC motor: its current limit caps the joint's torque (actuatorfrcrange, applied to all the
+    #    joint's actuators together), and its driver's largest voltage the torque along the back-EMF line
+    #    (motor_limits.JOINT_TORQUE_SPEED): the servo's command is capped at the stall torque (forcerange) and a
+    #    second actuator, the back-EMF, subtracts the line's slope times the speed. The servo's own damping is
+    #    lowered by that slope (compile_scene), so that below both limits the servo is what it was.
     torque_limit = dict(zip(variant_.actuated_joints, torque_limits(variant_.actuated_joints), strict=True))
+    stall, _ = torque_speed(variant_.actuated_joints)
+    emf = back_emf_damping(variant_.actuated_joints)
     for joint in spec.joints:
         if joint.name in variant_.active_joints:
             joint.actgravcomp = True
             joint.actfrclimited = False  # the URDF's placeholder effort (50 000); a motor's limit below
-    for name in variant_.actuated_joints:
+    for name, stall_torque in zip(variant_.actuated_joints, stall, strict=True):
         joint = spec.joint(name)
         act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         act.set_to_position(kp=_servo_kp(name), dampratio=1.0)
         act.ctrlrange = joint.range
         act.ctrllimited = True
+        act.forcerange = [-stall_torque, stall_torque]
+        act.forcelimited = True
         joint.actfrcrange = [-torque_limit[name], torque_limit[name]]
         joint.actfrclimited = True
+    for name, slope in zip(variant_.actuated_joints, emf, strict=True):  # after every servo: their ids stay
+        act = spec.add_actuator(name=f"{name}{BACK_EMF}", target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        act.gaintype = mujoco.mjtGain.mjGAIN_FIXED
+        act.gainprm[0] = 0.0
+        act.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+        act.biasprm[:3] = [0.0, 0.0, -float(slope)]
+        act.ctrllimited = False
     # 6b. The fingered hand's coupling: each distal joint follows its proximal joint; the grasp's timestep.
     if variant_.fingered:
         spec.option.timestep = GRASP_TIMESTEP
@@ -429,16 +450,26 @@ def build_spec(variant: str = "tap") -> mujoco.MjSpec:
     qpos = model.qpos0.copy()
     for name, value in home.items():
         qpos[model.jnt_qposadr[model.joint(name).id]] = value
-    ctrl = np.array([home[name] for name in variant_.actuated_joints])
+    ctrl = np.array([home[name] for name in variant_.actuated_joints] + [0.0] * len(variant_.actuated_joints))
     spec.add_key(name="home", qpos=qpos.tolist(), ctrl=ctrl.tolist())
     return spec
+
+
+def compile_scene(variant: str = "tap") -> mujoco.MjModel:
+    """Compile :func:`build_spec`, then lower each servo's damping by its motor's back-EMF slope, which the
+    back-EMF actuator applies (MuJoCo's ``dampratio`` gives the servo's damping only when it compiles)."""
+    model = build_spec(variant).compile()
+    actuated = get_variant(variant).actuated_joints
+    servos = [model.actuator(name).id for name in actuated]
+    model.actuator_biasprm[servos, 2] += back_emf_damping(actuated)  # biasprm[2] is minus the damping
+    return model
 
 
 def build_model(variant: str = "tap") -> mujoco.MjModel:
     """Compile :func:`build_spec` (about half a second: the robot meshes are processed), or load the same model
     from the cache of compiled models (:mod:`affordance_env.model_cache`) in a tenth of that."""
     urdfs = (icub_urdf(), hand_urdf()) if get_variant(variant).mk3_hand else (icub_urdf(),)
-    return cached_model(variant, urdfs, lambda: build_spec(variant).compile())
+    return cached_model(variant, urdfs, lambda: compile_scene(variant))
 
 
 @functools.cache

@@ -1,4 +1,4 @@
-"""TapAffordance-v1: one interaction of Akgun et al. (2009) per step."""
+"""TapAffordance-v2: one interaction of Akgun et al. (2009) per step."""
 
 from __future__ import annotations
 
@@ -49,7 +49,7 @@ def default_reward(info: dict[str, Any]) -> float:
 
 
 def observation(snapshot: Snapshot) -> dict[str, np.ndarray]:
-    """TapAffordance-v1's observation of a snapshot (fresh arrays)."""
+    """TapAffordance-v2's observation of a snapshot (fresh arrays)."""
     return {"range": snapshot.ranges.copy(), "mask": snapshot.mask.copy(),
             "features": snapshot.features.values.astype(np.float32), "joints": snapshot.joints.copy()}
 
@@ -79,13 +79,17 @@ class TapAffordanceEnv(gym.Env):
     proximal one as on the real hand; the right arm then hangs still), done as a careful robot does it: palm down
     over the object, the open hand descends slowly (4 cm/s) towards just above the object's top and stops there or
     at the first touch; the fingers and the opposed thumb close with a light touch until each has stalled on the
-    object, then grip with their motors' full torque; the hand lifts 8 cm and holds still for 1 s. A held object
-    is carried 6 cm to the robot's left and lowered slowly until it meets the table; once it rests there the hand
-    opens, rises straight up and goes home. An object the hand does not hold is left where it is: the hand opens
-    above it. The final snapshot sees the object where it was put down (a held object moved about 6 cm) or where
-    the attempt left it (a failed grasp moves it a median 1-2 cm). Only the fingers' motors move the object (no
-    welds, no applied forces). Whether the object fits the open hand, between the thumb and the fingertips,
-    decides the outcome (``info["success"]``): nearly all small objects are held, few large ones
+    object, then grip with their motors' full torque; the hand lifts 8 cm and holds still for 1 s. There the
+    paper's grasp ends, and so the final snapshot is taken at the end of the hold: "An environmental snapshot is
+    taken... Afterwards a behavior is executed. When the execution ends, another snapshot is taken" (Akgun et al.
+    2009). It sees a held object lifted in the hand, the fingers in front of part of it, and an object the hand did
+    not hold where the attempt left it (a median 1-2 cm from where it stood); ``object.final_pose``,
+    ``displacement`` and ``tilt`` are measured then too. The world then goes on as a robot's would: a held object is
+    carried 6 cm to the robot's left and lowered slowly until it meets the table; once it rests there the hand
+    opens, rises straight up and goes home; an object the hand does not hold is left where it is, the hand opening
+    above it (``outcome`` and ``outcome_time`` say how the object came to rest afterwards). Only the fingers'
+    motors move the object (no welds, no applied forces). Whether the object fits the open hand, between the thumb
+    and the fingertips, decides the outcome (``info["success"]``): nearly all small objects are held, few large ones
     (``python benchmarks/physics_audit.py --behavior grasp``).
     A tap's stroke, from its start to the end of its follow-through, is simulated at 2 ms, which resolves the
     impact; the rest of a tap interaction (the head turning, the reach, the way home, the object rolling to rest)
@@ -217,9 +221,17 @@ class TapAffordanceEnv(gym.Env):
       (``"human"`` too) is refused with a ValueError naming these |
     | ``two_arms`` | False | the scene with both arms (:data:`affordance_env.robot_model.VARIANTS` ``"two_arms"``):
       the other arm waits rigid at its home pose, and the relation features are measured to the right palm for every
-      behaviour (the scene of ``TapAffordanceGoal-v0``) |
+      behaviour (the scene of ``TapAffordanceGoal-v1``) |
 
     ## Version History
+    * v2: the grasp's final snapshot is taken where the paper's grasp ends, at the end of its hold with the object
+      held (Akgun et al. 2009: "When the execution ends, another snapshot is taken"), not after the put-down that
+      only a world that goes on needs (``TapAffordanceGoal-v1`` still puts the object down before its snapshot).
+      Every motor has its torque-speed curve (its torque falls along its back-EMF line to zero at its no-load
+      speed, ``affordance_env.motor_limits.JOINT_TORQUE_SPEED``; the wrist's pitch and yaw motors give 0.94 N m,
+      not 2), and the hand's controller keeps each finger's target within its servo's reach of the finger, so a
+      finger that loses the object never outruns its limit; the put-down is slower (2 cm/s). Data of v1 are not
+      comparable.
     * v1: the iCub's motor limits (joint speeds planned within 100 deg/s for the arm, torso and neck and 180 deg/s
       for the fingers, motor torques limited, gravity compensation included), stiff contacts (10 ms, impedance
       0.995), the palm's restitution 0.3, every move one minimum-jerk or line trajectory with feedforward, the
@@ -269,7 +281,8 @@ class TapAffordanceEnv(gym.Env):
         self.world = World((options.behavior,), two_arms=two_arms, camera_width=options.camera_width,
                            camera_height=options.camera_height, camera_fovy=options.camera_fovy,
                            range_noise=options.range_noise, roll_threshold=options.roll_threshold,
-                           settle_timeout=options.settle_timeout, typical_size=float(np.mean(options.size_range)))
+                           settle_timeout=options.settle_timeout, typical_size=float(np.mean(options.size_range)),
+                           final_snapshot="paper")
         self._render_size = (render_width, render_height)
         #: With a render mode: pictures taken every 1/render_fps s of simulated time since the last ``reset``
         #: (the whole interaction: placing, attention, the behaviour, the wait for the outcome).

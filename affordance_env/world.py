@@ -39,6 +39,7 @@ from affordance_env.placement import PLACEMENT_CENTRE, Placement, Table
 from affordance_env.range_noise import add_kinect_noise
 from affordance_env.registry import ARMS, BEHAVIOR_ARMS, check_behavior_name
 from affordance_env.results import IKReport, InitialSnapshot, InteractionResult, Observation, Snapshot, frozen_array
+from affordance_env.robot_model import HAND_JOINTS
 from affordance_env.scene import build_model
 
 #: Depth of the object's top, whose centre is where the object is seen on the table [m].
@@ -46,6 +47,11 @@ TOP_DEPTH = 0.003
 #: The placed object is at rest for the initial snapshot when slower than these [m/s], [rad/s]: ten and thirty
 #: times stricter than the outcome's rest (:func:`affordance_env.motion.object_at_rest`).
 REST_SPEED, REST_ANGULAR_SPEED = 1e-3, 1e-2
+#: When an interaction's final snapshot is taken: ``"paper"``, where the behaviour ends as the paper measures it
+#: (Akgun et al. 2009: "When the execution ends, another snapshot is taken"): the grasp at the end of its hold,
+#: the object held, a stroke once the struck object has come to rest; ``"rest"``, once the whole interaction is
+#: over and the object rests (a held object put down), as a world that goes on needs it.
+FINAL_SNAPSHOTS = ("paper", "rest")
 #: The robot variant of each arm's model: alone, or in the scene with both arms.
 ONE_ARM_VARIANT = {"right": "tap", "left": "grasp"}
 TWO_ARMS_VARIANT = {"right": "two_arms", "left": "two_arms_left"}
@@ -58,7 +64,7 @@ def _object_still(physics: TapPhysics) -> bool:
 
 def failure_reason(fault: str | None, initial: InitialSnapshot, outcome: ReachOutcome, home_still: bool,
                    touched_on_way_home: bool, behavior: Behavior) -> str | None:
-    """Why an interaction cannot be used, or None (TapAffordance-v1's ``info["failure"]``). ``outcome``: what the
+    """Why an interaction cannot be used, or None (TapAffordance-v2's ``info["failure"]``). ``outcome``: what the
     behaviour reported; ``home_still``: the robot was still for the final snapshot; ``touched_on_way_home``: the
     arm touched the object again after it had been clear of it."""
     if fault is not None:
@@ -96,6 +102,17 @@ class WorldState:
     q_home: np.ndarray
 
 
+@dataclass(frozen=True)
+class _Final:
+    """The final snapshot (None: a fault), the object's pose then, whether the robot was still, and whether the
+    object had left the table."""
+
+    snapshot: Snapshot | None
+    pose: np.ndarray
+    still: bool
+    left_table: bool
+
+
 class _Arm:
     """One arm's model of the world, and what acts in it: physics, kinematics, motion, cameras, the approach
     posture of each of its behaviours."""
@@ -110,6 +127,9 @@ class _Arm:
                                   support="table_top")
         self.attention_camera = RangeCamera(self.physics.model, width=40, height=30, fovy_deg=camera_fovy,
                                             support="table_top")
+        #: The joints that carry the camera and the hand (all but the fingers), by index of the active joints.
+        self.body_joints = np.array([i for i, name in enumerate(self.kinematics.joint_names)
+                                     if name not in HAND_JOINTS])
         self.postures: dict[str, np.ndarray | None] = {}
         self.renderer: Any = None
 
@@ -128,12 +148,17 @@ class World:
         roll_threshold: Rolling distance above which an interaction ``rolled`` [m].
         settle_timeout: Longest simulated wait for the outcome after the first touch [s].
         typical_size: Object size [m] for which the approach postures are solved (the mean of the size range).
+        final_snapshot: When the final snapshot is taken, one of :data:`FINAL_SNAPSHOTS`.
     """
 
     def __init__(self, behaviors: Sequence[str], *, two_arms: bool = False, camera_width: int = 160,
                  camera_height: int = 120, camera_fovy: float = 57.4, range_noise: str | None = None,
-                 roll_threshold: float = 0.03, settle_timeout: float = 3.0, typical_size: float = 0.07) -> None:
+                 roll_threshold: float = 0.03, settle_timeout: float = 3.0, typical_size: float = 0.07,
+                 final_snapshot: str = "rest") -> None:
         names = [check_behavior_name(name) for name in behaviors]
+        if final_snapshot not in FINAL_SNAPSHOTS:
+            raise InvalidValueError(f"final_snapshot must be one of {FINAL_SNAPSHOTS}, got {final_snapshot!r}.")
+        self.final_snapshot = final_snapshot
         if not names:
             raise InvalidValueError("a world needs at least one behaviour, got none.")
         arms = [arm for arm in ARMS if any(BEHAVIOR_ARMS[name] == arm for name in names)]
@@ -296,27 +321,40 @@ class World:
         b = get_behavior(behavior)
         physics, motion = arm.physics, arm.motion
         plan = b.plan(initial.geometry, initial.pose[:3], initial.yaw, physics.table_top, action)
+        ended: list[_Final] = []  # the final snapshot, if taken where the behaviour ends as the paper measures it
+
+        def at_end() -> None:
+            # The head and the arm must be still for the snapshot; the fingers squeezing what they hold may creep
+            # (an object slipping slowly in the grip is the grasp's outcome, not a blur).
+            speeds = np.abs(physics.joint_velocities()[arm.body_joints])
+            still = float(np.max(speeds)) <= HOLD_SPEED_TOLERANCE
+            ended.append(_Final(None if physics.unstable() else self.look(rng), physics.object_pose(), still,
+                                monitor.left_table))
+
         monitor = physics.start_monitor()  # from now on, whatever the arm does
         try:
-            done = b.execute(motion, plan, arm.postures[behavior])
+            done = b.execute(motion, plan, arm.postures[behavior], at_end if self.final_snapshot == "paper" else None)
             with motion.stepping(motion.free_timestep):
                 home = motion.go_home(self._q_home, via=b.via_home(done))
                 since = b.awaited_since(done, float(physics.data.time))
                 outcome, outcome_time = self._wait_outcome(monitor, since)
         finally:
             physics.monitor = None
-        return self._result(b, action, initial, done, home.still, home.touched, monitor, outcome, outcome_time, rng)
+        if not ended:  # the final snapshot where the object has come to rest
+            ended.append(_Final(None if physics.unstable() else self.look(rng), physics.object_pose(), home.still,
+                                monitor.left_table))
+        return self._result(b, action, initial, done, ended[0], home.touched, monitor, outcome, outcome_time)
 
     def _result(self, b: Behavior, action: np.ndarray, initial: InitialSnapshot, done: ReachOutcome,
-                home_still: bool, touched: bool, monitor: ObjectMonitor, outcome: str, outcome_time: float,
-                rng: np.random.Generator) -> InteractionResult:
+                end: _Final, touched: bool, monitor: ObjectMonitor, outcome: str,
+                outcome_time: float) -> InteractionResult:
         physics = self._acting.physics
         fault = physics.unstable()
-        final = None if fault else self.look(rng)  # after a fault the state is not to be trusted
-        final_pose = np.full(7, np.nan) if fault else physics.object_pose()
-        failure = failure_reason(fault, initial, done, home_still, touched, b)
+        final = None if fault else end.snapshot  # after a fault the state is not to be trusted
+        final_pose = np.full(7, np.nan) if fault else end.pose
+        failure = failure_reason(fault, initial, done, end.still, touched, b)
         # Travel on the table: to where the object rests, or to where it left the table (not where it fell).
-        p_end = monitor.exit_position if monitor.left_table else final_pose
+        p_end = monitor.exit_position if end.left_table else final_pose
         displacement = 0.0 if fault else norm(p_end[:2] - initial.pose[:2])
         labels = None if fault else outcome_labels(monitor, initial.pose[3:], final_pose[3:], self.roll_threshold)
         effect = (np.zeros(len(FEATURE_NAMES), np.float32) if final is None

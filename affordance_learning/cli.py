@@ -66,7 +66,7 @@ def _demo(args: argparse.Namespace) -> int:
     if args.object:
         kwargs["object_types"] = (args.object,)
     env = gym.make(ENV_ID, **kwargs)
-    print(f"TapAffordance-v1, behavior={args.behavior!r}: {args.episodes} interaction(s) from seed {args.seed}")
+    print(f"TapAffordance-v2, behavior={args.behavior!r}: {args.episodes} interaction(s) from seed {args.seed}")
     start = time.perf_counter()
     for i in range(args.episodes):
         _, info0 = env.reset(seed=args.seed + i)

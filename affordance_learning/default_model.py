@@ -253,7 +253,7 @@ def predict_effect(
 
     Args:
         features: One (49,) or many (n, 49) feature vectors of objects before the interaction, in the order
-            of ``affordance_env.features.FEATURE_NAMES`` (``obs["features"]`` of ``TapAffordance-v1``), or a
+            of ``affordance_env.features.FEATURE_NAMES`` (``obs["features"]`` of ``TapAffordance-v2``), or a
             DataFrame with those columns (in any order; other columns are ignored); finite.
         behavior: Whose default model predicts: ``"tap"`` (shipped), ``"grasp"``, ``"tap_back"`` or
             ``"push"`` (built by ``affordance train-default --behavior NAME``).

@@ -1,6 +1,6 @@
 """``affordance plan``: learn what the behaviours do, then use it to reach goals, against baselines in one run.
 
-1. Collect goal episodes of TapAffordanceGoal-v0 with random actions, objects spread over the workspaces
+1. Collect goal episodes of TapAffordanceGoal-v1 with random actions, objects spread over the workspaces
    (:func:`affordance_env.dataset.collect`, resumable), and keep at most ``max_per_behavior`` interactions of each
    behaviour for training.
 2. Fit an :class:`~affordance_learning.effect_model.ActionEffectModel` per behaviour, and the paper's model
@@ -22,7 +22,7 @@
 
 4. Leaving each shape out in turn: the effect models refitted without that object type, judged on the goals of
    step 3 whose object is of that type, from the same start (the oracle's verdict says which are feasible).
-5. Multi-step: episodes of TapAffordanceGoal-v0 (targets 10-25 cm away, 3 cm tolerance, at most 5
+5. Multi-step: episodes of TapAffordanceGoal-v1 (targets 10-25 cm away, 3 cm tolerance, at most 5
    interactions), re-planning after each interaction with a search over two interactions
    (:meth:`~affordance_learning.planner.Planner.toward`, the behaviours' workspaces saying where a second one can
    act), against random actions and a direction heuristic. Where no candidate is feasible the planner stops

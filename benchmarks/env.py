@@ -1,4 +1,4 @@
-"""Interactions per second of TapAffordance-v1 on one core, and where the time goes.
+"""Interactions per second of TapAffordance-v2 on one core, and where the time goes.
 
     python benchmarks/env.py [--episodes 200] [--repeats 3] [--width W] [--height H] [--behavior tap [grasp ...]]
 

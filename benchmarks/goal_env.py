@@ -1,9 +1,9 @@
-"""Cost of an interaction in TapAffordanceGoal-v0 against the same behaviour in TapAffordance-v1, same run.
+"""Cost of an interaction in TapAffordanceGoal-v1 against the same behaviour in TapAffordance-v2, same run.
 
     python benchmarks/goal_env.py [--episodes 40] [--repeats 3]
 
 For each behaviour, the same objects (type, size, position drawn once) with the canonical action: in
-TapAffordance-v1 an interaction is ``reset`` (place, settle, attend, snapshot) and ``step``; in the goal env it is
+TapAffordance-v2 an interaction is ``reset`` (place, settle, attend, snapshot) and ``step``; in the goal env it is
 ``step`` (the interaction, then the head turning to the object where it rests and the next snapshot), each from an
 object placed by ``reset`` outside the timing. The two take turns object by object so that they share the
 machine's load; the best of ``--repeats`` rounds is reported, with the ratio goal env / v1.

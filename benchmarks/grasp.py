@@ -2,13 +2,15 @@
 
     python benchmarks/grasp.py [--episodes 90] [--size-range LOW HIGH] [--timestep DT]
 
-Runs ``TapAffordance-v1`` with ``behavior="grasp"`` for seeds 0 .. episodes-1 (the env draws type, size, position
+Runs ``TapAffordance-v2`` with ``behavior="grasp"`` for seeds 0 .. episodes-1 (the env draws type, size, position
 and yaw; the action is the canonical 0) and prints: the share of valid interactions (``info["failure"] is
 None``), the success rate (``info["success"]``) over all valid grasps and per third of the sizes drawn, the
 largest size held and the smallest dropped per object type, the object's rise at the end of the hold for
 successes and failures (how clearly the lift threshold separates them), the outcome of every seed in one line
-(X held, . not held, F failed), and the wall time and physics steps per interaction. ``--timestep`` simulates the
-grasp at another timestep than the grasp variant's (to compare outcomes seed by seed).
+(X held, . not held, F failed), how much of a held object the hand hides from the final snapshot (taken at the
+end of the hold: the share of the object's pixels that a camera seeing through the robot has and the range camera
+does not), and the wall time and physics steps per interaction. ``--timestep`` simulates the grasp at another
+timestep than the grasp variant's (to compare outcomes seed by seed).
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from collections import Counter
 import numpy as np
 
 import affordance_env.scene
+from affordance_env.camera import RangeCamera
 from affordance_env.objects import OBJECT_TYPES
 from affordance_env.tap_env import TapAffordanceEnv
 
@@ -46,10 +49,26 @@ def main() -> None:
         step(n)
 
     env.physics.step = counted_step
+    # At the final snapshot, the object's pixels as a camera that sees through the robot (geom group 0 only: the
+    # table and the object) has them: what the hand hides.
+    world, camera = env.world, env.camera
+    through = RangeCamera(env.physics.model, width=camera.intrinsics.width, height=camera.intrinsics.height,
+                          fovy_deg=env.options.camera_fovy, geom_groups=(0,), support="table_top")
+    look, unhidden = world.look, []
+
+    def look_through(rng):
+        unhidden.append(int(through.capture(world.physics.data).mask_of(world.physics.active_geom).sum()))
+        return look(rng)
+
+    world.look = look_through
+    hidden = []
     start = time.perf_counter()
     for seed in range(args.episodes):
         env.reset(seed=seed)
         info = env.step(np.zeros(3))[4]
+        result = env.last_result
+        if info["success"] and result.final is not None and unhidden[-1] > 0:
+            hidden.append(1.0 - result.final.features.n_pixels / unhidden[-1])
         line.append("F" if info["failure"] is not None else "X" if info["success"] else ".")
         if info["failure"] is not None:
             failures[info["failure"].split(":")[0]] += 1
@@ -82,6 +101,9 @@ def main() -> None:
         print(f"  rise at the end of the hold: held {100 * rise[success].min():.1f}-{100 * rise[success].max():.1f}"
               f" cm, not held {100 * rise[~success].min():.1f}-{100 * rise[~success].max():.1f} cm")
     print(f"  seeds 0-{n - 1}: {''.join(line)}")
+    if hidden:
+        print(f"  share of a held object's pixels the hand hides at the final snapshot: median "
+              f"{100 * np.median(hidden):.0f} %, largest {100 * max(hidden):.0f} % ({len(hidden)} held)")
     print(f"  {1e3 * wall / n:.0f} ms wall per interaction (one core), {steps / n:.0f} physics steps")
 
 

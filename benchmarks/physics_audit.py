@@ -1,12 +1,15 @@
 """How physical the interactions are, measured from MuJoCo's state at every physics step.
 
     python benchmarks/physics_audit.py [--episodes 40] [--behavior tap tap_back push grasp] [--seed 1000]
+                                       [--action canonical|random]
 
-Canonical interactions (action 0) from seeds ``--seed``, ``--seed + 1``, ...; ``mujoco.mj_step`` is wrapped before
+Canonical interactions (action 0; ``--action random``: uniform in [-1, 1], drawn from the seed) from seeds
+``--seed``, ``--seed + 1``, ...; ``mujoco.mj_step`` is wrapped before
 the project is imported, so every step the environment takes is seen, whatever calls it. Per behaviour it prints:
 
 - joint speed peaks [deg/s] of the arm and torso, of the neck and of the finger motors, against their limits
-  (``affordance_env.motor_limits``), and the largest motor torque as a share of its limit;
+  (``affordance_env.motor_limits``), and the largest motor torque as a share of its limit and how many
+  interactions saturate a motor (99.9 % of its limit or more);
 - penetration [mm] of the robot (hand, fingers, wrist, forearm) into the object and of the object into the
   table: median and largest over interactions of each interaction's deepest;
 - interactions whose arm touches the object when the final snapshot is taken, and failures;
@@ -49,6 +52,13 @@ class Trace:
         }
         self.limit = u.motion.velocity_limit
         self.torque_limit = self.physics.torque_limit
+        self.motors = [i for i, n in enumerate(joints) if n in self.physics.variant.actuated_joints]
+        try:  # releases before the motors' torque-speed curves had the current limit alone
+            from affordance_env.motor_limits import torque_speed
+
+            self._torque_speed = torque_speed([joints[i] for i in self.motors])
+        except ImportError:
+            self._torque_speed = None
         self.speed_peak = {g: 0.0 for g in self.groups}
         self.speed_ratio = {g: 0.0 for g in self.groups}
         self.torque_ratio = 0.0
@@ -80,10 +90,18 @@ class Trace:
                     if g == "fingers" or (g == "arm" and not self.groups["fingers"]):
                         self.speed_phase = phase
                 self.speed_ratio[g] = max(self.speed_ratio[g], float((qd[idx] / self.limit[idx]).max()))
-        tau = np.abs(d.qfrc_actuator[self.dofs])
-        finite = np.isfinite(self.torque_limit)
-        if finite.any():
-            self.torque_ratio = max(self.torque_ratio, float((tau[finite] / self.torque_limit[finite]).max()))
+        # Against what the motor gives at its speed: the smaller of its current limit and its torque-speed line
+        # (which rises above the stall torque when the motor brakes, turning against its torque).
+        signed = d.qfrc_actuator[self.dofs][self.motors]
+        tau = np.abs(signed)
+        if self._torque_speed is None:
+            limit = self.torque_limit[self.motors]
+        else:
+            stall, no_load = self._torque_speed
+            along = np.sign(signed) * d.qvel[self.dofs][self.motors]  # > 0: turning the way it pushes
+            limit = np.minimum(self.torque_limit[self.motors], stall * (1.0 - along / no_load))
+        if len(tau):
+            self.torque_ratio = max(self.torque_ratio, float((tau / np.maximum(limit, 1e-9)).max()))
         obj, table = ph.active_geom, ph.table_geom
         grip = 0.0
         hand_touch = table_touch = False
@@ -187,7 +205,7 @@ def _label_phases(motion) -> None:
     motion.grasp, motion.go_home = grasp_named, home_named
 
 
-def audit(behavior: str, episodes: int, seed0: int) -> dict:
+def audit(behavior: str, episodes: int, seed0: int, action: str = "canonical") -> dict:
     env = gym.make(ENV_ID, behavior=behavior)
     u = env.unwrapped
     _label_phases(u.motion)
@@ -199,7 +217,8 @@ def audit(behavior: str, episodes: int, seed0: int) -> dict:
         env.reset(seed=seed)
         trace = Trace(env)
         _TRACE["t"] = trace
-        _, _, _, _, info = env.step(np.zeros(3))
+        params = np.zeros(3) if action == "canonical" else np.random.default_rng(seed).uniform(-1.0, 1.0, 3)
+        _, _, _, _, info = env.step(params)
         _TRACE["t"] = None
         ph = u.physics
         end_touch = ph.hand_touches_object()
@@ -208,13 +227,13 @@ def audit(behavior: str, episodes: int, seed0: int) -> dict:
                          size=float(info["object"]["size"]), success=bool(info["success"]),
                          failure=info["failure"], disp=float(info["displacement"])))
     env.close()
-    return {"behavior": behavior, "rows": rows, "dt": u.physics.model.opt.timestep}
+    return {"behavior": behavior, "rows": rows, "dt": u.physics.model.opt.timestep, "action": action}
 
 
 def report(result: dict) -> None:
     rows = [r for r in result["rows"] if not (r["failure"] or "").startswith(("physics", "ik"))]
     beh = result["behavior"]
-    print(f"\n## {beh}: {len(result['rows'])} canonical interactions, {len(result['rows']) - len(rows)} "
+    print(f"\n## {beh}: {len(result['rows'])} {result['action']} interactions, {len(result['rows']) - len(rows)} "
           "not executed (physics or ik failures)")
     failures = [r["failure"] for r in result["rows"] if r["failure"]]
     if failures:
@@ -228,7 +247,9 @@ def report(result: dict) -> None:
             ratio = max(r["trace"].speed_ratio[g] for r in rows)
             print(f"{g:8s} joint speed peak: median {np.median(peaks):6.1f}, max {max(peaks):6.1f} deg/s "
                   f"({ratio:.2f} of the limit)")
-    print(f"largest motor torque: {max(r['trace'].torque_ratio for r in rows):.2f} of its limit")
+    saturated = sum(r["trace"].torque_ratio >= 0.999 for r in rows)
+    print(f"largest motor torque: {max(r['trace'].torque_ratio for r in rows):.2f} of its limit; a motor saturated in "
+          f"{saturated}/{len(rows)} interactions")
     pr = np.array([r["trace"].pen_robot for r in rows]) * 1e3
     pt = np.array([r["trace"].pen_table for r in rows]) * 1e3
     print(f"penetration robot-object [mm]: median {np.median(pr):.2f}, max {pr.max():.2f}; "
@@ -290,9 +311,10 @@ def main() -> None:
     parser.add_argument("--episodes", type=int, default=40)
     parser.add_argument("--behavior", nargs="+", default=["tap", "tap_back", "push", "grasp"])
     parser.add_argument("--seed", type=int, default=1000)
+    parser.add_argument("--action", choices=("canonical", "random"), default="canonical")
     args = parser.parse_args()
     for behavior in args.behavior:
-        report(audit(behavior, args.episodes, args.seed))
+        report(audit(behavior, args.episodes, args.seed, args.action))
 
 
 if __name__ == "__main__":

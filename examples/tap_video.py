@@ -15,7 +15,7 @@ import gymnasium as gym
 import imageio.v3 as iio
 import numpy as np
 
-import affordance_env  # noqa: F401  (registers TapAffordance-v1)
+import affordance_env  # noqa: F401  (registers TapAffordance-v2)
 
 
 def main() -> None:
@@ -26,7 +26,7 @@ def main() -> None:
     parser.add_argument("--out", default="taps.mp4")
     args = parser.parse_args()
 
-    env = gym.make("TapAffordance-v1", render_mode="rgb_array_list", render_width=640, render_height=480)
+    env = gym.make("TapAffordance-v2", render_mode="rgb_array_list", render_width=640, render_height=480)
     frames = []
     for i in range(args.episodes):
         env.reset(seed=args.seed + i)

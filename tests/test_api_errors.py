@@ -105,7 +105,7 @@ def test_a_state_restores_only_into_an_env_of_the_same_robot_model():
 
 def test_steps_from_a_restored_state_return_infos_of_their_own():
     # The README's get_state / set_state example, stepped again from the restored state, under gym.make's checker.
-    env = gym.make("TapAffordance-v1", camera_width=32, camera_height=24)
+    env = gym.make("TapAffordance-v2", camera_width=32, camera_height=24)
     obs, reset_info = env.reset(seed=3)
     kept = reset_info["object"]["pose"].copy()
     state = env.unwrapped.get_state()

@@ -115,10 +115,10 @@ def test_plan_takes_the_sizes_given_and_plan_settings_defaults_otherwise(no_work
     assert started.value.args[1]["settings"] == PlanSettings(goals=3)
 
 
-def _manifest(directory, env_id="TapAffordance-v1", action="canonical", seed=0):
+def _manifest(directory, env_id="TapAffordance-v2", action="canonical", seed=0):
     from affordance_env.dataset.format import MANIFEST, dataset_header
 
-    options = {"behavior": "tap"} if env_id == "TapAffordance-v1" else {"position_range": "workspace"}
+    options = {"behavior": "tap"} if env_id == "TapAffordance-v2" else {"position_range": "workspace"}
     directory.mkdir(parents=True)
     header = dataset_header(seed, action, 25, options, False, env_id)
     (directory / MANIFEST).write_text(json.dumps({**header, "episodes": 6}))
@@ -133,14 +133,14 @@ def test_plan_refuses_an_out_that_holds_what_is_not_its_own(no_work, tmp_path, c
     _manifest(collected)
     before = _listing(collected)
     _refused(["plan", "--out", collected], capsys, f"--out {collected} is a dataset directory",
-             "(a TapAffordance-v1 dataset of 6 tap interactions with canonical actions, seed 0)")
+             "(a TapAffordance-v2 dataset of 6 tap interactions with canonical actions, seed 0)")
     assert _listing(collected) == before  # nothing written into it
     inside = tmp_path / "inside"
     _manifest(inside / "dataset")
-    _refused(["plan", "--out", inside], capsys, f"{inside / 'dataset'} holds a TapAffordance-v1 dataset",
-             "not the plan's TapAffordanceGoal-v0 episodes")
+    _refused(["plan", "--out", inside], capsys, f"{inside / 'dataset'} holds a TapAffordance-v2 dataset",
+             "not the plan's TapAffordanceGoal-v1 episodes")
     other_seed = tmp_path / "other-seed"
-    _manifest(other_seed / "dataset", env_id="TapAffordanceGoal-v0", action="random", seed=3)
+    _manifest(other_seed / "dataset", env_id="TapAffordanceGoal-v1", action="random", seed=3)
     _refused(["plan", "--out", other_seed, "--seed", "1"], capsys, "episodes of seed 3, not of --seed 1",
              "give --seed 3")
     reproduction = tmp_path / "reproduction"
@@ -167,7 +167,7 @@ def test_plan_takes_a_new_or_empty_out_or_an_earlier_plans(no_work, tmp_path):
     with pytest.raises(WorkStarted):
         main(["plan", "--out", str(empty)])
     earlier = tmp_path / "earlier"
-    _manifest(earlier / "dataset", env_id="TapAffordanceGoal-v0", action="random", seed=2)
+    _manifest(earlier / "dataset", env_id="TapAffordanceGoal-v1", action="random", seed=2)
     with pytest.raises(WorkStarted):
         main(["plan", "--out", str(earlier), "--seed", "2"])
     (earlier / "results.json").write_text(json.dumps({"format": "tap-affordance-plan-results"}))
@@ -192,7 +192,7 @@ def test_collect_options_that_do_not_go_together_are_refused_before_collecting(n
     collect = ["collect", "--out", out, "--episodes", "3"]
     _refused([*collect, "--size-range", "0.1", "0.05"], capsys, "--size-range 0.1 0.05: expected LOW <= HIGH")
     _refused([*collect, "--scheduler", "joblib", "--dask-address", "tcp://x:1"], capsys, "--dask-address")
-    _refused([*collect, "--env", "TapAffordanceGoal-v0", "--behavior", "push"], capsys, "drop --behavior push")
+    _refused([*collect, "--env", "TapAffordanceGoal-v1", "--behavior", "push"], capsys, "drop --behavior push")
     _refused([*collect, "--object-types", "sphere", "cube"], capsys, "Unknown object type 'cube'")
     _refused([*collect, "--behavior", "juggle"], capsys, "Unknown behavior 'juggle'")
     assert not out.exists()

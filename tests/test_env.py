@@ -1,4 +1,4 @@
-"""TapAffordance-v1 as a user meets it: Gymnasium's checker, determinism, the paper's phenomenon, errors."""
+"""TapAffordance-v2 as a user meets it: Gymnasium's checker, determinism, the paper's phenomenon, errors."""
 
 
 import gymnasium as gym
@@ -26,7 +26,7 @@ def env():
 # Accepted checker warnings: the features are unbounded real numbers (Box(-inf, inf)).
 @pytest.mark.filterwarnings("ignore:.*Box observation space m..imum value is .?infinity")
 def test_gym_make_and_check_env():
-    env = gym.make("TapAffordance-v1", camera_width=48, camera_height=40)
+    env = gym.make("TapAffordance-v2", camera_width=48, camera_height=40)
     with_checker_warnings = check_env(env.unwrapped, skip_render_check=True)
     assert with_checker_warnings is None
     obs, info = env.reset(seed=3)
@@ -36,7 +36,7 @@ def test_gym_make_and_check_env():
 
 
 def test_module_colon_id_works():
-    env = gym.make("affordance_env:TapAffordance-v1")
+    env = gym.make("affordance_env:TapAffordance-v2")
     assert isinstance(env.unwrapped, TapAffordanceEnv)
     env.close()
 
@@ -170,7 +170,7 @@ def test_effects_of_real_taps_carry_the_motion(canonical_taps):
 
 def test_async_vector_env():
     envs = gym.vector.AsyncVectorEnv(
-        [lambda: gym.make("TapAffordance-v1", camera_width=32, camera_height=32) for _ in range(2)]
+        [lambda: gym.make("TapAffordance-v2", camera_width=32, camera_height=32) for _ in range(2)]
     )
     obs, infos = envs.reset(seed=[1, 2])
     assert obs["features"].shape == (2, 49)
@@ -182,7 +182,7 @@ def test_async_vector_env():
 def test_every_vector_step_is_an_interaction():
     # gym.make_vec resets each env within the step that ends its one-interaction episode (AutoresetMode.SAME_STEP,
     # declared in the env's metadata): with Gymnasium's default, every second step would be a reset, reward 0.
-    envs = gym.make_vec("TapAffordance-v1", 2, camera_width=32, camera_height=24)
+    envs = gym.make_vec("TapAffordance-v2", 2, camera_width=32, camera_height=24)
     assert envs.metadata["autoreset_mode"] == gym.vector.AutoresetMode.SAME_STEP
     envs.reset(seed=0)
     objects = []
@@ -524,7 +524,7 @@ def test_gym_make_refuses_a_render_mode_the_env_lacks_naming_those_it_has():
     # not Gymnasium's HumanRendering wrapper (and its "pygame is not installed"): the env's own refusal
     with pytest.raises(ValueError, match=r"render_mode must be None or one of \['rgb_array', 'rgb_array_list'\], "
                                          "got 'human'"):
-        gym.make("TapAffordance-v1", render_mode="human")
+        gym.make("TapAffordance-v2", render_mode="human")
 
 
 def test_range_noise_is_seeded_and_realistic():

@@ -1,4 +1,4 @@
-"""TapAffordanceGoal-v0: four behaviours in one world, an object that stays, goals, snapshots and reach."""
+"""TapAffordanceGoal-v1: four behaviours in one world, an object that stays, goals, snapshots and reach."""
 
 import gymnasium as gym
 import numpy as np
@@ -23,7 +23,7 @@ def env():
 
 
 def test_check_env_and_registration():
-    env = gym.make("TapAffordanceGoal-v0", **SMALL)
+    env = gym.make("TapAffordanceGoal-v1", **SMALL)
     check_env(env.unwrapped, skip_render_check=True)
     assert env.spec.max_episode_steps == 5
     assert env.unwrapped.behaviors == ("tap", "tap_back", "push", "grasp")
@@ -91,7 +91,7 @@ def test_compute_reward_is_vectorised_and_matches_the_tolerance(env):
 
 
 def test_reaching_the_goal_terminates_and_an_episode_is_truncated_after_five_steps():
-    env = gym.make("TapAffordanceGoal-v0", **SMALL)
+    env = gym.make("TapAffordanceGoal-v1", **SMALL)
     obs, _ = env.reset(seed=2, options={"object_type": "box", "size": 0.05, "position": (-0.30, 0.05)})
     env.unwrapped._goal = obs["achieved_goal"].copy()  # already there: any interaction that leaves it ends it
     _, reward, terminated, _, info = env.step({"behavior": "grasp", "params": np.array([0.0, 0.0, 1.0])})
@@ -196,7 +196,7 @@ def test_workspaces_sample_inside_themselves():
 
 
 def test_every_vector_step_is_an_interaction():
-    envs = gym.make_vec("TapAffordanceGoal-v0", 2, camera_width=32, camera_height=24)
+    envs = gym.make_vec("TapAffordanceGoal-v1", 2, camera_width=32, camera_height=24)
     assert envs.metadata["autoreset_mode"] == gym.vector.AutoresetMode.SAME_STEP
     envs.reset(seed=0)
     ended = 0

@@ -17,7 +17,7 @@ from affordance_env.robot_model import (
     coupled_position,
     get_variant,
 )
-from affordance_env.scene import PHALANX_LINKS, SEEN_ROBOT_GEOM_GROUP, build_model, home_qpos, robot_spec
+from affordance_env.scene import BACK_EMF, PHALANX_LINKS, SEEN_ROBOT_GEOM_GROUP, build_model, home_qpos, robot_spec
 
 GRASP = get_variant("grasp")
 
@@ -43,7 +43,9 @@ def test_joints_actuators_and_home(grasp_model):
     assert hinges == set(GRASP.active_joints)
     assert len(GRASP.active_joints) == 3 + 3 + 7 + 11
     assert not hinges & set(ARM_JOINTS)  # the right arm is locked
-    assert [model.actuator(i).name for i in range(model.nu)] == list(GRASP.actuated_joints)
+    # a servo per motor, then the motors' back-EMF (scene.BACK_EMF), in the same order
+    assert [model.actuator(i).name for i in range(model.nu)] == [*GRASP.actuated_joints,
+                                                                 *(f"{n}{BACK_EMF}" for n in GRASP.actuated_joints)]
     assert set(GRASP.actuated_joints) == set(GRASP.active_joints) - set(HAND_COUPLINGS)
     assert len(HAND_DRIVEN_JOINTS) == 7
     data = mujoco.MjData(model)

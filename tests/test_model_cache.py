@@ -22,7 +22,7 @@ def _bytes(model: mujoco.MjModel) -> bytes:
 @pytest.fixture(scope="module")
 def compiled() -> bytes:
     """The tap model as compiling gives it, without the cache."""
-    return _bytes(scene.build_spec("tap").compile())
+    return _bytes(scene.compile_scene("tap"))
 
 
 @pytest.fixture

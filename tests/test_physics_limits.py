@@ -5,8 +5,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from affordance_env.motor_limits import JOINT_TORQUE_LIMITS, torque_limits, velocity_limits
-from affordance_env.robot_model import VARIANTS
+from affordance_env.motor_limits import JOINT_TORQUE_LIMITS, torque_limits, torque_speed, velocity_limits
+from affordance_env.robot_model import VARIANTS, get_variant
 from affordance_env.scene import CONTACT_SOLIMP, HAND_FRICTION, PALM_RESTITUTION, PALM_SOLREF, build_model
 from affordance_env.tap_env import TapAffordanceEnv
 
@@ -36,6 +36,39 @@ def test_the_torso_holds_both_arms_when_a_grasp_leans_it_over_the_table():
     _, _, _, _, info = env.step(np.array([0.664, 0.678, -0.721], np.float32))
     assert info["failure"] is None and info["success"]
     assert max(angles) < max(targets) + 0.02  # never leaning further than it was sent (it fell to 0.92 rad)
+
+
+@pytest.mark.parametrize("variant", ["tap", "grasp"])
+def test_each_motor_gives_the_smaller_of_its_current_limit_and_its_torque_speed_line(variant):
+    # A servo commanded far ahead while its joint already turns at a share of its no-load speed: the motor gives
+    # its current limit, or less where its back-EMF line is lower, and nothing turning at its no-load speed.
+    model = build_model(variant)
+    model.opt.gravity[:] = 0.0  # the gravity compensation aside
+    data = mujoco.MjData(model)
+    robot = get_variant(variant)
+    fingers = [n for n in robot.actuated_joints if n.startswith("l_hand")] or ["r_wrist_pitch", "r_wrist_yaw"]
+    stall, no_load = torque_speed(fingers)
+    current = torque_limits(fingers)
+    checked = 0
+    for share in (0.0, 0.5, 0.8, 1.0):
+        mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+        dofs = [model.jnt_dofadr[model.joint(n).id] for n in fingers]
+        for name, dof, speed in zip(fingers, dofs, no_load, strict=True):
+            actuator = model.actuator(name).id
+            data.ctrl[actuator] = model.actuator_ctrlrange[actuator, 1]  # far ahead: the servo asks for more
+            data.qvel[dof] = share * speed
+        mujoco.mj_forward(model, data)
+        expected = np.minimum(current, stall * (1.0 - share))
+        servos = [model.actuator(n).id for n in fingers]
+        qpos = data.qpos[[model.jnt_qposadr[model.joint(n).id] for n in fingers]]
+        command = model.actuator_gainprm[servos, 0] * (data.ctrl[servos] - qpos) \
+            + model.actuator_biasprm[servos, 2] * data.qvel[dofs]  # the servo's own (lowered) damping
+        asked = command > stall  # the servo asks for more than the motor can give: the motor's limits decide
+        np.testing.assert_allclose(data.qfrc_actuator[dofs][asked], expected[asked], rtol=1e-6, atol=1e-9,
+                                   err_msg=f"{variant}, {share} of the no-load speed")
+        checked += int(asked.sum())
+    assert checked >= len(fingers)
+    assert np.all(stall > 0) and np.all(no_load > np.radians(180.0))  # faster than the plans: they keep their speed
 
 
 def test_velocity_limits_name_every_joint_and_follow_the_finger_linkage():
@@ -89,8 +122,9 @@ class _PerStep:
 
     def run(self, monkeypatch, seed, action, options=None):
         self.limit = self.env.motion.velocity_limit
-        joints = self.physics.variant.active_joints
-        self.arm = np.array([i for i, n in enumerate(joints) if not n.startswith(("l_hand", "neck"))])
+        variant = self.physics.variant
+        # every joint a motor turns: arm, torso, neck and the hand's driven finger joints
+        self.arm = np.array([i for i, n in enumerate(variant.active_joints) if n in variant.actuated_joints])
         self.speed_ratio = self.penetration = 0.0
         real_step = mujoco.mj_step
 
@@ -108,19 +142,29 @@ class _PerStep:
         return info
 
 
+#: Interactions whose every physics step is checked: canonical ones, the hardest, and for the grasp the objects its
+#: fingers lose (a 7.4-7.6 cm lying cylinder slips out as the hand lifts; a 9 cm box is never held).
+CHECKED = [(0, (0, 0, 0), None), (1, (0, 0, 0), None), (2, (0, 0, 0), None), (3, (0, 0, 1), None),
+           (4, (1, -1, 1), None)]
+LOST = [(27, (0, 0, 0), {"object_type": "horizontal_cylinder", "size": 0.074}),
+        (25, (0, 0, 1), {"object_type": "horizontal_cylinder", "size": 0.076}),
+        (5, (0, 0, 1), {"object_type": "box", "size": 0.09})]
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("behavior", ["tap", "tap_back", "push", "grasp"])
 def test_joints_stay_within_their_speed_limits_and_nothing_sinks(behavior, monkeypatch):
-    """At every physics step of canonical and of the hardest interactions: no arm or torso joint faster than its
-    limit, and no contact of the object (with the hand, the fingers, the arm or the table) deeper than 2 mm, half
-    of them within 1 mm."""
+    """At every physics step of canonical and of the hardest interactions, and of grasps whose fingers lose the
+    object: no joint a motor turns (arm, torso, neck, the hand's fingers) faster than 1.05 times its limit, and no
+    contact of the object (with the hand, the fingers, the arm or the table) deeper than 2 mm, half of them within
+    1 mm."""
     env = TapAffordanceEnv(behavior=behavior, camera_width=32, camera_height=24)
     probe = _PerStep(env)
     depths = []
-    for seed, action in [(0, (0, 0, 0)), (1, (0, 0, 0)), (2, (0, 0, 0)), (3, (0, 0, 1)), (4, (1, -1, 1))]:
-        info = probe.run(monkeypatch, seed, action)
+    for seed, action, options in CHECKED + (LOST if behavior == "grasp" else []):
+        info = probe.run(monkeypatch, seed, action, options)
         assert info["failure"] is None, (seed, info["failure"])
-        assert probe.speed_ratio <= 1.0, (seed, action, probe.speed_ratio)
+        assert probe.speed_ratio <= 1.05, (seed, action, probe.speed_ratio)
         depths.append(probe.penetration)
     assert max(depths) <= 2e-3 and np.median(depths) <= 1e-3, depths
     env.close()

@@ -15,7 +15,7 @@ needs_gl = pytest.mark.skipif(choose_gl_backend() is None, reason="no OpenGL bac
 
 def test_import_leaves_the_process_environment_alone():
     env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "PYOPENGL_PLATFORM")}
-    code = ("import os, gymnasium as gym, affordance_env; e = gym.make('TapAffordance-v1', camera_width=32, "
+    code = ("import os, gymnasium as gym, affordance_env; e = gym.make('TapAffordance-v2', camera_width=32, "
             "camera_height=24); e.reset(seed=0); "
             "print(os.environ.get('MUJOCO_GL'), os.environ.get('PYOPENGL_PLATFORM'))")
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)

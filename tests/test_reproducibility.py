@@ -123,7 +123,7 @@ import numpy as np, gymnasium as gym
 import affordance_env  # noqa: F401
 digest = hashlib.sha256()
 for behavior in sys.argv[1:]:
-    env = gym.make("TapAffordance-v1", behavior=behavior, camera_width=40, camera_height=30)
+    env = gym.make("TapAffordance-v2", behavior=behavior, camera_width=40, camera_height=30)
     env.action_space.seed(0)
     for seed in range(2):
         env.reset(seed=seed)

@@ -7,7 +7,7 @@ import pytest
 from affordance_env.objects import OBJECT_TYPES, object_geometry
 from affordance_env.physics import TapPhysics
 from affordance_env.robot_model import ACTIVE_JOINTS, CONTACT_LINKS
-from affordance_env.scene import build_model
+from affordance_env.scene import BACK_EMF, build_model
 
 
 def test_every_element_is_named(model):
@@ -29,7 +29,8 @@ def test_every_element_is_named(model):
 
 
 def test_actuated_joints_and_home_keyframe(model):
-    assert [model.actuator(i).name for i in range(model.nu)] == list(ACTIVE_JOINTS)
+    servos_then_back_emf = [*ACTIVE_JOINTS, *(f"{n}{BACK_EMF}" for n in ACTIVE_JOINTS)]
+    assert [model.actuator(i).name for i in range(model.nu)] == servos_then_back_emf
     assert model.key("home").id == 0
     hinge_names = [model.joint(i).name for i in range(model.njnt) if model.jnt_type[i] == mujoco.mjtJoint.mjJNT_HINGE]
     assert hinge_names == list(ACTIVE_JOINTS)

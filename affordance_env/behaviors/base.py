@@ -14,7 +14,7 @@ is. A behaviour
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any, ClassVar, Protocol
 
 import numpy as np
@@ -44,8 +44,12 @@ class Behavior(Protocol):
              action: np.ndarray) -> Any:
         """The plan of the interaction with the object at ``p_object`` [m] and ``yaw`` [rad]: a pure function."""
 
-    def execute(self, motion: MotionExecutor, plan: Any, posture: np.ndarray | None) -> ReachOutcome:
-        """Run the plan on the robot up to the way home, the IK starting from ``posture`` (:meth:`prepare`)."""
+    def execute(self, motion: MotionExecutor, plan: Any, posture: np.ndarray | None,
+                at_end: Callable[[], None] | None = None) -> ReachOutcome:
+        """Run the plan on the robot up to the way home, the IK starting from ``posture`` (:meth:`prepare`).
+        ``at_end``, if given, is called where the behaviour ends as the paper measures it, if that is before the
+        plan's end (the grasp: at the end of the hold, the object held); the world takes its final snapshot
+        there."""
 
     def reachable(self, motion: MotionExecutor, plan: Any, posture: np.ndarray | None) -> bool:
         """Whether the arm can reach every pose of the plan (kinematics only: no physics step)."""

@@ -30,7 +30,7 @@ fingertips: larger objects meet the thumb on the way down and are not enclosed, 
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -188,12 +188,20 @@ def plan_grasp(
     )
 
 
-#: Speed of the grasp's guarded moves [m/s]: the hand's final approach to the object, with its lowest point
-#: within GUARD_CLEARANCE of the object's top, and the put-down of a held object. A careful robot's speed near
-#: what it touches: the first touch is at most this fast, and stops the move (the fingertips' and palm's tactile
-#: skin of the mk3 hand sense it; the put-down's touch of the table is sensed as the load leaving the arm, through
-#: the iCub's force-torque sensors).
+#: Speed of the grasp's guarded move [m/s]: the hand's final approach to the object, with its lowest point
+#: within GUARD_CLEARANCE of the object's top. A careful robot's speed near what it touches: the first touch is at
+#: most this fast, and stops the move (the fingertips' and palm's tactile skin of the mk3 hand sense it).
 GUARDED_SPEED = 0.04
+#: Speed of the put-down [m/s], slower still: a held object meets the table at this speed, plus what it slips in
+#: the grip as the fingertips under a small one meet the table first (the touch is sensed as the load leaving the
+#: arm, through the iCub's force-torque sensors).
+PLACE_SPEED = 0.02
+#: Speed of the carry of a held object to above where it is put down [m/s]: gentle, so that the largest objects
+#: the hand holds, gripped near their equator, do not slip out as it starts and stops.
+CARRY_SPEED = 0.04
+#: How far the hand rises again [m] when the fingertips under a small object meet the table before it does:
+#: enough to take the table's push off them.
+PLACE_BACK_OFF = 0.001
 #: Speed of the grasp's free lines [m/s]: the lift of a held object and the retreat of the open hand.
 LIFT_SPEED = 0.1
 #: A closing finger joint has stalled when slower than FINGER_STALL_SPEED [rad/s] and within FINGER_ARRIVED [rad]
@@ -204,7 +212,7 @@ FINGER_STALL_SPEED, FINGER_ARRIVED = 0.05, 0.02
 #: object without sweeping it away. Then they squeeze with their motors' full torque.
 CLOSING_TORQUE = 0.1
 #: Share of their speed limit at which the fingers open to let down an object that does not touch the table yet.
-RELEASE_SPEED_SHARE = 0.25
+RELEASE_SPEED_SHARE = 0.05
 #: Once the closing fingers hold, their grip rises to the motors' full torque over this time [s].
 GRASP_SQUEEZE_TIME = 0.1
 #: The carry brings a held object to this height above where it would touch the table [m]; the guarded
@@ -252,10 +260,14 @@ def move_fingers(motion: MotionExecutor, hand: Mapping[str, float], speed_scale:
     ``until_held`` the move ends once every driven finger joint is still and either there or pressing with
     its motor's full torque (the closing of a hand that has stalled on what it holds)."""
     physics = motion.physics
-    q_to = with_hand(motion, physics.joint_targets(), hand)
-    trajectory = minimum_jerk(physics.joint_targets(), [q_to], motion.planned_speed * speed_scale,
-                              CONTROL_DT, min_duration=MIN_MOVE_TIME)
     fingers = np.array([motion.kinematics.joint_names.index(name) for name in hand])
+    # The move starts where the fingers are, not where their targets are: a finger held back by what it touches
+    # would otherwise spring towards its target as the move lets it go.
+    q_from = physics.joint_targets()
+    q_from[fingers] = physics.joint_positions()[fingers]
+    q_to = with_hand(motion, q_from, hand)
+    trajectory = minimum_jerk(q_from, [q_to], motion.planned_speed * speed_scale, CONTROL_DT,
+                              min_duration=MIN_MOVE_TIME)
     target = q_to[fingers]
     limit = np.minimum(physics.torque_limit[fingers], CLOSING_TORQUE)
 
@@ -271,12 +283,22 @@ def move_fingers(motion: MotionExecutor, hand: Mapping[str, float], speed_scale:
     physics.limit_torques(fingers, CLOSING_TORQUE)  # a light touch while the fingers close ...
     try:
         motion.follow(trajectory, held)
-        # ... then the grip rises to the motors' full torque over GRASP_SQUEEZE_TIME, without a jolt
+        # ... then the grip rises to the motors' full torque over GRASP_SQUEEZE_TIME, without a jolt. The grip is
+        # an impedance: each finger's target lies just so far beyond where it stopped that its servo presses with
+        # that torque, so a finger that loses what it holds moves no further than that (at its servo's pace, not
+        # at its motor's no-load speed, as a target far beyond the object would let it).
         motion.phase = "squeeze"
+        physics.limit_torques(fingers, None)
         full = physics.torque_limit[fingers]
+        stiffness = physics.servo_kp[fingers]
         n = max(1, round(GRASP_SQUEEZE_TIME / CONTROL_DT))
+        q_stopped = physics.joint_positions()[fingers]
+        towards = q_to[fingers] - q_stopped
         for k in range(1, n + 1):
-            physics.limit_torques(fingers, CLOSING_TORQUE + (full - CLOSING_TORQUE) * k / n)
+            press = (CLOSING_TORQUE + (full - CLOSING_TORQUE) * k / n) / stiffness  # [rad] beyond where it stopped
+            q = physics.joint_targets()
+            q[fingers] = q_stopped + np.sign(towards) * np.minimum(np.abs(towards), press)
+            physics.set_joint_targets(q)
             motion.hold(CONTROL_DT)
     finally:
         physics.limit_torques(fingers, None)
@@ -312,10 +334,11 @@ def grasp_reachable(motion: MotionExecutor, plan: GraspPlan) -> bool:
     return ik_verdict([above, at, lifted, *descent.results, *lift.results, *high_lift.results, place])[0]
 
 
-def run_grasp(motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
+def run_grasp(motion: MotionExecutor, plan: GraspPlan, at_end: Callable[[], None] | None = None) -> GraspOutcome:
     """Reach above the object with the open hand, descend slowly until the hand touches it or is at the grasp
     pose, close the hand, lift, hold; if the object is held, carry it beside and put it down until it rests on
-    the table; open the hand once the object rests. Not the way home, which rises first (``q_retreat``)."""
+    the table; open the hand once the object rests. Not the way home, which rises first (``q_retreat``).
+    ``at_end`` is called at the end of the hold: where the paper's grasp ends."""
     physics = motion.physics
     hand = hand_target(plan)
     results = grasp_poses(motion, plan)
@@ -342,32 +365,31 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan) -> GraspOutcome:
     rise = float(physics.object_pose()[2]) - z_start
     holding = tuple(sorted(physics.links_touching_object()))
     on_table = physics.object_touches_table()
+    if at_end is not None:
+        at_end()
     held = rise > 0.5 * (plan.p_lift[2] - plan.p_grasp[2]) and bool(holding) and not on_table
     placed = False
     if held:  # carry it to above where it is put down: as high above the table as it was lifted
         motion.phase = "carry"
-        # where the object would touch the table, from how far it has risen with the hand
-        z_touch = float(motion.palm[2]) - (float(physics.object_pose()[2]) - z_start)
+        # Where the palm is when the object's lowest point (as it hangs in the hand now) is PLACE_APPROACH above
+        # the table; there along a straight line, which never dips towards the table.
+        z_touch = float(motion.palm[2]) - (physics.object_bottom() - physics.table_top)
         p_carry = np.array([plan.p_place[0], plan.p_place[1], z_touch + PLACE_APPROACH])
-        carry = motion.ik(p_carry, physics.joint_targets(), hand)
-        results.append(carry)
-        motion.move_through([carry.q])
+        carry = motion.line(motion.palm.copy(), p_carry, hand, CARRY_SPEED)
+        results += carry.results
+        motion.follow_line(carry)
         # Place: down until the object meets the table (sensed as the arm's load leaving it), then still until
-        # it rests. Fingertips curled under a small object meet the table first: the grip loosens to the
-        # closing's light touch, and the fingers yield and spread on the table as the hand goes on down.
+        # it rests. Fingertips curled under a small object meet the table first, a millimetre or two before the
+        # object would: the hand stops there, and opens slowly (below).
         motion.phase = "place"
         p_hand = motion.palm.copy()
         p_low = p_hand - np.array([0.0, 0.0, PLACE_APPROACH + PLACE_OVERTRAVEL])
-        down = motion.line(p_hand, p_low, hand, GUARDED_SPEED)
+        down = motion.line(p_hand, p_low, hand, PLACE_SPEED)
         placed = motion.follow_line(down, lambda: physics.object_touches_table()
                                   or physics.hand_touches_table()).touched and physics.object_touches_table()
-        if not placed:  # the fingers under the object met the table: they loosen and yield as the hand goes on
-            fingers = np.array([motion.kinematics.joint_names.index(name) for name in plan.hand_closed])
-            physics.limit_torques(fingers, CLOSING_TORQUE)
+        if not placed:  # the fingertips under it met the table: off it again, so that they keep their grip
             p_hand = motion.palm.copy()
-            on_down = motion.line(p_hand, p_hand - np.array([0.0, 0.0, PLACE_OVERTRAVEL]), hand, GUARDED_SPEED)
-            placed = motion.follow_line(on_down, physics.object_touches_table).touched
-            physics.limit_torques(fingers, None)
+            motion.follow_line(motion.line(p_hand, p_hand + np.array([0.0, 0.0, PLACE_BACK_OFF]), hand, PLACE_SPEED))
         motion.hold_still(also=object_at_rest)
     motion.phase = "open"
     # A held object the hand could not set down (the thumb under a small one met the table first) is let down
@@ -407,8 +429,9 @@ class GraspBehavior:
              action: np.ndarray) -> GraspPlan:
         return plan_grasp(self, geometry, p_object, yaw, table_top, action)
 
-    def execute(self, motion: MotionExecutor, plan: GraspPlan, posture: np.ndarray | None) -> GraspOutcome:
-        return run_grasp(motion, plan)
+    def execute(self, motion: MotionExecutor, plan: GraspPlan, posture: np.ndarray | None,
+                at_end: Callable[[], None] | None = None) -> GraspOutcome:
+        return run_grasp(motion, plan, at_end)
 
     def reachable(self, motion: MotionExecutor, plan: GraspPlan, posture: np.ndarray | None) -> bool:
         return grasp_reachable(motion, plan)

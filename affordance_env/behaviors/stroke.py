@@ -34,7 +34,7 @@ rolling objects move 2-3 cm, at the hardest (+1, as fast as the joints allow) ma
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -339,7 +339,9 @@ class StrokeBehavior:
              action: np.ndarray) -> StrokePlan:
         return plan_stroke(self, geometry, p_object, yaw, table_top, action)
 
-    def execute(self, motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> StrokeOutcome:
+    def execute(self, motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None,
+                at_end: Callable[[], None] | None = None) -> StrokeOutcome:
+        # A stroke ends as the paper measures it when the struck object has come to rest: after the plan.
         return run_stroke(motion, plan, posture)
 
     def reachable(self, motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> bool:

@@ -215,7 +215,7 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) ->
 def _full_options(env_options: dict[str, Any], env_id: str = ENV_IDS[0]) -> dict[str, Any]:
     """The env options with every default filled in, as JSON values, so that equal settings compare equal;
     checked (:class:`~affordance_env.options.EnvOptions`) without building an env or importing the simulator.
-    TapAffordanceGoal-v0 chooses the behaviour at every step: it has no ``behavior`` option."""
+    TapAffordanceGoal-v1 chooses the behaviour at every step: it has no ``behavior`` option."""
     if env_id == GOAL_ENV_ID and "behavior" in env_options:
         raise InvalidValueError(f"{GOAL_ENV_ID} chooses among all four behaviours at every step: drop the behavior "
                          f"option (--behavior), got {env_options['behavior']!r}.")
@@ -269,7 +269,7 @@ def collect(
         workers: Processes on this machine (joblib), or in the local Dask cluster of ``scheduler="dask"``.
             The data do not depend on it.
         action: ``"canonical"`` (the paper's tap, all zeros) or ``"random"`` (uniform in the action box).
-        env_options: Keyword arguments of ``TapAffordance-v1`` (behavior, object_types, size_range,
+        env_options: Keyword arguments of ``TapAffordance-v2`` (behavior, object_types, size_range,
             camera_width, camera_height, camera_fovy, roll_threshold, settle_timeout); the others keep the
             env's defaults, which are recorded too.
         chunk_size: Interactions per file: the most a crash can lose, per worker.
@@ -283,7 +283,7 @@ def collect(
             zstd-compressed; read them with ``load_dataset(out, with_images=True)`` and :func:`images`.
         max_failure_share: Stop with :class:`FailureShareError` once more than this share of the interactions
             collected so far were marked failed by the environment, in [0, 1] (1 accepts any).
-        env_id: ``"TapAffordance-v1"`` (one interaction per episode, a row each) or ``"TapAffordanceGoal-v0"``:
+        env_id: ``"TapAffordance-v2"`` (one interaction per episode, a row each) or ``"TapAffordanceGoal-v1"``:
             goal episodes of up to 5 interactions (``GOAL_MAX_EPISODE_STEPS``), each a behaviour drawn uniformly
             with its parameters by ``action``, drawn again (up to ``GOAL_ACTION_DRAWS`` times) until the arm can
             reach it (``feasible``), one row per interaction with its ``step`` and the goal columns. An action that

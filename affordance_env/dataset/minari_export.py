@@ -16,7 +16,7 @@ The Parquet dataset stays the source of truth; :func:`export_minari` writes a co
   so both entries of each info (Minari keeps one per observation) hold the same labels.
 - action (3,) float32; reward: the object's displacement [m] (the environment's default reward); terminated
   True, truncated False.
-- the environment spec: ``TapAffordance-v1`` with the dataset's settings, so that
+- the environment spec: ``TapAffordance-v2`` with the dataset's settings, so that
   ``dataset.recover_environment()`` makes the environment the data came from.
 
 The id is checked before anything is written, and the dataset is written to a hidden directory beside Minari's
@@ -208,8 +208,8 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
     frame = load_dataset(dataset, with_images=True)
     manifest = frame.attrs["manifest"]
     if is_goal_dataset(manifest):
-        raise DatasetError(f"{dataset} holds TapAffordanceGoal-v0 episodes; the Minari export writes one "
-                           "TapAffordance-v1 episode per interaction and does not take goal episodes: read them "
+        raise DatasetError(f"{dataset} holds TapAffordanceGoal-v1 episodes; the Minari export writes one "
+                           "TapAffordance-v2 episode per interaction and does not take goal episodes: read them "
                            "with load_dataset (a row per interaction, with 'episode' and 'step').")
     options = manifest["settings"]["env_options"]
     with_images = bool(manifest["settings"].get("save_images"))
