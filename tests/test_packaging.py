@@ -23,6 +23,10 @@ def test_wheel_ships_assets(tmp_path):
     assert "affordance_env/assets/scene.xml" in names
     assert "affordance_env/assets/README.md" in names
     assert "affordance_env/tap_env.py" in names and "affordance_learning/__init__.py" in names
+    # every module of every package in the source tree (a subpackage left out of pyproject.toml is caught here)
+    sources = {str(p.relative_to(ROOT)) for package in ("affordance_env", "affordance_learning")
+               for p in (ROOT / package).rglob("*.py")}
+    assert not sources - names, sorted(sources - names)
     assert "affordance_learning/data/tap_model.joblib" in names
     assert "affordance_learning/data/grasp_model.joblib" in names
     entry_points = next(n for n in names if n.endswith("entry_points.txt"))
