@@ -7,17 +7,22 @@ are in metres, times in seconds.
 
 from __future__ import annotations
 
-import numbers
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
 from typing import Any
 
 from affordance_learning.exceptions import InvalidValueError
+from affordance_learning.json_reading import Path as _Path
+from affordance_learning.json_reading import Reader, is_number
 
 #: The ``format`` a plan's ``results.json`` names.
 PLAN_RESULTS_FORMAT = "tap-affordance-plan-results"
 _EXPECTED = "expected the results of affordance plan (run_plan)"
+
+_READ = Reader("plan results", _EXPECTED)
+_where, _mapping, _list, _entry = _READ.where, _READ.mapping, _READ.list, _READ.entry
+_number, _count, _is_number = _READ.number, _READ.count, is_number
 
 
 @dataclass(frozen=True)
@@ -238,53 +243,6 @@ class PlanResults:
 
 
 # --- reading and checking -------------------------------------------------------------------------------------
-#: Where a value lies in the results: its keys from the top, ("multi_step", "planner", "n").
-_Path = tuple[Any, ...]
-
-
-def _where(path: _Path) -> str:
-    return "plan results" + "".join(f"[{part!r}]" for part in path)
-
-
-def _mapping(value: Any, path: _Path) -> Mapping[Any, Any]:
-    if not isinstance(value, Mapping):
-        raise InvalidValueError(f"{_where(path)} must be a mapping, got {type(value).__name__}; {_EXPECTED}.")
-    return value
-
-
-def _list(value: Any, path: _Path) -> list[Any] | tuple[Any, ...]:
-    if not isinstance(value, list | tuple):
-        raise InvalidValueError(f"{_where(path)} must be a list, got {type(value).__name__}; {_EXPECTED}.")
-    return value
-
-
-def _entry(value: Any, path: _Path, keys: Iterable[str]) -> Mapping[str, Any]:
-    """``value`` as a mapping that holds every one of ``keys``."""
-    entry = _mapping(value, path)
-    missing = [key for key in keys if key not in entry]
-    if missing:
-        raise InvalidValueError(f"{_where(path)} lacks {', '.join(repr(k) for k in missing)}; {_EXPECTED}.")
-    return entry
-
-
-def _is_number(value: Any) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
-
-
-def _number(value: Any, path: _Path, optional: bool = False) -> Any:
-    """``value`` as a float (None when ``optional`` and None)."""
-    if value is None and optional:
-        return None
-    if not _is_number(value):
-        what = "a number or None" if optional else "a number"
-        raise InvalidValueError(f"{_where(path)} must be {what}, got {value!r}; {_EXPECTED}.")
-    return float(value)
-
-
-def _count(value: Any, path: _Path) -> int:
-    if not _is_number(value) or not float(value).is_integer():
-        raise InvalidValueError(f"{_where(path)} must be a count (a whole number), got {value!r}; {_EXPECTED}.")
-    return int(value)
 
 
 def _text(value: Any, path: _Path) -> str:

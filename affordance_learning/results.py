@@ -17,13 +17,14 @@ reads it as format 2, so reports, figures and claims can be drawn from an ``resu
 from __future__ import annotations
 
 import copy
-import numbers
 from collections.abc import Callable, Iterable, Iterator, Mapping, MutableMapping
 from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any
 
 from affordance_learning.exceptions import InvalidValueError
+from affordance_learning.json_reading import Path as _Path
+from affordance_learning.json_reading import Reader, is_number
 
 #: Version of the results dict; raise it when the meaning or the unit of a key changes.
 RESULTS_FORMAT = 2
@@ -38,6 +39,10 @@ UNIFORMITY_DEFINITION = (
 )
 #: What the error messages point to.
 _EXPECTED = "expected the dict returned by run_protocol"
+
+_READ = Reader("results", _EXPECTED)
+_where, _mapping, _list, _entry = _READ.where, _READ.mapping, _READ.list, _READ.entry
+_number, _count, _is_number = _READ.number, _READ.count, is_number
 
 
 def k_key(k: int) -> str:
@@ -464,58 +469,10 @@ def as_results(results: Results | Mapping[str, Any], required: Iterable[str] = (
 
 
 # --- reading and checking -------------------------------------------------------------------------------------
-def _is_number(value: Any) -> bool:
-    return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 def _count_or_none(value: Any) -> int | None:
     return int(value) if _is_number(value) else None
-
-
-#: Where a value lies in the results dict: its keys from the top, ("uniformity", "3", "mean").
-_Path = tuple[Any, ...]
-
-
-def _where(path: _Path) -> str:
-    """``results['uniformity']['3']['mean']`` for the path ("uniformity", "3", "mean")."""
-    return "results" + "".join(f"[{part!r}]" for part in path)
-
-
-def _mapping(value: Any, path: _Path) -> Mapping[str, Any]:
-    if not isinstance(value, Mapping):
-        raise InvalidValueError(f"{_where(path)} must be a mapping, got {type(value).__name__}; {_EXPECTED}.")
-    return value
-
-
-def _list(value: Any, path: _Path) -> list[Any] | tuple[Any, ...]:
-    if not isinstance(value, list | tuple):
-        raise InvalidValueError(f"{_where(path)} must be a list, got {type(value).__name__}; {_EXPECTED}.")
-    return value
-
-
-def _entry(value: Any, path: _Path, keys: Iterable[str]) -> Mapping[str, Any]:
-    """``value`` as a mapping that holds every one of ``keys``."""
-    entry = _mapping(value, path)
-    missing = [key for key in keys if key not in entry]
-    if missing:
-        raise InvalidValueError(f"{_where(path)} lacks {', '.join(repr(k) for k in missing)}; {_EXPECTED}.")
-    return entry
-
-
-def _number(value: Any, path: _Path, optional: bool = False) -> Any:
-    """``value`` as a float (None when ``optional`` and None)."""
-    if value is None and optional:
-        return None
-    if not _is_number(value):
-        what = "a number or None" if optional else "a number"
-        raise InvalidValueError(f"{_where(path)} must be {what}, got {value!r}; {_EXPECTED}.")
-    return float(value)
-
-
-def _count(value: Any, path: _Path) -> int:
-    if not _is_number(value) or not float(value).is_integer():
-        raise InvalidValueError(f"{_where(path)} must be a count (a whole number), got {value!r}; {_EXPECTED}.")
-    return int(value)
 
 
 def _k(key: Any, path: _Path) -> int:
