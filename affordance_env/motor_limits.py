@@ -105,14 +105,11 @@ def back_emf_damping(joints: Sequence[str]) -> np.ndarray:
     return stall / no_load
 
 
-def available_torque(joints: Sequence[str], velocity: np.ndarray, direction: np.ndarray | float = 1.0
-                     ) -> np.ndarray:
-    """The largest torque [N m] the motors of ``joints`` give in ``direction`` (its sign, per joint) while their
-    joints turn at ``velocity`` [rad/s]: the smaller of the current limit and the torque-speed line, which falls
-    to 0 at the no-load speed turning that way and rises above the stall torque turning against it (braking)."""
-    stall, no_load = torque_speed(joints)
-    line = stall * (1.0 - np.sign(direction) * np.asarray(velocity) / no_load)
-    return np.clip(np.minimum(torque_limits(joints), line), 0.0, None)
+def available_torque(current: np.ndarray, stall: np.ndarray, no_load: np.ndarray, along: np.ndarray) -> np.ndarray:
+    """The largest torque [N m] motors give: the smaller of their ``current`` limit and their torque-speed line
+    (``stall`` torque [N m], ``no_load`` speed [rad/s]) at ``along`` [rad/s], their joint's speed in the
+    direction of the torque (negative: braking, where the line rises above the stall torque); never below 0."""
+    return np.maximum(np.minimum(current, stall * (1.0 - along / no_load)), 0.0)
 
 
 def _side_free(name: str) -> str:

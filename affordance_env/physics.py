@@ -208,9 +208,10 @@ class TapPhysics:
         of coupled joints, which have no servo, are ignored. A finger's target is kept within
         :attr:`finger_reach` of where the finger is (the hand's controller: see there)."""
         if self._actuated is not None:
-            q = np.asarray(q)[self._actuated]
+            q = np.asarray(q)[self._actuated]  # a new array
+        elif self._fingers is not None:
+            q = np.array(q)  # the caller's stays as it was
         if self._fingers is not None:
-            q = q.copy()
             where = self.data.qpos[self._finger_qpos]
             q[self._fingers] = np.minimum(np.maximum(q[self._fingers], where - self.finger_reach),
                                           where + self.finger_reach)

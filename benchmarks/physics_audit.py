@@ -54,9 +54,10 @@ class Trace:
         self.torque_limit = self.physics.torque_limit
         self.motors = [i for i, n in enumerate(joints) if n in self.physics.variant.actuated_joints]
         try:  # releases before the motors' torque-speed curves had the current limit alone
-            from affordance_env.motor_limits import torque_speed
+            from affordance_env.motor_limits import available_torque, torque_speed
 
             self._torque_speed = torque_speed([joints[i] for i in self.motors])
+            self._available = available_torque
         except ImportError:
             self._torque_speed = None
         self.speed_peak = {g: 0.0 for g in self.groups}
@@ -99,7 +100,7 @@ class Trace:
         else:
             stall, no_load = self._torque_speed
             along = np.sign(signed) * d.qvel[self.dofs][self.motors]  # > 0: turning the way it pushes
-            limit = np.minimum(self.torque_limit[self.motors], stall * (1.0 - along / no_load))
+            limit = self._available(self.torque_limit[self.motors], stall, no_load, along)
         if len(tau):
             self.torque_ratio = max(self.torque_ratio, float((tau / np.maximum(limit, 1e-9)).max()))
         obj, table = ph.active_geom, ph.table_geom

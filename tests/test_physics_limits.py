@@ -5,7 +5,13 @@ import mujoco
 import numpy as np
 import pytest
 
-from affordance_env.motor_limits import JOINT_TORQUE_LIMITS, torque_limits, torque_speed, velocity_limits
+from affordance_env.motor_limits import (
+    JOINT_TORQUE_LIMITS,
+    available_torque,
+    torque_limits,
+    torque_speed,
+    velocity_limits,
+)
 from affordance_env.robot_model import VARIANTS, get_variant
 from affordance_env.scene import CONTACT_SOLIMP, HAND_FRICTION, PALM_RESTITUTION, PALM_SOLREF, build_model
 from affordance_env.tap_env import TapAffordanceEnv
@@ -58,7 +64,8 @@ def test_each_motor_gives_the_smaller_of_its_current_limit_and_its_torque_speed_
             data.ctrl[actuator] = model.actuator_ctrlrange[actuator, 1]  # far ahead: the servo asks for more
             data.qvel[dof] = share * speed
         mujoco.mj_forward(model, data)
-        expected = np.minimum(current, stall * (1.0 - share))
+        expected = np.minimum(current, stall * (1.0 - share))  # the plateau, then the line
+        np.testing.assert_allclose(available_torque(current, stall, no_load, share * no_load), expected)
         servos = [model.actuator(n).id for n in fingers]
         qpos = data.qpos[[model.jnt_qposadr[model.joint(n).id] for n in fingers]]
         command = model.actuator_gainprm[servos, 0] * (data.ctrl[servos] - qpos) \
