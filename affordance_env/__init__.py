@@ -1,13 +1,13 @@
 """TapAffordance environment: an iCub in MuJoCo taps objects and sees the effect through a range camera.
 
 ``import affordance_env`` registers ``TapAffordance-v2`` (one interaction of one behaviour per episode) and
-``TapAffordanceGoal-v1`` (bring the object to a goal, choosing among the four behaviours) with Gymnasium::
+``TapAffordanceGoal-v2`` (bring the object to a goal, choosing among the five behaviours) with Gymnasium::
 
     import gymnasium as gym
     import affordance_env  # noqa: F401
 
     env = gym.make("TapAffordance-v2")
-    goal_env = gym.make("TapAffordanceGoal-v1")
+    goal_env = gym.make("TapAffordanceGoal-v2")
 
 or, without the import, ``gym.make("affordance_env:TapAffordance-v2")``.
 """

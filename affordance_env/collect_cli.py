@@ -76,14 +76,14 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     )
     parser.add_argument("--episodes", type=positive_int, required=True,
                         help="how many to collect: interactions of TapAffordance-v2, episodes (of several "
-                        "interactions each) of TapAffordanceGoal-v1")
+                        "interactions each) of TapAffordanceGoal-v2")
     parser.add_argument("--out", type=Path, required=True, help="dataset directory (resumed if it exists)")
     parser.add_argument("--seed", type=non_negative_int, default=0, help="dataset seed (default 0)")
     parser.add_argument("--workers", type=positive_int, default=1,
                         help="worker processes, or workers of the local Dask cluster (default 1)")
     parser.add_argument("--env", default=ENV_ID, choices=ENV_IDS,
                         dest="env_id",
-                        help="TapAffordance-v2: one interaction per episode; TapAffordanceGoal-v1: goal episodes of "
+                        help="TapAffordance-v2: one interaction per episode; TapAffordanceGoal-v2: goal episodes of "
                              "up to 5 interactions, a reachable behaviour and parameters drawn at each, one row per "
                              "interaction with 'step' and the goal's columns (default TapAffordance-v2)")
     parser.add_argument("--action", default="canonical", choices=("canonical", "random"),
@@ -126,7 +126,7 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
                      help="depth noise of the range camera (default: none)")
     env.add_argument("--position-range", default=None, choices=POSITION_RANGES,
                      help="where objects are placed: within +-3 cm of the paper's spot (canonical), or uniformly "
-                          "over the behaviour's workspace (workspace; for TapAffordanceGoal-v1, the union of the "
+                          "over the behaviour's workspace (workspace; for TapAffordanceGoal-v2, the union of the "
                           "four) (default canonical)")
     parser.set_defaults(func=run_collect)
     return parser
@@ -151,7 +151,7 @@ def check_collect_args(args: argparse.Namespace) -> None:
         low, high = args.size_range
         raise InvalidValueError(f"--size-range {low:g} {high:g}: expected LOW <= HIGH (equal for a single size).")
     if args.env_id == GOAL_ENV_ID and args.behavior is not None:
-        raise InvalidValueError(f"--env {GOAL_ENV_ID} chooses among all four behaviours at every step: drop --behavior "
+        raise InvalidValueError(f"--env {GOAL_ENV_ID} chooses among all the behaviours at every step: drop --behavior "
                          f"{args.behavior}.")
     try:
         EnvOptions.checked(**env_options_from_args(args))

@@ -1,4 +1,4 @@
-"""TapAffordanceGoal-v1: bring the object to a place on the table, choosing among the four behaviours."""
+"""TapAffordanceGoal-v2: bring the object to a place on the table, choosing among the five behaviours."""
 
 from __future__ import annotations
 
@@ -60,21 +60,31 @@ class TapAffordanceGoalEnv(gym.Env):
 
     ## Description
     The world of ``TapAffordance-v2`` with both arms in one scene: the right arm with the V2.5 hand taps, taps
-    back and pushes, the left arm with the fingered ``left_hand_mk3`` hand grasps (lifts, holds and puts down 6 cm
-    to the robot's left); the arm that does not act waits rigid at its home pose, where it is in every scene of
-    this env, so every behaviour sees the same robot and measures the relation features to the same (right) palm.
+    back, pushes and draws, the left arm with the fingered ``left_hand_mk3`` hand picks and places (grasps, lifts,
+    holds and puts the object down where its action asks); the arm that does not act waits rigid at its home pose,
+    where it is in every scene of this env, so every behaviour sees the same robot and measures the relation
+    features to the same (right) palm.
     ``reset`` places an object and draws a goal; each ``step`` runs one interaction with the behaviour and its
     parameters that the action chooses. The object stays exactly where the interaction left it, at rest (the
     interaction ends once it rests, has left the table, or ``settle_timeout`` passed); then the head turns to it
     again and the next observation is taken. A goal-conditioned env in the style of Gymnasium-Robotics' Fetch
     envs (a ``Dict`` observation with ``achieved_goal`` and ``desired_goal``, ``compute_reward``).
 
+    ## Frame
+    Positions are (x, y) [m] in the robot's root frame, on the table top: **+x points toward the robot** (the
+    table's near edge is at x = -0.16, objects stand around x = -0.30), +y to the robot's right, -y to its left.
+    ``tap`` moves objects toward -y, ``tap_back`` toward +y, ``push`` toward -x (away), ``draw`` toward +x (toward
+    the robot), and ``grasp`` wherever its action asks.
+
     ## Action Space
-    ``Dict(behavior=Discrete(4), params=Box(-1, 1, (3,), float32))``: the behaviour, named by
-    ``env.unwrapped.behaviors`` (``tap``, ``tap_back``, ``push``, ``grasp``), and its parameters, those of
-    ``TapAffordance-v2``'s action for that behaviour (0 is the canonical action). :class:`FlatActionWrapper` gives a
-    ``Box(-1, 1, (7,))`` action (four behaviour scores, the highest chosen, then the parameters) for libraries that
-    need one. Out-of-range parameters, NaN, a wrong shape or an unknown behaviour raise ``ValueError``.
+    ``Dict(behavior=Discrete(5), params=Box(-1, 1, (3,), float32))``: the behaviour, named by
+    ``env.unwrapped.behaviors`` (``tap``, ``tap_back``, ``push``, ``grasp``, ``draw``), and its parameters, those of
+    ``TapAffordance-v2``'s action for that behaviour (0 is the canonical action), except the grasp's: it is pick and
+    place, ``params[0]`` and ``params[1]`` name where the held object is put down, ``PLACE_RANGE`` (0.2 m) times
+    them along x and y from where it stood (the hand takes it as the canonical grasp does), and ``params[2]`` is
+    the fingers' closing speed as in TapAffordance-v2. :class:`FlatActionWrapper` gives a ``Box(-1, 1, (8,))``
+    action (one score per behaviour, the highest chosen, then the parameters) for libraries that need one.
+    Out-of-range parameters, NaN, a wrong shape or an unknown behaviour raise ``ValueError``.
 
     ## Observation Space
     ``Dict`` of
@@ -110,7 +120,8 @@ class TapAffordanceGoalEnv(gym.Env):
     ## Info
     After ``reset``: ``object``, ``visible``, ``attention``, ``still`` as TapAffordance-v2, and ``distance``.
     After ``step``: every key of TapAffordance-v2's step info for the interaction (``effect``, ``object`` with
-    ``initial_pose`` and ``final_pose``, ``displacement``, ``success``, ``failure``, ...), and ``behavior``,
+    ``pose`` (where it is now, as after ``reset``), ``initial_pose`` and ``final_pose``, ``displacement``,
+    ``success``, ``failure``, ...), and ``behavior``,
     ``distance`` [m] to the goal and ``is_success``; ``attention`` (the head turning to the object again, as after
     ``reset``; None when the episode ended without looking) and ``observation_visible``: whether the returned
     observation sees the object, as ``visible`` after ``reset``. Where it does not (the object lies hidden behind an
@@ -126,10 +137,14 @@ class TapAffordanceGoalEnv(gym.Env):
     ## Snapshots
     ``get_state()`` and ``set_state(state)``: the world (both arms' scenes and which one acts), the episode's goal
     and observation and the random generator; the same action after a restore gives the same interaction, bit for
-    bit. ``feasible(behavior, params)``: whether the arm can reach every pose of that interaction with the object
-    where it is, from the kinematics alone (no physics step).
+    bit. ``feasible(behavior, params, state=None)``: whether the arm can reach every pose of that interaction with
+    the object where it is (or where it is in ``state``, a snapshot of ``get_state()``, the env left as it was),
+    from the kinematics alone (no physics step).
 
     ## Version History
+    * v2: five behaviours: ``draw`` (the right hand drags the object toward the robot) is new, and the grasp is pick
+      and place (its first two parameters name where the object is put down). Goals may lie toward the robot (the
+      draw's workspace joins the union goals are drawn in). Data of v1 are not comparable.
     * v1: the motors of TapAffordance-v2 (each with its torque-speed curve) and its hand's controller (a finger's
       target kept within its servo's reach of the finger); the put-down lowers a held object at 2 cm/s, carries it
       along a straight line to above where it goes, and stops where fingertips under it meet the table first. Data
@@ -284,11 +299,24 @@ class TapAffordanceGoalEnv(gym.Env):
             name = BEHAVIORS[index]
         return name, check_action(action["params"])
 
-    def feasible(self, behavior: int | str, params: Any) -> bool:
-        """Whether the arm can reach every pose of ``behavior`` with ``params`` on the object where it is now, from
-        the kinematics alone (no physics step); False: the interaction would fail with ``"ik: ..."``, or a stroke's
-        reach would sweep the arm into the object (``"reach: ..."``)."""
+    def feasible(self, behavior: int | str, params: Any, state: GoalEnvState | None = None) -> bool:
+        """Whether the arm can reach every pose of ``behavior`` with ``params`` on the object where it is now (or
+        where it is in ``state``, a snapshot of :meth:`get_state`: the env is left as it was), from the kinematics
+        alone (no physics step); False: the interaction would fail with ``"ik: ..."``, or a stroke's reach would
+        sweep the arm into the object (``"reach: ..."``)."""
         name, a = self._check_action({"behavior": behavior, "params": params})
+        if state is not None:
+            if not isinstance(state, GoalEnvState):
+                raise TypeError(f"state must be what get_state() returned (a GoalEnvState), got "
+                                f"{type(state).__name__}.")
+            if state.obs is None:
+                raise RuntimeError("feasible() needs an object: the state is of an episode that ended.")
+            now = self.get_state()
+            self.set_state(state)
+            try:
+                return self.world.feasible(name, a)
+            finally:
+                self.set_state(now)
         if self._obs is None:
             raise RuntimeError("feasible() needs an object: call reset() first.")
         return self.world.feasible(name, a)
@@ -339,7 +367,7 @@ class TapAffordanceGoalEnv(gym.Env):
 
 
 class FlatActionWrapper(gym.ActionWrapper):
-    """``Box(-1, 1, (7,), float32)`` actions for TapAffordanceGoal-v1: four behaviour scores (the highest one's
+    """``Box(-1, 1, (8,), float32)`` actions for TapAffordanceGoal-v2: one score per behaviour (the highest one's
     behaviour is run, ties to the first) and the three parameters."""
 
     def __init__(self, env: gym.Env) -> None:
@@ -349,8 +377,8 @@ class FlatActionWrapper(gym.ActionWrapper):
     def action(self, action: Any) -> dict[str, Any]:
         a = np.asarray(action, dtype=np.float64)
         if a.shape != self.action_space.shape or not np.all(np.isfinite(a)):
-            raise InvalidValueError(f"action must be {self.action_space.shape[0]} finite values (4 behaviour scores, 3 "
-                             f"parameters in [-1, 1]), got {action!r}.")
+            raise InvalidValueError(f"action must be {self.action_space.shape[0]} finite values ({len(BEHAVIORS)} "
+                                    f"behaviour scores, 3 parameters in [-1, 1]), got {action!r}.")
         return {"behavior": int(np.argmax(a[: len(BEHAVIORS)])), "params": a[len(BEHAVIORS):].astype(np.float32)}
 
 

@@ -22,7 +22,7 @@ from affordance_env.registry import check_behavior_name
 
 #: Where objects are placed: ``"canonical"``, uniform within +-3 cm of the paper's spot in front of the robot;
 #: ``"workspace"``, uniform over the workspace of the behaviour (:mod:`affordance_env.workspace`; in
-#: TapAffordanceGoal-v1, the union of the four behaviours' workspaces).
+#: TapAffordanceGoal-v2, the union of the behaviours' workspaces).
 POSITION_RANGES = ("canonical", "workspace")
 
 

@@ -39,7 +39,7 @@ def make_tap_vector_env(num_envs: int = 1, **kwargs: Any) -> gym.vector.VectorEn
 
 
 def make_goal_env(**kwargs: Any) -> gym.Env:
-    """``TapAffordanceGoalEnv(**kwargs)``: the entry point of ``TapAffordanceGoal-v1`` (a function for the reason
+    """``TapAffordanceGoalEnv(**kwargs)``: the entry point of ``TapAffordanceGoal-v2`` (a function for the reason
     given at :func:`make_tap_env`)."""
     from affordance_env.goal_env import TapAffordanceGoalEnv
 
@@ -48,7 +48,7 @@ def make_goal_env(**kwargs: Any) -> gym.Env:
 
 def make_goal_vector_env(num_envs: int = 1, max_episode_steps: int = GOAL_MAX_EPISODE_STEPS,
                          **kwargs: Any) -> gym.vector.VectorEnv:
-    """``gym.make_vec("TapAffordanceGoal-v1", num_envs)``: environments side by side in this process, each
+    """``gym.make_vec("TapAffordanceGoal-v2", num_envs)``: environments side by side in this process, each
     truncated after ``max_episode_steps`` interactions and reset in the same vector step that ends its episode
     (``AutoresetMode.SAME_STEP``, declared in the env's metadata; the episode's last observation and info are in
     ``infos["final_obs"]`` and ``infos["final_info"]``), so that every vector step is an interaction."""
@@ -62,7 +62,7 @@ def make_goal_vector_env(num_envs: int = 1, max_episode_steps: int = GOAL_MAX_EP
 
 
 def register_envs() -> None:
-    """Register ``TapAffordance-v2`` and ``TapAffordanceGoal-v1`` (idempotent)."""
+    """Register ``TapAffordance-v2`` and ``TapAffordanceGoal-v2`` (idempotent)."""
     if GOAL_ENV_ID not in gym.registry:
         gym.register(id=GOAL_ENV_ID, entry_point="affordance_env.registration:make_goal_env",
                      vector_entry_point="affordance_env.registration:make_goal_vector_env",

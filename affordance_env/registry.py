@@ -17,7 +17,7 @@ from affordance_env.exceptions import InvalidValueError
 #: One interaction per episode (Gymnasium's registration: :mod:`affordance_env.registration`).
 ENV_ID = "TapAffordance-v2"
 #: Goal episodes of several interactions on one object, with both arms.
-GOAL_ENV_ID = "TapAffordanceGoal-v1"
+GOAL_ENV_ID = "TapAffordanceGoal-v2"
 #: The environments, as datasets record them.
 ENV_IDS: tuple[str, ...] = (ENV_ID, GOAL_ENV_ID)
 
@@ -44,6 +44,7 @@ REGISTERED: Mapping[str, Registered] = MappingProxyType({
     "tap_back": Registered("right", "stroke"),
     "push": Registered("right", "stroke"),
     "grasp": Registered("left", "grasp"),
+    "draw": Registered("right", "draw"),
 })
 #: The arm that does each behaviour.
 BEHAVIOR_ARMS: Mapping[str, str] = MappingProxyType({name: entry.arm for name, entry in REGISTERED.items()})

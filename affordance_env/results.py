@@ -196,7 +196,8 @@ class InteractionResult:
         """The ``info`` of TapAffordance-v2's ``step`` (fresh arrays: a restored state steps again)."""
         return {
             "object": {"type": self.object_type, "size": self.size,
-                       "initial_pose": self.initial.pose.copy(), "final_pose": self.final_pose.copy()},
+                       "pose": self.final_pose.copy(), "initial_pose": self.initial.pose.copy(),
+                       "final_pose": self.final_pose.copy()},
             "initial_features": self.initial.features.values.copy(),
             "final_features": np.array(self.final_features),
             "effect": self.effect.copy(),

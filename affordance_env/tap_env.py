@@ -119,6 +119,14 @@ class TapAffordanceEnv(gym.Env):
     | 2 | hand speed along the stroke, 0.18 x 3 ** a m/s, at most what the joints' speed limits allow
       (``info["stroke_speed"]``; the hardest tap reaches 0.29-0.54 m/s, the hardest push 0.18-0.35) | 0.06 .. 0.54 m/s |
 
+    For ``behavior="draw"``, 0 is the canonical draw (:mod:`affordance_env.behaviors.draw`):
+
+    | index | meaning | range |
+    |-------|---------|-------|
+    | 0 | lateral offset of the line, across the draw direction (+y) | -2 .. +2 cm |
+    | 1 | drag length: where the palm stops, past the object's centre toward the robot | -2 .. +6 cm |
+    | 2 | hand speed along the line, 0.08 x 2 ** a m/s, at most what the joints' speed limits allow | 0.04 .. 0.16 m/s |
+
     For ``behavior="grasp"``, 0 is the canonical grasp:
 
     | index | meaning | range |
@@ -191,16 +199,17 @@ class TapAffordanceEnv(gym.Env):
     ``"fault"``), ``"snapshot: ..."`` (the robot's head or arm still moved when a snapshot was taken),
     ``"perception: ..."`` (object not visible initially), ``"ik: ..."`` (stroke or grasp not reachable),
     ``"reach: ..."`` (the arm touched the object before the stroke, or the stroke started more than 1 cm from
-    its planned pose), ``"tap: ..."`` (the hand never touched the object). A grasp is invalid only for physics,
-    snapshot, perception or ik: its hand meets the object on the way down, and a miss is a failed grasp
-    (``success`` False), not an invalid one. The next ``reset`` recovers from any of them.
+    its planned pose), ``"tap: ..."`` or ``"draw: ..."`` (the hand never touched the object). A grasp is invalid
+    only for physics, snapshot, perception or ik: its hand meets the object on the way down, and a miss is a
+    failed grasp (``success`` False), not an invalid one. The next ``reset`` recovers from any of them.
 
     ## Arguments
 
     | argument | default | meaning |
     |----------|---------|---------|
     | ``behavior`` | ``"tap"`` | ``"tap"``; ``"tap_back"`` (other side, back of hand); ``"push"`` (from the front);
-      ``"grasp"`` (left arm, fingered hand; see Description) |
+      ``"draw"`` (from behind, toward the robot: :mod:`affordance_env.behaviors.draw`); ``"grasp"`` (left arm,
+      fingered hand; see Description) |
     | ``object_types`` | all four | types to sample from |
     | ``size_range`` | (0.04, 0.10) | object size range [m]; for the grasp it straddles the critical size (about 7 cm;
       spheres, which the fingers wrap, are held up to 10 cm, not at 11): both outcomes occur |
@@ -221,12 +230,13 @@ class TapAffordanceEnv(gym.Env):
       (``"human"`` too) is refused with a ValueError naming these |
     | ``two_arms`` | False | the scene with both arms (:data:`affordance_env.robot_model.VARIANTS` ``"two_arms"``):
       the other arm waits rigid at its home pose, and the relation features are measured to the right palm for every
-      behaviour (the scene of ``TapAffordanceGoal-v1``) |
+      behaviour (the scene of ``TapAffordanceGoal-v2``) |
 
     ## Version History
-    * v2: the grasp's final snapshot is taken where the paper's grasp ends, at the end of its hold with the object
-      held (Akgun et al. 2009: "When the execution ends, another snapshot is taken"), not after the put-down that
-      only a world that goes on needs (``TapAffordanceGoal-v1`` still puts the object down before its snapshot).
+    * v2: ``behavior="draw"`` is offered too (the other behaviours' interactions do not change with it). The
+      grasp's final snapshot is taken where the paper's grasp ends, at the end of its hold with the object held
+      (Akgun et al. 2009: "When the execution ends, another snapshot is taken"), not after the put-down that only a
+      world that goes on needs (``TapAffordanceGoal-v2`` still puts the object down before its snapshot).
       Every motor has its torque-speed curve (its torque falls along its back-EMF line to zero at its no-load
       speed, ``affordance_env.motor_limits.JOINT_TORQUE_SPEED``; the wrist's pitch and yaw motors give 0.94 N m,
       not 2), and the hand's controller keeps each finger's target within its servo's reach of the finger, so a

@@ -174,7 +174,7 @@ class World:
             arm = self._arms[arm_name] = _Arm(variant, (camera_width, camera_height), camera_fovy)
             for name in names:
                 if BEHAVIOR_ARMS[name] == arm_name:
-                    arm.postures[name] = get_behavior(name).prepare(arm.motion, PLACEMENT_CENTRE, typical_size)
+                    arm.postures[name] = self._behavior(name).prepare(arm.motion, PLACEMENT_CENTRE, typical_size)
         self._acting = self._arms[arms[0]]
         self._initial: InitialSnapshot | None = None
         self._q_home = np.zeros(self._acting.kinematics.nq)
@@ -182,6 +182,11 @@ class World:
         low, high = physics.table_extent()
         #: The table top.
         self.table = Table(low, high, physics.table_top)
+
+    def _behavior(self, name: str) -> Behavior:
+        """The behaviour ``name`` as this world runs it: a world whose final snapshot is taken at rest goes on after
+        each interaction (the goal env), and runs the behaviours' goal versions (the grasp: pick and place)."""
+        return get_behavior(name, goal=self.final_snapshot == "rest")
 
     # --- what it is ----------------------------------------------------------------------------------------------
     @property
@@ -302,7 +307,7 @@ class World:
         if initial is None:
             raise RuntimeError("feasible() needs an object: place one first (the env's reset()).")
         self._world_to(arm)  # the world as it is, as an interaction would continue it
-        b = get_behavior(behavior)
+        b = self._behavior(behavior)
         plan = b.plan(initial.geometry, initial.pose[:3], initial.yaw, arm.physics.table_top, a)
         return bool(b.reachable(arm.motion, plan, arm.postures[behavior]))
 
@@ -318,7 +323,7 @@ class World:
             self._acting = arm
             self._q_home = arm.physics.joint_targets()
         initial, self._initial = self._initial, None
-        b = get_behavior(behavior)
+        b = self._behavior(behavior)
         physics, motion = arm.physics, arm.motion
         plan = b.plan(initial.geometry, initial.pose[:3], initial.yaw, physics.table_top, action)
         ended: list[_Final] = []  # the final snapshot, if taken where the behaviour ends as the paper measures it

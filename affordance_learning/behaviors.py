@@ -18,6 +18,7 @@ OUTCOME_WORDS: dict[str, tuple[str, str]] = {
     "grasp": ("lifted and held", "not held"),
     "tap_back": ("rolled", "did not roll"),
     "push": ("moved", "did not move"),
+    "draw": ("moved", "did not move"),
 }
 #: The behaviours of the environment (:mod:`affordance_env.registry`), in the order reports list them: the
 #: paper's two, then the others.

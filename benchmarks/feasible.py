@@ -1,4 +1,4 @@
-"""How often ``feasible()`` of TapAffordanceGoal-v1 agrees with what the interaction then does: its own IK verdict,
+"""How often ``feasible()`` of TapAffordanceGoal-v2 agrees with what the interaction then does: its own IK verdict,
 and whether its reach left the object where it was (no ``"reach: ..."`` failure).
 
     python benchmarks/feasible.py [--draws 400] [--seed 0]

@@ -1,4 +1,4 @@
-"""Cost of an interaction in TapAffordanceGoal-v1 against the same behaviour in TapAffordance-v2, same run.
+"""Cost of an interaction in TapAffordanceGoal-v2 against the same behaviour in TapAffordance-v2, same run.
 
     python benchmarks/goal_env.py [--episodes 40] [--repeats 3]
 

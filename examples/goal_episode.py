@@ -1,4 +1,4 @@
-"""One episode of TapAffordanceGoal-v1, choosing each interaction by trying candidates in simulation.
+"""One episode of TapAffordanceGoal-v2, choosing each interaction by trying candidates in simulation.
 
     python examples/goal_episode.py [--seed 3] [--candidates 12]
 
@@ -22,7 +22,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=3)
     parser.add_argument("--candidates", type=int, default=12, help="random actions per step, besides the canonical")
     args = parser.parse_args()
-    env = gym.make("TapAffordanceGoal-v1")
+    env = gym.make("TapAffordanceGoal-v2")
     world = env.unwrapped
     rng = np.random.default_rng(args.seed)
     obs, info = env.reset(seed=args.seed)

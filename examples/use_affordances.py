@@ -27,7 +27,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=3)
     args = parser.parse_args()
     planner = Planner(fit_models(training_frames(load_dataset(args.dataset), 1000), random_state=0))
-    env = gym.make("TapAffordanceGoal-v1")
+    env = gym.make("TapAffordanceGoal-v2")
     world = env.unwrapped
 
     obs, info = env.reset(seed=args.seed, options={"object_type": "sphere", "size": 0.06, "position": (-0.3, 0.05)})

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from affordance_env.behaviors import BEHAVIORS, check_action, get_behavior, is_success
+from affordance_env.behaviors.draw import DRAW_GAP, DRAW_PAST, DRAW_PAST_RANGE, DRAW_SPEED, PALM_OFFSET
 from affordance_env.behaviors.stroke import CLEARANCE, FOLLOW_THROUGH, SPEED_CANONICAL, half_extent_along, plan_stroke
 from affordance_env.objects import object_geometry
 
@@ -72,7 +73,7 @@ def test_bad_actions(action, match):
 
 
 def test_unknown_behavior_lists_valid_ones():
-    with pytest.raises(ValueError, match="tap, tap_back, push, grasp"):
+    with pytest.raises(ValueError, match="tap, tap_back, push, grasp, draw"):
         get_behavior("pinch")
 
 
@@ -86,3 +87,34 @@ def test_success_rules():
                                   [False, False, True])
     with pytest.raises(ValueError, match="rolled"):
         is_success("slid", True, 0.1)
+
+
+def test_canonical_draw_reaches_behind_the_object_and_drags_it_toward_the_robot():
+    box = object_geometry("box", 0.08)
+    p_object = np.array([-0.30, 0.03, TABLE + 0.04])
+    draw = get_behavior("draw")
+    plan = draw.plan(box, p_object, 0.0, TABLE, np.zeros(3))
+    np.testing.assert_allclose(plan.direction, [1, 0, 0])  # +x: toward the robot
+    # the palm surface starts DRAW_GAP beyond the object's far side, and the palm stops DRAW_PAST past its centre
+    assert p_object[0] - 0.04 - (plan.p_start[0] + PALM_OFFSET) == pytest.approx(DRAW_GAP)
+    assert plan.p_end[0] == pytest.approx(p_object[0] + DRAW_PAST)
+    assert plan.p_start[1] == plan.p_end[1] == pytest.approx(p_object[1])
+    # it drags to the line's end and stops at rest there, instead of a follow-through past the first touch
+    assert plan.follow_through == np.inf and plan.to_rest and plan.speed == pytest.approx(DRAW_SPEED)
+    # it comes from above the start: the hand crosses over the object to get behind it
+    assert plan.p_above[:2] == pytest.approx(plan.p_start[:2]) and plan.p_above[2] - 0.033 > TABLE + 0.08
+    # the palm faces the robot (and the table): it can pull, not only push
+    normal = draw.R_world_hand[:, 2]
+    assert normal[0] > 0.5 and normal[2] < 0
+
+
+def test_draw_action_moves_the_line_across_lengthens_it_and_speeds_it_up():
+    sphere = object_geometry("sphere", 0.06)
+    p_object = np.array([-0.30, 0.03, TABLE + 0.03])
+    draw = get_behavior("draw")
+    base = draw.plan(sphere, p_object, 0.0, TABLE, np.zeros(3))
+    moved = draw.plan(sphere, p_object, 0.0, TABLE, np.array([1.0, 1.0, 1.0]))
+    np.testing.assert_allclose(moved.p_start - base.p_start, [0.0, 0.02, 0.0], atol=1e-12)
+    np.testing.assert_allclose(moved.p_end - base.p_end, [DRAW_PAST_RANGE, 0.02, 0.0], atol=1e-12)
+    assert moved.speed == pytest.approx(2 * DRAW_SPEED)
+    assert draw.plan(sphere, p_object, 0.0, TABLE, np.array([0.0, -1.0, -1.0])).speed == pytest.approx(DRAW_SPEED / 2)

@@ -138,9 +138,9 @@ def test_plan_refuses_an_out_that_holds_what_is_not_its_own(no_work, tmp_path, c
     inside = tmp_path / "inside"
     _manifest(inside / "dataset")
     _refused(["plan", "--out", inside], capsys, f"{inside / 'dataset'} holds a TapAffordance-v2 dataset",
-             "not the plan's TapAffordanceGoal-v1 episodes")
+             "not the plan's TapAffordanceGoal-v2 episodes")
     other_seed = tmp_path / "other-seed"
-    _manifest(other_seed / "dataset", env_id="TapAffordanceGoal-v1", action="random", seed=3)
+    _manifest(other_seed / "dataset", env_id="TapAffordanceGoal-v2", action="random", seed=3)
     _refused(["plan", "--out", other_seed, "--seed", "1"], capsys, "episodes of seed 3, not of --seed 1",
              "give --seed 3")
     reproduction = tmp_path / "reproduction"
@@ -167,7 +167,7 @@ def test_plan_takes_a_new_or_empty_out_or_an_earlier_plans(no_work, tmp_path):
     with pytest.raises(WorkStarted):
         main(["plan", "--out", str(empty)])
     earlier = tmp_path / "earlier"
-    _manifest(earlier / "dataset", env_id="TapAffordanceGoal-v1", action="random", seed=2)
+    _manifest(earlier / "dataset", env_id="TapAffordanceGoal-v2", action="random", seed=2)
     with pytest.raises(WorkStarted):
         main(["plan", "--out", str(earlier), "--seed", "2"])
     (earlier / "results.json").write_text(json.dumps({"format": "tap-affordance-plan-results"}))
@@ -192,7 +192,7 @@ def test_collect_options_that_do_not_go_together_are_refused_before_collecting(n
     collect = ["collect", "--out", out, "--episodes", "3"]
     _refused([*collect, "--size-range", "0.1", "0.05"], capsys, "--size-range 0.1 0.05: expected LOW <= HIGH")
     _refused([*collect, "--scheduler", "joblib", "--dask-address", "tcp://x:1"], capsys, "--dask-address")
-    _refused([*collect, "--env", "TapAffordanceGoal-v1", "--behavior", "push"], capsys, "drop --behavior push")
+    _refused([*collect, "--env", "TapAffordanceGoal-v2", "--behavior", "push"], capsys, "drop --behavior push")
     _refused([*collect, "--object-types", "sphere", "cube"], capsys, "Unknown object type 'cube'")
     _refused([*collect, "--behavior", "juggle"], capsys, "Unknown behavior 'juggle'")
     assert not out.exists()

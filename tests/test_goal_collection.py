@@ -18,7 +18,7 @@ SETTINGS = {"seed": 5, "action": "random", "save_images": False}
 
 
 class StubEnv:
-    """Just enough of TapAffordanceGoal-v1 for ``_goal_episode_rows``: ``feasible`` as told, and a ``step`` that
+    """Just enough of TapAffordanceGoal-v2 for ``_goal_episode_rows``: ``feasible`` as told, and a ``step`` that
     records its actions and returns an interaction with no failure (``interaction_row`` is replaced)."""
 
     def __init__(self, feasible, seen_after=lambda step: True, visible_at_reset=True):
@@ -82,7 +82,7 @@ def test_a_goal_episode_ends_where_the_head_does_not_see_the_object(rows_as_step
 
 def test_truncated_episodes_are_recorded_and_a_dataset_of_other_rules_is_not_resumed(tmp_path, monkeypatch):
     monkeypatch.setattr(TapAffordanceGoalEnv, "feasible", lambda self, behavior, params: False)
-    run = {"seed": 2, "action": "random", "chunk_size": 2, "progress": False, "env_id": "TapAffordanceGoal-v1",
+    run = {"seed": 2, "action": "random", "chunk_size": 2, "progress": False, "env_id": "TapAffordanceGoal-v2",
            "env_options": SMALL}
     out = collect(tmp_path / "goal", 2, **run)
     meta, rows = chunk_metadata(out / chunk_name(0))

@@ -1,4 +1,4 @@
-"""Collections of TapAffordanceGoal-v1 episodes: a row per interaction with its episode and step, and the goal."""
+"""Collections of TapAffordanceGoal-v2 episodes: a row per interaction with its episode and step, and the goal."""
 
 import json
 
@@ -13,7 +13,7 @@ from affordance_env.workspace import in_any_workspace
 
 SMALL = {"camera_width": 32, "camera_height": 24}
 RUN = {"seed": 3, "action": "random", "chunk_size": 3, "progress": False, "max_failure_share": 1.0,
-       "env_id": "TapAffordanceGoal-v1"}
+       "env_id": "TapAffordanceGoal-v2"}
 
 
 @pytest.fixture(scope="module")
@@ -25,11 +25,11 @@ def goal_dir(tmp_path_factory):
 def test_goal_episodes_are_rows_of_interactions_with_episode_step_and_goal(goal_dir):
     frame = load_dataset(goal_dir)
     manifest = read_manifest(goal_dir)
-    assert manifest["settings"]["env_id"] == "TapAffordanceGoal-v1"
+    assert manifest["settings"]["env_id"] == "TapAffordanceGoal-v2"
     assert "behavior" not in manifest["settings"]["env_options"]  # the env chooses it at every step
     assert manifest["rows"] == len(frame) > 6  # several interactions per episode
     command = collect_command(goal_dir, manifest)  # what an error message tells a user to run
-    assert "--env TapAffordanceGoal-v1" in command and "--position-range workspace" in command
+    assert "--env TapAffordanceGoal-v2" in command and "--position-range workspace" in command
     assert {"step", *GOAL_COLUMNS} <= set(frame.columns)
     assert set(frame["behavior"]) <= set(BEHAVIORS) and frame["behavior"].nunique() >= 3
     truncated = {k: v for chunk in sorted(goal_dir.glob("chunk-*.parquet"))
@@ -66,7 +66,7 @@ def test_goal_episodes_resume_to_the_same_rows(goal_dir, tmp_path):
 
 
 def test_the_goal_env_takes_no_behavior_option(tmp_path):
-    with pytest.raises(ValueError, match="chooses among all four behaviours"):
+    with pytest.raises(ValueError, match="chooses among all the behaviours"):
         collect(tmp_path / "x", 2, env_options={"behavior": "tap"}, **RUN)
 
 
@@ -86,5 +86,5 @@ def test_the_minari_export_refuses_goal_episodes_with_a_reason(goal_dir):
     pytest.importorskip("minari")
     from affordance_env.dataset.minari_export import export_minari
 
-    with pytest.raises(ValueError, match="holds TapAffordanceGoal-v1 episodes"):
+    with pytest.raises(ValueError, match="holds TapAffordanceGoal-v2 episodes"):
         export_minari(goal_dir, "tap-affordance/goal-v0")

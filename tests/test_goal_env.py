@@ -1,4 +1,4 @@
-"""TapAffordanceGoal-v1: four behaviours in one world, an object that stays, goals, snapshots and reach."""
+"""TapAffordanceGoal-v2: five behaviours in one world, an object that stays, goals, snapshots and reach."""
 
 import gymnasium as gym
 import numpy as np
@@ -23,10 +23,10 @@ def env():
 
 
 def test_check_env_and_registration():
-    env = gym.make("TapAffordanceGoal-v1", **SMALL)
+    env = gym.make("TapAffordanceGoal-v2", **SMALL)
     check_env(env.unwrapped, skip_render_check=True)
     assert env.spec.max_episode_steps == 5
-    assert env.unwrapped.behaviors == ("tap", "tap_back", "push", "grasp")
+    assert env.unwrapped.behaviors == ("tap", "tap_back", "push", "grasp", "draw")
     env.close()
 
 
@@ -36,8 +36,9 @@ def test_the_object_stays_where_the_interaction_left_it_for_every_behaviour(env)
     np.testing.assert_allclose(obs["desired_goal"], (-0.45, -0.2))
     pose = info["object"]["pose"]
     for k, behavior in enumerate(BEHAVIORS):
+        reachable = env.feasible(k, np.zeros(3))
         obs, reward, terminated, truncated, info = env.step({"behavior": k, "params": np.zeros(3, np.float32)})
-        assert info["behavior"] == behavior and info["failure"] is None, info["failure"]
+        assert info["behavior"] == behavior and (info["failure"] is None) == reachable, info["failure"]
         # each interaction starts where the last one left the object (at rest while the head turned to it)
         np.testing.assert_allclose(info["object"]["initial_pose"], pose, atol=1e-9)
         pose = info["object"]["final_pose"]
@@ -52,10 +53,55 @@ def test_interactions_of_the_two_arms_move_the_object_their_way(env):
     _, _, _, _, tap = env.step({"behavior": "tap", "params": np.zeros(3)})
     assert tap["displacement"] > 0.05 and tap["success"]  # the ball rolls
     env.reset(seed=1, options={"object_type": "box", "size": 0.05, "position": (-0.30, 0.05)})
-    _, _, _, _, grasp = env.step({"behavior": "grasp", "params": np.zeros(3)})
+    _, _, _, _, grasp = env.step({"behavior": "grasp", "params": np.array([0.0, -0.3, 0.0])})
     assert grasp["success"] and grasp["grasp"]["rise"] > 0.05  # the left hand lifts it ...
     moved = grasp["object"]["final_pose"][:2] - grasp["object"]["initial_pose"][:2]
-    assert moved[1] < -0.04  # ... and puts it down to the robot's left (-y in the root frame)
+    assert moved[1] < -0.05  # ... and puts it down to the robot's left (-y in the root frame), as asked
+    env.reset(seed=1, options={"object_type": "box", "size": 0.05, "position": (-0.32, 0.0)})
+    _, _, _, _, draw = env.step({"behavior": "draw", "params": np.zeros(3)})
+    moved = draw["object"]["final_pose"][:2] - draw["object"]["initial_pose"][:2]
+    assert draw["failure"] is None and moved[0] > 0.04 and abs(moved[1]) < 0.02  # toward the robot (+x)
+
+
+@pytest.mark.parametrize(("object_type", "position", "params"), [
+    ("box", (-0.30, 0.10), (0.4, 0.3, 0.0)),
+    ("vertical_cylinder", (-0.32, 0.05), (-0.3, 0.5, 0.0)),
+    ("sphere", (-0.28, 0.12), (0.25, -0.4, 0.0)),
+])
+def test_pick_and_place_puts_a_held_object_down_at_rest_where_asked(env, object_type, position, params):
+    from affordance_env.behaviors.grasp import PLACE_RANGE
+
+    env.reset(seed=0, options={"object_type": object_type, "size": 0.05, "position": position})
+    start = env.get_state()
+    assert env.feasible("grasp", params)
+    _, _, _, _, info = env.step({"behavior": "grasp", "params": np.array(params, np.float32)})
+    asked = np.asarray(info["object"]["initial_pose"][:2]) + PLACE_RANGE * np.asarray(params[:2])
+    assert info["success"] and info["outcome"] == "rest"
+    assert np.linalg.norm(info["object"]["pose"][:2] - asked) < 0.01
+    # a place off the table is refused before anything moves
+    assert not env.feasible("grasp", (1.0, 0.0, 0.0), state=start)
+
+
+def test_feasible_from_a_snapshot_answers_for_it_and_leaves_the_env_as_it_was(env):
+    env.reset(seed=0, options={"object_type": "box", "size": 0.06, "position": (-0.30, 0.05)})
+    start = env.get_state()
+    env.step({"behavior": "push", "params": np.zeros(3)})  # the box is now elsewhere
+    now = env.get_state()
+    params = np.array([0.0, 0.0, 0.0])
+    answers = {b: env.feasible(b, params, state=start) for b in BEHAVIORS}
+    after = env.get_state()
+    for field in ("qpos", "qvel", "ctrl", "act"):  # nothing moved
+        np.testing.assert_array_equal(getattr(after.world.physics[1], field), getattr(now.world.physics[1], field))
+    assert after.world.arm == now.world.arm and after.obs is now.obs
+    env.set_state(start)
+    assert answers == {b: env.feasible(b, params) for b in BEHAVIORS}
+
+
+def test_the_object_pose_has_the_same_key_after_reset_and_after_step(env):
+    _, info = env.reset(seed=3)
+    assert set(info["object"]) >= {"pose"}
+    _, _, _, _, info = env.step({"behavior": "tap", "params": np.zeros(3)})
+    np.testing.assert_array_equal(info["object"]["pose"], info["object"]["final_pose"])
 
 
 def test_relation_features_are_measured_to_the_same_palm_whichever_arm_acts():
@@ -91,7 +137,7 @@ def test_compute_reward_is_vectorised_and_matches_the_tolerance(env):
 
 
 def test_reaching_the_goal_terminates_and_an_episode_is_truncated_after_five_steps():
-    env = gym.make("TapAffordanceGoal-v1", **SMALL)
+    env = gym.make("TapAffordanceGoal-v2", **SMALL)
     obs, _ = env.reset(seed=2, options={"object_type": "box", "size": 0.05, "position": (-0.30, 0.05)})
     env.unwrapped._goal = obs["achieved_goal"].copy()  # already there: any interaction that leaves it ends it
     _, reward, terminated, _, info = env.step({"behavior": "grasp", "params": np.array([0.0, 0.0, 1.0])})
@@ -147,7 +193,7 @@ def test_bad_actions_options_and_goals_get_clear_errors(env):
     env.reset(seed=0)
     with pytest.raises(ValueError, match="Unknown behavior 'kick'"):
         env.step({"behavior": "kick", "params": np.zeros(3)})
-    with pytest.raises(ValueError, match="index in 0..3"):
+    with pytest.raises(ValueError, match="index in 0..4"):
         env.step({"behavior": 7, "params": np.zeros(3)})
     with pytest.raises(ValueError, match=r"\[-1, 1\]"):
         env.step({"behavior": 0, "params": np.full(3, 2.0)})
@@ -161,10 +207,10 @@ def test_bad_actions_options_and_goals_get_clear_errors(env):
 
 def test_flat_action_wrapper_runs_the_highest_scoring_behaviour():
     wrapper = FlatActionWrapper(TapAffordanceGoalEnv.__new__(TapAffordanceGoalEnv))
-    assert wrapper.action_space.shape == (7,)
-    action = wrapper.action(np.array([0.1, -0.2, 0.9, 0.3, 0.5, -0.5, 0.0]))
+    assert wrapper.action_space.shape == (8,)
+    action = wrapper.action(np.array([0.1, -0.2, 0.9, 0.3, -0.4, 0.5, -0.5, 0.0]))
     assert action["behavior"] == 2 and action["params"].tolist() == [0.5, -0.5, 0.0]
-    with pytest.raises(ValueError, match="7 finite values"):
+    with pytest.raises(ValueError, match="8 finite values"):
         wrapper.action(np.zeros(3))
 
 
@@ -196,7 +242,7 @@ def test_workspaces_sample_inside_themselves():
 
 
 def test_every_vector_step_is_an_interaction():
-    envs = gym.make_vec("TapAffordanceGoal-v1", 2, camera_width=32, camera_height=24)
+    envs = gym.make_vec("TapAffordanceGoal-v2", 2, camera_width=32, camera_height=24)
     assert envs.metadata["autoreset_mode"] == gym.vector.AutoresetMode.SAME_STEP
     envs.reset(seed=0)
     ended = 0

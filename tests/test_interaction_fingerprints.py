@@ -26,7 +26,7 @@ OPTIONS = {"camera_width": 40, "camera_height": 30}
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("behavior", ["tap", "tap_back", "push", "grasp"])
+@pytest.mark.parametrize("behavior", ["tap", "tap_back", "push", "grasp", "draw"])
 def test_interactions_at_random_actions_stay_the_same(behavior, tmp_path):
     out = collect(tmp_path / behavior, episodes=EPISODES, seed=0, workers=1, action="random",
                   env_options={"behavior": behavior, **OPTIONS}, chunk_size=EPISODES, progress=False)

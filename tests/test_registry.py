@@ -33,7 +33,7 @@ def test_an_unknown_name_is_refused_with_the_valid_ones(check):
     assert check("push") == "push"
     with pytest.raises(ValueError, match="Unknown behavior 'kick'. Valid behaviors: tap, tap_back, push, grasp"):
         check("kick")
-    with pytest.raises(ValueError, match="Valid ids: TapAffordance-v2, TapAffordanceGoal-v1"):
+    with pytest.raises(ValueError, match="Valid ids: TapAffordance-v2, TapAffordanceGoal-v2"):
         registry.check_env_id("TapAffordance-v0")
 
 

@@ -2,8 +2,10 @@
 
 - :mod:`~affordance_env.behaviors.stroke`: ``tap``, ``tap_back``, ``push``, a straight line of the right hand
   through the object;
+- :mod:`~affordance_env.behaviors.draw`: ``draw``, the right hand reaches behind the object and drags it toward
+  the robot;
 - :mod:`~affordance_env.behaviors.grasp`: ``grasp``, the fingered left hand takes the object from above, lifts,
-  holds and puts it down beside.
+  holds and puts it down beside (in the goal env: where its action asks, pick and place).
 
 Each implements :class:`~affordance_env.behaviors.base.Behavior`, the protocol the world runs
 (:class:`affordance_env.world.World`). The registry (:data:`affordance_env.registry.REGISTERED`) names every
@@ -26,10 +28,16 @@ if TYPE_CHECKING:
     from affordance_env.behaviors.base import Behavior
 
 
-def get_behavior(name: str) -> Behavior:
+def get_behavior(name: str, goal: bool = False) -> Behavior:
     """The behaviour called ``name``, from the module the registry names for it; raises InvalidValueError listing
-    the valid names."""
+    the valid names.
+
+    With ``goal``, the behaviour as a world that goes on after it runs it (the goal env), where its module defines
+    one (its ``GOAL_BEHAVIORS``): the grasp then puts the object down where its action asks (pick and place).
+    """
     module = importlib.import_module(f"{__name__}.{REGISTERED[check_behavior_name(name)].module}")
+    if goal and name in getattr(module, "GOAL_BEHAVIORS", {}):
+        return module.GOAL_BEHAVIORS[name]
     return module.BEHAVIORS[name]
 
 

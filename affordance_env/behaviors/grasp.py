@@ -96,6 +96,9 @@ LIFT_HEIGHT, HOLD_TIME = 0.08, 1.0
 #: Where the object is put down, relative to where it was [m] (world x, y): to the robot's left, towards the
 #: arm, so that a grasped object ends 6 cm from where it stood: the final snapshot shows the grasp's effect.
 PLACE_SHIFT = (0.0, -0.06)
+#: Pick and place: where the object goes at action[0] = +-1 (along x) and action[1] = +-1 (along y) [m], from
+#: where it stood.
+PLACE_RANGE = 0.2
 #: The palm lowers the object to this height above the grasp pose [m] before the hand opens: a held object that
 #: has not slipped is released a few millimetres above the table.
 PLACE_CLEARANCE = 0.004
@@ -135,6 +138,8 @@ class GraspPlan:
         hold_time: How long the lifted object is held still [s].
         hand_open, hand_closed, hand_release: Targets of the driven finger joints [rad], by joint name: the
             open hand of the approach, the closed hand, and the hand that lets go.
+        object_place: Where the held object's centre is put down (x, y) [m], the carry aiming the object there
+            as it hangs in the hand (pick and place); None: the hand carries to ``p_place``.
     """
 
     p_above: np.ndarray
@@ -148,6 +153,7 @@ class GraspPlan:
     hand_open: dict[str, float]
     hand_closed: dict[str, float]
     hand_release: dict[str, float]
+    object_place: np.ndarray | None = None
 
 
 def plan_grasp(
@@ -169,10 +175,14 @@ def plan_grasp(
     top = float(p_world_object[2]) + geometry.half_height
     if top <= table_top:
         raise InvalidValueError(f"the object's top ({top:.3f} m) must be above the table top ({table_top:.3f} m).")
-    centre_hand = np.array([GRASP_CENTRE_HAND[0], GRASP_CENTRE_HAND[1] + a[1] * GRASP_LATERAL_RANGE, 0.0])
+    if behavior.places:  # pick and place: the hand takes the object as the canonical grasp does
+        shift, height, lateral = PLACE_RANGE * a[:2], 0.0, 0.0
+    else:
+        shift, height, lateral = np.array(PLACE_SHIFT), a[0], a[1]
+    centre_hand = np.array([GRASP_CENTRE_HAND[0], GRASP_CENTRE_HAND[1] + lateral * GRASP_LATERAL_RANGE, 0.0])
     p_grasp = np.array([p_world_object[0], p_world_object[1], 0.0]) - matmul(R, centre_hand)
-    p_grasp[2] = top + GRASP_GAP + a[0] * GRASP_HEIGHT_RANGE
-    p_place = p_grasp + np.array([PLACE_SHIFT[0], PLACE_SHIFT[1], PLACE_CLEARANCE])
+    p_grasp[2] = top + GRASP_GAP + height * GRASP_HEIGHT_RANGE
+    p_place = p_grasp + np.array([shift[0], shift[1], PLACE_CLEARANCE])
     return GraspPlan(
         p_above=np.array([p_grasp[0], p_grasp[1], max(p_grasp[2], top + OPEN_HAND_DEPTH + GRASP_GUARD_CLEARANCE)]),
         p_grasp=p_grasp,
@@ -185,6 +195,7 @@ def plan_grasp(
         hand_open=dict(HAND_OPEN),
         hand_closed=dict(HAND_CLOSED),
         hand_release=dict(HAND_RELEASE),
+        object_place=(np.array([p_world_object[0], p_world_object[1]]) + shift) if behavior.places else None,
     )
 
 
@@ -375,6 +386,8 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan, at_end: Callable[[], None
         # the table; there along a straight line, which never dips towards the table.
         z_touch = float(motion.palm[2]) - (physics.object_bottom() - physics.table_top)
         p_carry = np.array([plan.p_place[0], plan.p_place[1], z_touch + PLACE_APPROACH])
+        if plan.object_place is not None:  # the object, as it hangs in the hand now, over the place asked
+            p_carry[:2] = plan.object_place + (motion.palm[:2] - physics.object_pose()[:2])
         carry = motion.line(motion.palm.copy(), p_carry, hand, CARRY_SPEED)
         results += carry.results
         motion.follow_line(carry)
@@ -414,12 +427,16 @@ class GraspBehavior:
             for an object at zero yaw, (3, 3).
         description: One line for the documentation.
         robot: The robot variant it needs.
+        places: Pick and place: action[0] and action[1] name where the held object is put down, PLACE_RANGE
+            times them from where it stood along x and y (the hand takes it as the canonical grasp does), instead
+            of the grasp's height and lateral offset (the object then goes down PLACE_SHIFT beside).
     """
 
     name: str
     R_world_hand: np.ndarray
     description: str
     robot: str = "grasp"
+    places: bool = False
     kind: ClassVar[str] = "grasp"
 
     def prepare(self, motion: MotionExecutor, placement_centre: np.ndarray, size: float) -> None:
@@ -434,6 +451,10 @@ class GraspBehavior:
         return run_grasp(motion, plan, at_end)
 
     def reachable(self, motion: MotionExecutor, plan: GraspPlan, posture: np.ndarray | None) -> bool:
+        if plan.object_place is not None:  # pick and place puts the object down on the table, or not at all
+            low, high = motion.physics.table_extent()
+            if np.any(plan.object_place < low) or np.any(plan.object_place > high):
+                return False
         return grasp_reachable(motion, plan)
 
     def via_home(self, outcome: GraspOutcome) -> np.ndarray | None:
@@ -459,5 +480,14 @@ BEHAVIORS: Mapping[str, GraspBehavior] = {
     "grasp": GraspBehavior(
         "grasp", grasp_orientation(0.0),
         "grasp from above with the fingered left hand, lift 8 cm, hold 1 s, put down 6 cm to the robot's left",
+    ),
+}
+#: The grasp as a world that goes on runs it (the goal env): pick and place, the held object put down where the
+#: action asks (:attr:`GraspBehavior.places`).
+GOAL_BEHAVIORS: Mapping[str, GraspBehavior] = {
+    "grasp": GraspBehavior(
+        "grasp", grasp_orientation(0.0),
+        "pick and place: grasp from above with the fingered left hand, lift 8 cm, hold 1 s, put down where asked",
+        places=True,
     ),
 }

@@ -94,6 +94,10 @@ CROSSING_CLEARANCE = 0.08
 #: the object at most this much before the stroke [m]; otherwise the interaction is marked failed.
 MAX_START_ERROR, MAX_OBJECT_MOVED_BEFORE = 0.01, 0.003
 
+#: The stroke reaches its speed in this time [s] from rest, within the first 3 cm (the clearance before the
+#: object) even at its fastest.
+STROKE_RAMP = 0.1
+
 
 @dataclass(frozen=True)
 class StrokePlan:
@@ -109,6 +113,9 @@ class StrokePlan:
         R_world_hand: Hand orientation during the stroke.
         follow_through: Travel after first contact [m].
         joint_ranges: The behaviour's joint ranges for the IK (:attr:`StrokeBehavior.joint_ranges`).
+        to_rest: Whether the line ends at rest (the draw, which drags the object to its end); else at speed (the
+            strokes, which stop ``follow_through`` past the first touch).
+        ramp: Time [s] in which the line reaches its speed from rest (and comes to rest, with ``to_rest``).
     """
 
     p_above: np.ndarray | None
@@ -119,6 +126,8 @@ class StrokePlan:
     R_world_hand: np.ndarray
     follow_through: float
     joint_ranges: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    to_rest: bool = False
+    ramp: float = STROKE_RAMP
 
 
 def half_extent_along(geometry: ObjectGeometry, yaw: float, direction: np.ndarray) -> float:
@@ -170,9 +179,6 @@ def plan_stroke(
     )
 
 
-#: The stroke reaches its speed in this time [s] from rest, within the first 3 cm (the clearance before the
-#: object) even at its fastest.
-STROKE_RAMP = 0.1
 #: The reach's servo targets must keep the arm's geoms (hand, fingers, wrist, forearm) at least this far from the
 #: object [m] (checked every REACH_SWEEP_STRIDE control ticks), else the stroke is not feasible: an arm that sweeps
 #: into the object moves it before the stroke (a "reach" failure). Over 150 random strokes per behaviour at
@@ -244,8 +250,7 @@ def plan_stroke_path(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarr
     length = dot(plan.p_end - plan.p_start, plan.direction)
     # The joint speeds along the whole line cap the stroke's speed.
     path = LinePath(motion, plan.p_start, plan.direction, length, hand_target(plan), plan.speed, start.q,
-                    ramp=STROKE_RAMP,
-                    to_rest=False)
+                    ramp=plan.ramp, to_rest=plan.to_rest)
     return above, start, path
 
 

@@ -215,9 +215,9 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) ->
 def _full_options(env_options: dict[str, Any], env_id: str = ENV_IDS[0]) -> dict[str, Any]:
     """The env options with every default filled in, as JSON values, so that equal settings compare equal;
     checked (:class:`~affordance_env.options.EnvOptions`) without building an env or importing the simulator.
-    TapAffordanceGoal-v1 chooses the behaviour at every step: it has no ``behavior`` option."""
+    TapAffordanceGoal-v2 chooses the behaviour at every step: it has no ``behavior`` option."""
     if env_id == GOAL_ENV_ID and "behavior" in env_options:
-        raise InvalidValueError(f"{GOAL_ENV_ID} chooses among all four behaviours at every step: drop the behavior "
+        raise InvalidValueError(f"{GOAL_ENV_ID} chooses among all the behaviours at every step: drop the behavior "
                          f"option (--behavior), got {env_options['behavior']!r}.")
     EnvOptions.checked(**env_options)
     full = {f.name: f.default for f in dataclasses.fields(EnvOptions)}
@@ -283,7 +283,7 @@ def collect(
             zstd-compressed; read them with ``load_dataset(out, with_images=True)`` and :func:`images`.
         max_failure_share: Stop with :class:`FailureShareError` once more than this share of the interactions
             collected so far were marked failed by the environment, in [0, 1] (1 accepts any).
-        env_id: ``"TapAffordance-v2"`` (one interaction per episode, a row each) or ``"TapAffordanceGoal-v1"``:
+        env_id: ``"TapAffordance-v2"`` (one interaction per episode, a row each) or ``"TapAffordanceGoal-v2"``:
             goal episodes of up to 5 interactions (``GOAL_MAX_EPISODE_STEPS``), each a behaviour drawn uniformly
             with its parameters by ``action``, drawn again (up to ``GOAL_ACTION_DRAWS`` times) until the arm can
             reach it (``feasible``), one row per interaction with its ``step`` and the goal columns. An action that

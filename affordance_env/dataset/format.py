@@ -22,7 +22,7 @@ The columns fall in namespaces that cannot be confused (:func:`arrow_schema`):
   :data:`GROUND_TRUTH_COLUMNS` (``type``, ``size``, ``success``, ...);
 - the action: ``action_<j>``; the images: ``image_<stage>_<kind>`` (:data:`IMAGE_COLUMNS`);
 - bookkeeping: ``episode``, ``seed``, ``behavior``;
-- in a dataset of TapAffordanceGoal-v1 episodes (``env_id``), one row per interaction of an episode, also
+- in a dataset of TapAffordanceGoal-v2 episodes (``env_id``), one row per interaction of an episode, also
   ``step`` (0, 1, ... within the episode) and the goal: :data:`GOAL_COLUMNS`.
 """
 
@@ -73,7 +73,7 @@ IMAGE_COLUMNS = tuple(f"image_{stage}_{kind}" for stage in STAGES for kind in ("
 #: The manifest's record of each finished chunk's SHA-256 (hex), by file name.
 CHECKSUMS = "chunk_sha256"
 #: The environments a dataset can be collected from: one interaction per episode, or goal episodes of several.
-#: The goal columns of a dataset of TapAffordanceGoal-v1 episodes: the goal (x, y) [m], where the object was seen
+#: The goal columns of a dataset of TapAffordanceGoal-v2 episodes: the goal (x, y) [m], where the object was seen
 #: after the interaction (``achieved_goal``) [m], its distance to the goal [m] and whether it reached it.
 GOAL_COLUMNS = ("goal_x", "goal_y", "achieved_x", "achieved_y", "goal_distance", "goal_reached")
 #: Settings added after the first datasets, with the value every dataset made before had: a dataset that lacks
@@ -84,7 +84,7 @@ LATER_ENV_OPTIONS = {"position_range": "canonical"}
 
 def arrow_schema(save_images: bool = False, goal: bool = False) -> pa.Schema:
     """The columns of every chunk, in order: bookkeeping, action, ground truth, (goal,) 3 x 49 features, images.
-    ``goal``: a dataset of TapAffordanceGoal-v1 episodes, with ``step`` and :data:`GOAL_COLUMNS`."""
+    ``goal``: a dataset of TapAffordanceGoal-v2 episodes, with ``step`` and :data:`GOAL_COLUMNS`."""
     fields = [("episode", pa.int64())] + ([("step", pa.int64())] if goal else [])
     fields += [("seed", pa.int64()), ("behavior", pa.string()), ("type", pa.string()), ("size", pa.float64())]
     fields += [(f"action_{j}", pa.float32()) for j in range(ACTION_DIM)]
@@ -104,7 +104,7 @@ def arrow_schema(save_images: bool = False, goal: bool = False) -> pa.Schema:
 
 @dataclass(frozen=True)
 class GoalStep:
-    """Where a TapAffordanceGoal-v1 episode stands after one of its interactions.
+    """Where a TapAffordanceGoal-v2 episode stands after one of its interactions.
 
     Attributes:
         step: The interaction's index in its episode.
@@ -125,7 +125,7 @@ def interaction_row(episode: int, env_seed: int, result: InteractionResult, save
                     goal: GoalStep | None = None) -> dict[str, Any]:
     """The row of a valid interaction (``result.failure`` is None; a failed one has no row, InvalidValueError).
     A row with non-finite numbers raises RuntimeError: a bug, not a failed interaction. ``goal``: the interaction
-    is a step of a TapAffordanceGoal-v1 episode."""
+    is a step of a TapAffordanceGoal-v2 episode."""
     if result.failure is not None:
         raise InvalidValueError(f"interaction {episode} failed ({result.failure}): a failed interaction has no row.")
     row: dict[str, Any] = {"episode": episode, "seed": env_seed, "behavior": result.behavior,
@@ -220,9 +220,10 @@ def dataset_header(seed: int, action: str, chunk_size: int, env_options: dict, s
 
 
 def is_goal_dataset(description: dict) -> bool:
-    """Whether the dataset (its manifest, or a chunk's metadata) holds TapAffordanceGoal-v1 episodes."""
+    """Whether the dataset (its manifest, or a chunk's metadata) holds goal episodes (TapAffordanceGoal-v2, or an
+    earlier version)."""
     settings = description.get("settings")
-    return isinstance(settings, dict) and settings.get("env_id") == GOAL_ENV_ID
+    return isinstance(settings, dict) and str(settings.get("env_id")).startswith(GOAL_ENV_ID.rsplit("-", 1)[0] + "-")
 
 
 def with_later_defaults(settings: dict) -> dict[str, Any]:

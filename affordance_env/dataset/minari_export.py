@@ -208,7 +208,7 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
     frame = load_dataset(dataset, with_images=True)
     manifest = frame.attrs["manifest"]
     if is_goal_dataset(manifest):
-        raise DatasetError(f"{dataset} holds TapAffordanceGoal-v1 episodes; the Minari export writes one "
+        raise DatasetError(f"{dataset} holds TapAffordanceGoal-v2 episodes; the Minari export writes one "
                            "TapAffordance-v2 episode per interaction and does not take goal episodes: read them "
                            "with load_dataset (a row per interaction, with 'episode' and 'step').")
     options = manifest["settings"]["env_options"]
