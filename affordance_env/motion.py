@@ -452,9 +452,10 @@ class MotionExecutor:
                 if not state["clear"]:
                     state["clear"] = physics.arm_object_distance(HOME_CLEARANCE) >= HOME_CLEARANCE
                     return False
-                state["touched"] = state["touched"] or physics.hand_touches_object()
                 # once clear, only whether the arm is that near counts, and only if it stops the move
-                return stop_near and physics.arm_near_object(HOME_CLEARANCE)
+                near, touching = physics.arm_near_or_touching(HOME_CLEARANCE)
+                state["touched"] = state["touched"] or touching
+                return stop_near and near
             return near
 
         waited = self.move_through([q_home] if via is None else [via, q_home], until=watch(True))

@@ -103,6 +103,11 @@ class TapPhysics:
         #: Bounding-sphere radius of each of them [m], as Python floats: the distance checks of every control
         #: tick run in plain Python over a handful of geoms, cheaper than numpy's per-call overhead.
         self._hand_rbound = model.geom_rbound[self.hand_geoms].tolist()
+        #: The largest distance [m] at which MuJoCo may make a contact between bounding spheres: their margin
+        #: (of a geom, or of an explicit pair); infinite if one of those geoms has no bounding sphere, which
+        #: MuJoCo's test then skips (:meth:`arm_near_or_touching`).
+        margins = [*model.geom_margin.tolist(), *model.pair_margin.tolist()]
+        self._contact_margin = max(margins) if all(r > 0 for r in self._hand_rbound) else math.inf
         #: Torque limit of each active joint's motor [N m] (inf for a joint without a motor of its own).
         ids = self._joint_ids
         self.torque_limit = np.where(model.jnt_actfrclimited[ids], model.jnt_actfrcrange[ids, 1], np.inf)
@@ -328,9 +333,26 @@ class TapPhysics:
     def arm_near_object(self, max_distance: float) -> bool:
         """Whether :meth:`arm_object_distance` (of the simulated state) is below ``max_distance`` [m]: the same
         answer, measuring only until a geom is found that near."""
+        return self._any_nearer(self._hand_geoms_near(self.data, max_distance), max_distance)
+
+    def arm_near_or_touching(self, max_distance: float) -> tuple[bool, bool]:
+        """``(arm_near_object(max_distance), hand_touches_object())``, the contacts read only where they can be.
+
+        MuJoCo makes no contact between two geoms whose bounding spheres are farther apart than their margin, so
+        while no geom's bounding sphere is within ``max_distance`` of the object's (and ``max_distance`` exceeds
+        every margin of the model), the hand cannot touch the object: both answers are False without reading the
+        contacts. What watches the arm at every control tick asks this."""
+        near = self._hand_geoms_near(self.data, max_distance)
+        if not near and max_distance > self._contact_margin:
+            return False, False
+        return self._any_nearer(near, max_distance), self.hand_touches_object()
+
+    def _any_nearer(self, geoms: list[int], max_distance: float) -> bool:
+        """Whether ``min`` of the distances [m] between ``geoms`` and the object (``mj_geomDistance`` up to
+        ``max_distance``) is below ``max_distance``: the same answer, measuring only until a geom is that near."""
         model, data, obj = self.model, self.data, self.active_geom
         nearest = None
-        for g in self._hand_geoms_near(data, max_distance):
+        for g in geoms:
             distance = mujoco.mj_geomDistance(model, data, g, obj, max_distance, None)
             # min()'s running minimum: the first distance, then any smaller one
             if nearest is None or distance < nearest:

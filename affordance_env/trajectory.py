@@ -101,6 +101,8 @@ def minimum_jerk(q_from: np.ndarray, waypoints: list[np.ndarray] | np.ndarray, v
     for k in range(1, len(deltas)):
         starts[k] = starts[k - 1] + lengths[k - 1] - blend * min(lengths[k - 1], lengths[k])
     end = float(np.max(starts + lengths))
+    if not deltas.any():
+        return _hold(q_from, end, dt, duration)
 
     def grid(stretch: float) -> tuple[np.ndarray, float]:
         """Each segment's progress (ticks, segments) at the samples of the move stretched ``stretch`` times, and
@@ -131,6 +133,19 @@ def minimum_jerk(q_from: np.ndarray, waypoints: list[np.ndarray] | np.ndarray, v
     position = tau ** 3 * (10.0 + tau * (6.0 * tau - 15.0))
     acceleration = 60.0 * tau * (1.0 + tau * (2.0 * tau - 3.0)) / lengths ** 2
     return JointTrajectory(q_from + matmul(position, deltas), qd, matmul(acceleration, deltas) / time_scale ** 2, dt)
+
+
+def _hold(q_from: np.ndarray, end: float, dt: float, duration: float | None) -> JointTrajectory:
+    """What :func:`minimum_jerk` gives for a move that goes nowhere (every waypoint at ``q_from``), lasting ``end``
+    [s] unstretched, without its arithmetic: the same samples, bit for bit.
+
+    Every product with a zero delta is zero and einsum sums them from +0, so the velocities and accelerations are
+    +0, no joint exceeds its limit (the move stretches only to ``duration``), and the positions are
+    ``q_from + 0.0`` (a -0 becomes +0, as there)."""
+    stretch = 1.0 if duration is None else max(1.0, duration / end)
+    n = max(1, round(stretch * end / dt))
+    zeros = np.zeros((n, q_from.size))
+    return JointTrajectory(zeros + (q_from + 0.0), zeros, zeros.copy(), dt)
 
 
 def line_profile(length: float, speed: float, dt: float, *, ramp: float = 0.0, from_rest: bool = True,

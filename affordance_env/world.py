@@ -253,7 +253,10 @@ class World:
             uv_hand = np.array([image.intrinsics.cx, image.intrinsics.cy])
         features = compute_features(image.p_world_points, image.ranges, mask, image.p_world_camera, p_world_hand,
                                     uv_hand)
-        points = image.p_world_points[mask]
+        # p_world_points[mask], gathered by the mask's pixel indices from the camera's (3, n) points: the same
+        # (k, 3) row-major array, without boolean indexing of the transposed view
+        pixels = mask.ravel().nonzero()[0]
+        points = image.p_world_points.reshape(-1, 3).T.take(pixels, axis=1).T.copy()
         top = points[points[:, 2] >= points[:, 2].max() - TOP_DEPTH] if len(points) else points
         seen = top[:, :2].mean(axis=0) if len(top) else np.full(2, np.nan)
         ranges = np.where(np.isfinite(image.ranges), image.ranges, 0.0).astype(np.float32)
