@@ -58,7 +58,7 @@ def main() -> None:
         print(line(t, types == t))
     edges = np.quantile(sizes, [0, 1 / 3, 2 / 3, 1])
     for i in range(3):
-        sel = (sizes >= edges[i]) & (sizes <= edges[i + 1])
+        sel = (sizes >= edges[i]) & ((sizes < edges[i + 1]) if i < 2 else (sizes <= edges[i + 1]))
         print(line(f"size {100 * edges[i]:.1f}-{100 * edges[i + 1]:.1f} cm", sel))
     print("outcomes:", dict(Counter(r[4] for r in rows)))
 
