@@ -1,6 +1,6 @@
 """How physical the interactions are, measured from MuJoCo's state at every physics step.
 
-    python benchmarks/physics_audit.py [--episodes 40] [--behavior tap tap_back push grasp] [--seed 1000]
+    python benchmarks/physics_audit.py [--episodes 40] [--behavior tap tap_back push grasp draw] [--seed 1000]
                                        [--action canonical|random]
 
 Canonical interactions (action 0; ``--action random``: uniform in [-1, 1], drawn from the seed) from seeds
@@ -173,6 +173,7 @@ import gymnasium as gym  # noqa: E402
 
 import affordance_env  # noqa: E402,F401
 from affordance_env.registration import ENV_ID  # noqa: E402
+from affordance_env.registry import BEHAVIOR_NAMES  # noqa: E402
 
 _OLD_GRASP_PHASES = ("reach", "descend", "close", "squeeze", "lift", "hold", "place", "open", "retreat")
 
@@ -310,7 +311,7 @@ def report(result: dict) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--episodes", type=int, default=40)
-    parser.add_argument("--behavior", nargs="+", default=["tap", "tap_back", "push", "grasp"])
+    parser.add_argument("--behavior", nargs="+", default=list(BEHAVIOR_NAMES))
     parser.add_argument("--seed", type=int, default=1000)
     parser.add_argument("--action", choices=("canonical", "random"), default="canonical")
     args = parser.parse_args()

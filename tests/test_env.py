@@ -285,10 +285,10 @@ def test_outcome_is_checked_before_the_timeout():
     assert info["outcome"] == "rest"
 
 
-@pytest.mark.parametrize("behavior", ["tap_back", "push"])
+@pytest.mark.parametrize("behavior", ["tap_back", "push", "draw"])
 def test_other_behaviors_reach_their_stroke_and_move_the_object_their_way(behavior):
     # The canonical action over 60 seeds: at most 3 interactions (5 %) may fail, and each valid one moves the object
-    # the way the behaviour strokes (tap_back: +y, push: -x; lying cylinders pushed end-on veer the most).
+    # the way the behaviour strokes (tap_back: +y, push: -x, draw: +x; lying cylinders pushed end-on veer the most).
     env = TapAffordanceEnv(behavior=behavior, camera_width=32, camera_height=32)
     direction = env.behavior.direction
     failures, veered = [], []
@@ -305,10 +305,13 @@ def test_other_behaviors_reach_their_stroke_and_move_the_object_their_way(behavi
         assert np.linalg.norm(travel) > 0.005, seed
         if not travel @ direction > 0.5 * np.linalg.norm(travel):
             veered.append((seed, info["object"]["type"], travel))
+        if behavior == "draw":  # the draw brings every object at least 2 cm toward the robot
+            assert travel[0] >= 0.02, (seed, travel)
     assert len(failures) <= 3, failures
     # a lying cylinder, pushed on its end by the back of the hand turned 15 degrees, may turn aside more than it
     # goes forward (3 of the 60 here: 2 cm aside, 1 cm forward), never anything else
     assert len(veered) <= 4 and all(t == "horizontal_cylinder" for _, t, _ in veered), veered
+    assert not (behavior == "draw" and veered), veered
 
 
 def test_a_stroke_started_off_its_pose_is_reported(monkeypatch):
