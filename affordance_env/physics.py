@@ -395,6 +395,20 @@ class TapPhysics:
             nearest = min(nearest, self.arm_object_distance(nearest, scratch))
         return nearest
 
+    def sweep_table_clearance(self, path: np.ndarray, max_distance: float) -> float:
+        """Smallest distance [m] between the robot's geoms that touch the world and the table top over the joint
+        configurations ``path`` ((k, active joints) [rad]): kinematics only, on the scratch data. ``max_distance``
+        if never nearer."""
+        scratch, model, table = self.scratch, self.model, self.table_geom
+        scratch.qpos[:] = self.data.qpos
+        nearest = max_distance
+        for q in np.atleast_2d(path):
+            scratch.qpos[self.robot_qpos] = q
+            mujoco.mj_kinematics(model, scratch)
+            for g in self.hand_geoms:
+                nearest = min(nearest, mujoco.mj_geomDistance(model, scratch, g, table, nearest, None))
+        return nearest
+
     def hand_touches_object(self) -> bool:
         """Whether any contact joins the hand (or wrist, forearm) and the object."""
         data = self.data

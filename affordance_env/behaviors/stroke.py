@@ -187,6 +187,12 @@ def plan_stroke(
 #: the stroke more than 1 cm from its pose and 1 passed 0.8 mm from the object on its targets) and 4 of 4 of push
 #: (1 wrongly); a 1 cm margin would refuse 8, 17 and 11 strokes that work.
 REACH_CLEARANCE, REACH_SWEEP_STRIDE = 0.0, 5
+#: The reach's servo targets may put the arm's geoms at most this far into the table [m] (checked at the same
+#: samples and at the pre-stroke pose), else the stroke is not feasible: the forearm then rests on the table and
+#: holds the hand off its pre-stroke pose. Over 375 random tap_backs that passed the checks above (objects over its
+#: workspace, the scene with both arms), the 2 whose targets went 6.2 and 8.5 mm into the table started 12-15 mm
+#: off their pose (a "reach" failure); none of the others, down to 4.9 mm; pushes go at most 1.5 mm in.
+REACH_TABLE_PENETRATION = 0.005
 
 
 @dataclass(frozen=True)
@@ -264,12 +270,15 @@ def reach_trajectory(motion: MotionExecutor, above: IKResult | None, start: IKRe
 
 def stroke_reachable(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> bool:
     """Whether :func:`run_stroke` will find every pose of ``plan`` within the IK's tolerances, and its reach keeps
-    the arm ``REACH_CLEARANCE`` from the object; kinematics only."""
+    the arm ``REACH_CLEARANCE`` from the object and out of the table beyond ``REACH_TABLE_PENETRATION``;
+    kinematics only."""
     above, start, path = plan_stroke_path(motion, plan, posture)
     if not ik_verdict([start, *path.results])[0]:
         return False
     samples = reach_trajectory(motion, above, start).q[::REACH_SWEEP_STRIDE]
-    return motion.physics.sweep_clearance(samples, REACH_CLEARANCE) >= REACH_CLEARANCE
+    if motion.physics.sweep_clearance(samples, REACH_CLEARANCE) < REACH_CLEARANCE:
+        return False
+    return motion.physics.sweep_table_clearance(np.vstack([samples, start.q]), 0.0) >= -REACH_TABLE_PENETRATION
 
 
 def run_stroke(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> StrokeOutcome:
