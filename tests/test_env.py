@@ -579,3 +579,19 @@ def test_kinect_noise_model_values():
     assert kinect_axial_sigma(2.0, 0.0) == pytest.approx(1.2e-3 + 1.9e-3 * 1.6**2)
     assert kinect_axial_sigma(1.0, np.pi / 4) == pytest.approx(1.2e-3 + 1.9e-3 * 0.36 + 1e-4 * 1.0)
     assert kinect_axial_sigma(1.0, np.pi / 2) == kinect_axial_sigma(1.0, np.deg2rad(80.0))  # clipped, finite
+
+
+def test_feasible_refuses_a_stroke_whose_reach_rests_the_forearm_on_the_table(monkeypatch):
+    # A low tap_back near the robot's left, in the scene with both arms: the reach's servo targets put the forearm
+    # 8.5 mm into the table; the forearm then rests on it and the stroke starts 15 mm off its pose.
+    import affordance_env.behaviors.stroke as stroke
+
+    env = TapAffordanceEnv(behavior="tap_back", two_arms=True, camera_width=32, camera_height=24)
+    pose = (-0.23601, -0.10064, -0.04474, 1.0, 0.0, 0.0, 0.0)
+    action = np.array([-0.6319, -0.1912, 0.4824])
+    env.reset(seed=86, options={"object_type": "vertical_cylinder", "size": 0.0505, "object_pose": pose})
+    assert not env.feasible(action)
+    monkeypatch.setattr(stroke, "REACH_TABLE_PENETRATION", 1.0)  # the table not asked: the IK alone would accept it
+    assert env.feasible(action)
+    _, _, _, _, info = env.step(action.astype(np.float32))
+    assert info["failure"].startswith("reach: the stroke started")
