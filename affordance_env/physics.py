@@ -285,6 +285,17 @@ class TapPhysics:
                 links.add(self.body_names[self.model.geom_bodyid[g1]])
         return links
 
+    def links_touching_table(self) -> set[str]:
+        """Names of the robot links (of the variant's contact links) in contact with the table top."""
+        links = set()
+        table, hand = self.table_geom, self._is_hand_geom
+        for g1, g2 in self.data.contact.geom[: self.data.ncon].tolist():
+            if g1 == table and hand[g2]:
+                links.add(self.body_names[self.model.geom_bodyid[g2]])
+            elif g2 == table and hand[g1]:
+                links.add(self.body_names[self.model.geom_bodyid[g1]])
+        return links
+
     def hand_touches_table(self) -> bool:
         """Whether any contact joins the hand (or wrist, forearm, fingers) and the table top."""
         table, hand = self.table_geom, self._hand_geom_set

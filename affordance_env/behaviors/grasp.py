@@ -345,6 +345,44 @@ def grasp_reachable(motion: MotionExecutor, plan: GraspPlan) -> bool:
     return ik_verdict([above, at, lifted, *descent.results, *lift.results, *high_lift.results, place])[0]
 
 
+def finger_of(name: str) -> str:
+    """The finger a hand link or joint belongs to: ``l_hand_pinky_fingertip_link`` and
+    ``l_hand_pinky_proximal_joint`` to ``pinky`` (the thumb's opposition, ``metacarpus``, counts apart)."""
+    return name.removeprefix("l_hand_").split("_")[0]
+
+
+def put_down(motion: MotionExecutor, plan: GraspPlan) -> bool:
+    """Lower the held object until it meets the table (sensed as the arm's load leaving it); returns whether it
+    did. A finger curled under the hand beside the object may meet the table first, a millimetre or two before
+    the object would: it holds nothing, so it opens out of the way (its tip rises towards the palm) and the hand
+    goes on down. If a finger under the object meets the table first, the hand stops there and backs off
+    PLACE_BACK_OFF, the object about a millimetre above the table; the hand then opens slowly (:func:`run_grasp`)."""
+    physics = motion.physics
+    hand = hand_target(plan)
+    joints = motion.kinematics.joint_names
+    p_low = motion.palm - np.array([0.0, 0.0, PLACE_APPROACH + PLACE_OVERTRAVEL])
+    opened: set[str] = set()
+    while True:
+        grip = physics.joint_targets()  # the fingers' targets: just beyond where they press, their squeeze
+        down = motion.line(motion.palm.copy(), p_low, hand, PLACE_SPEED)
+        touched = motion.follow_line(down, lambda: physics.object_touches_table()
+                                     or physics.hand_touches_table()).touched
+        if touched and physics.object_touches_table():
+            return True
+        # The arm stops where it is, and the fingers go on squeezing: stopping them too (their targets where they
+        # are) would leave the object held by nothing, to drop the last millimetres onto the table.
+        squeeze = {name: grip[joints.index(name)] for name in plan.hand_closed}
+        physics.set_joint_targets(with_hand(motion, physics.joint_targets(), squeeze))
+        idle = {finger_of(link) for link in physics.links_touching_table() - physics.links_touching_object()}
+        out_of_way = {name: value for name, value in plan.hand_open.items() if finger_of(name) in idle - opened}
+        if not touched or not out_of_way:  # a finger under the object met the table: off it again
+            p_hand = motion.palm.copy()
+            motion.follow_line(motion.line(p_hand, p_hand + np.array([0.0, 0.0, PLACE_BACK_OFF]), hand, PLACE_SPEED))
+            return False
+        move_fingers(motion, out_of_way)
+        opened |= idle
+
+
 def run_grasp(motion: MotionExecutor, plan: GraspPlan, at_end: Callable[[], None] | None = None) -> GraspOutcome:
     """Reach above the object with the open hand, descend slowly until the hand touches it or is at the grasp
     pose, close the hand, lift, hold; if the object is held, carry it beside and put it down until it rests on
@@ -391,22 +429,13 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan, at_end: Callable[[], None
         carry = motion.line(motion.palm.copy(), p_carry, hand, CARRY_SPEED)
         results += carry.results
         motion.follow_line(carry)
-        # Place: down until the object meets the table (sensed as the arm's load leaving it), then still until
-        # it rests. Fingertips curled under a small object meet the table first, a millimetre or two before the
-        # object would: the hand stops there, and opens slowly (below).
+        # Place: down until the object meets the table, then still until it rests.
         motion.phase = "place"
-        p_hand = motion.palm.copy()
-        p_low = p_hand - np.array([0.0, 0.0, PLACE_APPROACH + PLACE_OVERTRAVEL])
-        down = motion.line(p_hand, p_low, hand, PLACE_SPEED)
-        placed = motion.follow_line(down, lambda: physics.object_touches_table()
-                                  or physics.hand_touches_table()).touched and physics.object_touches_table()
-        if not placed:  # the fingertips under it met the table: off it again, so that they keep their grip
-            p_hand = motion.palm.copy()
-            motion.follow_line(motion.line(p_hand, p_hand + np.array([0.0, 0.0, PLACE_BACK_OFF]), hand, PLACE_SPEED))
+        placed = put_down(motion, plan)
         motion.hold_still(also=object_at_rest)
     motion.phase = "open"
-    # A held object the hand could not set down (the thumb under a small one met the table first) is let down
-    # slowly: the fingers open at a quarter of their speed, and it slides down them onto the table.
+    # A held object the hand could not set down (a finger under a small one met the table first) is let down
+    # slowly: the fingers open at RELEASE_SPEED_SHARE of their speed, and it slides down them onto the table.
     move_fingers(motion, plan.hand_release, 1.0 if placed or not held else RELEASE_SPEED_SHARE)
     motion.hold_still(also=object_at_rest)
     release_time = float(physics.data.time)
