@@ -32,7 +32,7 @@ if TYPE_CHECKING:
 
 #: The sizes of ``affordance plan`` (:class:`~affordance_learning.plan_experiment.PlanSettings`' defaults), for its
 #: help; an option not given keeps PlanSettings' own default.
-PLAN_DEFAULTS = {"episodes": 1500, "objects": 24, "multi_episodes": 80}
+PLAN_DEFAULTS = {"episodes": 2000, "objects": 32, "multi_episodes": 80}
 #: What ``affordance plan`` writes into its ``--out``: its goal episodes in this directory, and its results
 #: (of the format :data:`~affordance_learning.plan_results.PLAN_RESULTS_FORMAT`), report and figures beside it.
 PLAN_DATASET = "dataset"
