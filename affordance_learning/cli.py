@@ -32,7 +32,7 @@ if TYPE_CHECKING:
 
 #: The sizes of ``affordance plan`` (:class:`~affordance_learning.plan_experiment.PlanSettings`' defaults), for its
 #: help; an option not given keeps PlanSettings' own default.
-PLAN_DEFAULTS = {"episodes": 1000, "goals": 160, "multi_episodes": 40}
+PLAN_DEFAULTS = {"episodes": 2000, "objects": 32, "multi_episodes": 80}
 #: What ``affordance plan`` writes into its ``--out``: its goal episodes in this directory, and its results
 #: (of the format :data:`~affordance_learning.plan_results.PLAN_RESULTS_FORMAT`), report and figures beside it.
 PLAN_DATASET = "dataset"
@@ -114,7 +114,26 @@ def _reproduce(args: argparse.Namespace) -> int:
     return 0
 
 
+def _train_action_models(args: argparse.Namespace) -> int:
+    """``affordance train-default --action-conditioned``: goal episodes with random actions (collected into
+    ``--dataset`` or reused from there) until every behaviour has 1000 interactions, then an action-conditioned
+    model per behaviour."""
+    from affordance_learning.default_model import ACTION_INTERACTIONS, train_action_models, user_model_dir
+    from affordance_learning.plan_experiment import PlanSettings, collect_training
+
+    dataset = args.dataset or Path("default-actions")
+    settings = PlanSettings(max_per_behavior=ACTION_INTERACTIONS)
+    frame = collect_training(dataset, settings, seed=0, workers=args.workers, camera=(160, 120))
+    out = args.out or user_model_dir()
+    written = train_action_models(frame, out)
+    print(f"action-conditioned default models of {', '.join(written)} written to {out} "
+          f"({', '.join(f'{b} {int((frame.behavior == b).sum())}' for b in written)} interactions collected)")
+    return 0
+
+
 def _train_default(args: argparse.Namespace) -> int:
+    if args.action_conditioned:
+        return _train_action_models(args)
     from affordance_learning.behaviors import check_behavior, check_env_offers
 
     behavior = check_behavior(args.behavior)
@@ -357,9 +376,11 @@ def build_parser() -> argparse.ArgumentParser:
                       help="seed of the data and of the evaluation (default 0)")
     plan.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
     plan.add_argument("--episodes", type=positive_int, default=None,
-                      help=f"goal episodes collected for training (default {PLAN_DEFAULTS['episodes']})")
-    plan.add_argument("--goals", type=positive_int, default=None,
-                      help=f"held-out objects of the single-step evaluation (default {PLAN_DEFAULTS['goals']})")
+                      help="goal episodes collected for training at first, extended until every behaviour has 1000 "
+                      f"interactions (default {PLAN_DEFAULTS['episodes']})")
+    plan.add_argument("--objects", type=positive_int, default=None,
+                      help="held-out objects of the single-step evaluation, 20 goals each (default "
+                      f"{PLAN_DEFAULTS['objects']})")
     plan.add_argument("--multi-episodes", type=positive_int, default=None,
                       help=f"multi-step episodes per policy (default {PLAN_DEFAULTS['multi_episodes']})")
     plan.set_defaults(func=_plan)
@@ -373,7 +394,12 @@ def build_parser() -> argparse.ArgumentParser:
     train.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
     train.add_argument("--out", type=Path, default=None,
                        help="model file (default: BEHAVIOR_model.joblib in the user's data directory, "
-                       "$TAP_AFFORDANCE_DATA or ~/.local/share/tap-affordance, where predict_effect finds it)")
+                       "$TAP_AFFORDANCE_DATA or ~/.local/share/tap-affordance, where predict_effect finds it); "
+                       "with --action-conditioned the directory of the models")
+    train.add_argument("--action-conditioned", action="store_true",
+                       help="build every behaviour's action-conditioned model (predict_effect(..., action=...)) "
+                       "from goal episodes with random actions, collected into --dataset (default "
+                       "./default-actions) until every behaviour has 1000 interactions")
     train.set_defaults(func=_train_default)
     return parser
 

@@ -19,12 +19,20 @@ or stored under other versions (:class:`DefaultModelError`, a ``RuntimeError``),
 to rebuild it; it never uses a model it could not check. :data:`FORMAT` is raised whenever the fitted layout of
 :class:`AffordanceModel` changes, so that an older file is refused rather than half-used. A good load is
 cached, keyed by the file's path, size and modification time, so a rebuilt file is used at the next call.
+
+Action-conditioned: ``predict_effect(features, behavior, action=params)`` predicts what one action of the
+behaviour does (:class:`ActionEffectPrediction`), from the behaviour's
+:class:`~affordance_learning.effect_model.ActionEffectModel` fitted on goal episodes with random actions
+(:func:`train_action_models`; ``affordance train-default --action-conditioned`` collects the episodes and builds
+every behaviour's at once). They are stored and found as the others (``BEHAVIOR_action_model.joblib``, the user's
+before the package's: :func:`action_model_path`) and checked the same way on loading (:data:`ACTION_FORMAT`).
 """
 
 from __future__ import annotations
 
 import functools
 import os
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -246,10 +254,11 @@ def load_default_model(path: str | Path | None = None, *, behavior: str = "tap")
 
 
 def predict_effect(
-    features: ArrayLike | pd.DataFrame, behavior: str = "tap", *, path: str | Path | None = None
-) -> EffectPrediction:
+    features: ArrayLike | pd.DataFrame, behavior: str = "tap", *, action: ArrayLike | None = None,
+    path: str | Path | None = None
+) -> EffectPrediction | ActionEffectPrediction:
     """Predict the effect category of a behaviour's canonical interaction with objects, and what the effect
-    looks like, from their 49 features.
+    looks like, from their 49 features; given an ``action``, what that action of the behaviour does to them.
 
     Args:
         features: One (49,) or many (n, 49) feature vectors of objects before the interaction, in the order
@@ -257,13 +266,18 @@ def predict_effect(
             DataFrame with those columns (in any order; other columns are ignored); finite.
         behavior: Whose default model predicts: ``"tap"`` (shipped), ``"grasp"``, ``"tap_back"`` or
             ``"push"`` (built by ``affordance train-default --behavior NAME``).
+        action: The behaviour's 3 parameters in [-1, 1] (0: the canonical action), (3,) for every object or
+            (n, 3) one per object. Then the behaviour's action-conditioned default model predicts
+            (:func:`action_model_path`; ``affordance train-default --action-conditioned`` rebuilds them) and the
+            result is an :class:`ActionEffectPrediction`: the mean perceptual effect, displacement [m] and
+            P(rolled), P(off the table), P(lifted).
         path: The stored model (default: the user's model of the behaviour, else the package's:
-            :func:`model_path`).
+            :func:`model_path`, or :func:`action_model_path` with an ``action``).
 
     Returns:
-        For a batch, (n, 49) or a DataFrame: ``category`` (n,) int and ``effect`` (n, 49) float, the category's
-        prototype effect (final minus initial features, in each feature's unit). For one (49,) vector: one
-        result, ``category`` an int and ``effect`` (49,).
+        Without ``action``, for a batch, (n, 49) or a DataFrame: ``category`` (n,) int and ``effect`` (n, 49)
+        float, the category's prototype effect (final minus initial features, in each feature's unit). For one
+        (49,) vector: one result, ``category`` an int and ``effect`` (49,).
 
     Raises:
         ValueError: An unknown behaviour, or ``features`` has another shape or lacks feature columns, or holds
@@ -272,8 +286,9 @@ def predict_effect(
         DefaultModelError: The default model is broken, of another behaviour or stale (rebuild it with
             ``affordance train-default --behavior NAME``).
     """
-    path = model_path(behavior) if path is None else Path(path)
     check_behavior(behavior)
+    if action is None:
+        path = model_path(behavior) if path is None else Path(path)
     if isinstance(features, pd.DataFrame):
         names = _feature_names()
         missing = [n for n in names if n not in features.columns]
@@ -297,8 +312,175 @@ def predict_effect(
         count, row, col, value = found
         raise InvalidValueError(
             f"features must be finite; row {row}, feature {col} is {value} ({count} non-finite value(s)).")
+    if action is not None:
+        return _predict_action(X, behavior, action, path, single)
     model, names = _load_checked(path, behavior)
     prediction = model.predict_effect(pd.DataFrame(X, columns=list(names)))
     if single:  # one vector in, one result out
         return EffectPrediction(category=int(prediction.category[0]), effect=prediction.effect[0])
     return prediction
+
+
+# --- the action-conditioned default models ---------------------------------------------------------------------
+#: Layout of a stored action-conditioned bundle; raise it when the bundle or ActionEffectModel's fitted attributes
+#: change.
+ACTION_FORMAT = 1
+#: Trees of each shipped action-conditioned model: 100 instead of the planner's 200 keep a file near 1.6 MB (200:
+#: 3 MB), and a prediction averages over 100 trees' leaves, each of at least 3 training outcomes.
+ACTION_TREES = 100
+#: Training interactions per behaviour of an action-conditioned default model.
+ACTION_INTERACTIONS = 1000
+#: The command that rebuilds the action-conditioned default models, every behaviour's at once.
+ACTION_REBUILD_COMMAND = "affordance train-default --action-conditioned"
+
+
+@dataclass(frozen=True)
+class ActionEffectPrediction:
+    """What a behaviour's action-conditioned default model predicts for objects and an action: the mean of its
+    predictive distribution (:class:`~affordance_learning.effect_model.ActionEffectModel`).
+
+    Attributes:
+        effect: The perceptual effect, final minus initial features (n, 49), each in its feature's unit.
+        displacement: How far the object's centre moves on the table (n, 2) [m], root frame (+x toward the robot).
+        rolled: P(the object rolls further than the roll threshold), (n,).
+        off_table: P(it leaves the table), (n,).
+        lifted: P(a grasp lifts and holds it), (n,) (0 for the other behaviours).
+
+    For one (49,) feature vector: ``effect`` (49,), ``displacement`` (2,) and the probabilities floats.
+    """
+
+    effect: np.ndarray
+    displacement: np.ndarray
+    rolled: np.ndarray | float
+    off_table: np.ndarray | float
+    lifted: np.ndarray | float
+
+
+def action_model_path(behavior: str = "tap") -> Path:
+    """The action-conditioned default model of ``behavior`` that :func:`predict_effect` uses with an ``action``:
+    the user's (rebuilt by ``affordance train-default --action-conditioned``) if there is one, else the package's;
+    where the user's would be if neither exists."""
+    name = f"{check_behavior(behavior)}_action_model.joblib"
+    user, packaged = user_model_dir() / name, MODEL_DIR / name
+    return user if user.exists() or not packaged.exists() else packaged
+
+
+def train_action_models(frame: pd.DataFrame, out: str | Path | None = None, *,
+                        max_per_behavior: int = ACTION_INTERACTIONS, n_estimators: int = ACTION_TREES,
+                        random_state: int = 0, behaviors: list[str] | None = None) -> dict[str, Path]:
+    """Fit the action-conditioned default model of every behaviour in a goal-episode frame and store each.
+
+    Args:
+        frame: Goal episodes with random actions (``affordance_env.load_dataset`` of a collection of the goal
+            env, as ``affordance plan`` and ``affordance train-default --action-conditioned`` collect them).
+        out: The directory the models go to (``BEHAVIOR_action_model.joblib``; default: the user's data directory,
+            :func:`user_model_dir`, where :func:`predict_effect` finds them).
+        max_per_behavior: The first interactions of each behaviour the model is fitted on.
+        n_estimators: Trees of each model.
+        random_state: Seed of the forests.
+        behaviors: The behaviours to fit (default: every one the frame holds).
+
+    Returns:
+        Each behaviour's file.
+
+    Raises:
+        ValueError: A behaviour without interactions in the frame, or a frame without the goal dataset's columns.
+    """
+    from affordance_learning.effect_model import ActionEffectModel
+    from affordance_learning.outcomes import model_inputs, outcome_table
+
+    out = user_model_dir() if out is None else Path(out)
+    held = [str(b) for b in dict.fromkeys(frame["behavior"].astype(str))] if "behavior" in frame else []
+    behaviors = [check_behavior(b) for b in (behaviors or held)]
+    written = {}
+    for behavior in behaviors:
+        rows = frame[frame["behavior"].astype(str) == behavior]
+        if "episode" in rows:
+            rows = rows.sort_values([c for c in ("episode", "step") if c in rows])
+        rows = rows.head(max_per_behavior)
+        if rows.empty:
+            raise InvalidValueError(f"the frame holds no {behavior!r} interactions to fit its action-conditioned "
+                                    f"model on (it holds {', '.join(held) or 'none'}).")
+        model = ActionEffectModel(n_estimators=n_estimators, random_state=random_state).fit(
+            model_inputs(rows), outcome_table(rows))
+        bundle = {"format": ACTION_FORMAT, "behavior": behavior, "model": model, "versions": library_versions(),
+                  "feature_names": _feature_names(), "n_interactions": int(len(rows))}
+        path = out / f"{behavior}_action_model.joblib"
+        path.parent.mkdir(parents=True, exist_ok=True)
+        partial = path.with_name(f"{path.name}.{os.getpid()}.partial")
+        joblib.dump(bundle, partial, compress=3)
+        partial.replace(path)
+        written[behavior] = path
+    _load_action.cache_clear()
+    return written
+
+
+def _action_problem(path: Path | str, problem: str) -> str:
+    return (f"The action-conditioned default model {path} {problem}. Rebuild them with `{ACTION_REBUILD_COMMAND}` "
+            f"(it collects or reuses goal episodes with random actions until every behaviour has "
+            f"{ACTION_INTERACTIONS} interactions, fits a model per behaviour and stores them in the user's data "
+            f"directory, {user_model_dir()}, where predict_effect finds them).")
+
+
+@functools.lru_cache(maxsize=8)
+def _load_action(path: str, size: int, mtime_ns: int, behavior: str):
+    """Load and check a stored action-conditioned model of ``behavior``; ``size`` and ``mtime_ns`` key the cache."""
+    from affordance_learning.effect_model import ActionEffectModel
+
+    try:
+        bundle: Any = joblib.load(path)
+    except Exception as exc:  # unpickling a damaged file can raise almost anything
+        raise DefaultModelError(_action_problem(path, f"could not be read ({type(exc).__name__}: {exc})")) from exc
+    if not isinstance(bundle, dict) or bundle.get("format") != ACTION_FORMAT:
+        found = bundle.get("format") if isinstance(bundle, dict) else type(bundle).__name__
+        raise DefaultModelError(_action_problem(path, f"is not an action-conditioned bundle of format "
+                                                      f"{ACTION_FORMAT} (found {found!r})"))
+    if bundle.get("behavior") != behavior:
+        raise DefaultModelError(_action_problem(path, f"holds a {bundle.get('behavior')!r} model, not a "
+                                                      f"{behavior!r} one"))
+    model = bundle.get("model")
+    if not isinstance(model, ActionEffectModel) or model.n_features_in_ != _N_FEATURES + 3:
+        raise DefaultModelError(_action_problem(path, "does not hold an ActionEffectModel of the 49 features and "
+                                                      "3 parameters"))
+    stored, installed = bundle.get("versions", {}), library_versions()
+    changed = [f"{k} {stored.get(k)} (model) vs {v} (installed)" for k, v in installed.items() if stored.get(k) != v]
+    if changed:
+        raise DefaultModelError(_action_problem(path, "was stored under other library versions: "
+                                                + "; ".join(changed)))
+    return model
+
+
+def load_action_model(behavior: str = "tap", path: str | Path | None = None):
+    """The action-conditioned default model of ``behavior`` (an
+    :class:`~affordance_learning.effect_model.ActionEffectModel`), checked against the installed library versions
+    (cached). Raises DefaultModelMissingError (with the command that builds it) or DefaultModelError as
+    :func:`load_default_model`."""
+    behavior = check_behavior(behavior)
+    path = action_model_path(behavior) if path is None else Path(path)
+    try:
+        stat = path.stat()
+    except OSError as exc:
+        raise DefaultModelMissingError(_action_problem(path, f"is missing ({exc.strerror})")) from exc
+    return _load_action(str(path.resolve()), stat.st_size, stat.st_mtime_ns, behavior)
+
+
+def _predict_action(X: np.ndarray, behavior: str, action: ArrayLike, path: str | Path | None,
+                    single: bool) -> ActionEffectPrediction:
+    """:func:`predict_effect` with an ``action``: the action-conditioned model's mean outcome."""
+    a = np.asarray(action, dtype=np.float64)
+    if a.ndim not in (1, 2) or a.shape[-1] != 3 or not np.all(np.isfinite(a)) or np.any(np.abs(a) > 1):
+        raise InvalidValueError(f"action must be the behaviour's 3 parameters in [-1, 1], (3,) or (n, 3), got "
+                                f"{action!r}.")
+    a = np.broadcast_to(np.atleast_2d(a), (len(X), 3)) if a.ndim == 1 or len(a) == 1 else a
+    if len(a) != len(X):
+        raise InvalidValueError(f"action must be one (3,) for every object or one per object, got {len(a)} actions "
+                                f"for {len(X)} objects.")
+    model = load_action_model(behavior, path)
+    mean = model.predict(np.hstack([X, a]))
+    column = {name: j for j, name in enumerate(model.outcome_names_)}
+    effect = mean[:, model.effect_columns_]
+    displacement = mean[:, [column["dx"], column["dy"]]]
+    probs = {k: mean[:, column[k]] for k in ("rolled", "off_table", "lifted")}
+    if single:
+        return ActionEffectPrediction(effect[0], displacement[0], *(float(v[0]) for v in probs.values()))
+    return ActionEffectPrediction(effect, displacement, probs["rolled"], probs["off_table"], probs["lifted"])

@@ -1,39 +1,54 @@
 """``affordance plan``: learn what the behaviours do, then use it to reach goals, against baselines in one run.
 
-1. Collect goal episodes of TapAffordanceGoal-v1 with random actions, objects spread over the workspaces
-   (:func:`affordance_env.dataset.collect`, resumable), and keep at most ``max_per_behavior`` interactions of each
-   behaviour for training.
-2. Fit an :class:`~affordance_learning.effect_model.ActionEffectModel` per behaviour, and the paper's model
-   (:class:`~affordance_learning.model.AffordanceModel`, its effect categories) per behaviour for the
-   ``som_categories`` baseline.
-3. Single step, on held-out objects (reset seeds disjoint from the training episodes): one goal per object, the
-   kinds in turn (:mod:`affordance_learning.goals`: roll, lift, move 5 cm in one of 8 directions, place within
-   3 cm of a point 5-15 cm away). Every policy acts from the same snapshot (``get_state`` / ``set_state``):
+1. Collect goal episodes of the goal env (:data:`affordance_env.registry.GOAL_ENV_ID`) with random actions,
+   objects spread over the workspaces (:func:`affordance_env.dataset.collect`, resumable), extending the dataset
+   in rounds until every behaviour has ``max_per_behavior`` interactions (or ``max_episodes`` were collected), and
+   keep the first ``max_per_behavior`` of each behaviour for training.
+2. Fit an :class:`~affordance_learning.effect_model.ActionEffectModel` per behaviour, the same without each shape
+   (step 4), and the paper's model (:class:`~affordance_learning.model.AffordanceModel`, its effect categories)
+   per behaviour for the ``som_categories`` baseline.
+3. Single step, on held-out objects (reset seeds disjoint from the training episodes, ``objects`` of them, the
+   shapes in turn). On each object every behaviour's :func:`oracle_params` (the canonical action and a 4 x 4 x 4
+   grid, 65 per behaviour, the same for every object) is run from the same snapshot (``get_state`` /
+   ``set_state``), once; then :data:`GOALS_PER_OBJECT` goals (:mod:`affordance_learning.goals`: roll, lift, move
+   5 cm in each of 8 directions, and places within 3 cm of points 5-15 cm away) are each judged against those
+   outcomes. Policies, all from that snapshot (an action run once is not run again: the env repeats an
+   interaction bit for bit from a snapshot):
 
-   - ``planner``: :meth:`~affordance_learning.planner.Planner.choose`, with ``feasible`` ruling out reach failures;
-   - ``random``: a uniform behaviour and uniform parameters;
+   - ``planner``: :meth:`~affordance_learning.planner.Planner.choose`, with ``feasible`` ruling out reach
+     failures, remembering the actions that failed on this object (:meth:`~affordance_learning.planner.Planner.
+     note_failure`); the time of each decision is measured, ``feasible``'s calls included;
+   - ``random``: a uniform behaviour and a uniform action of the oracle's set;
    - ``best_fixed``: per goal kind, the behaviour whose canonical action reached that kind most often (chosen
      after the fact over all objects: an upper bound for a fixed choice);
    - ``canonical_choice``: the planner's choice of behaviour with the canonical action only;
    - ``som_categories``: the paper's categories as a planner: the behaviour whose predicted effect category
      reached the goal most often in training, at the canonical action;
-   - ``oracle``: tries the canonical action of every behaviour, then ``oracle_candidates`` parameter vectors per
-     behaviour, in simulation, until one reaches the goal. A goal it reaches is *feasible*.
+   - ``oracle``: whether any action of the oracle's set reached the goal. A goal it reaches is *feasible*.
 
-4. Leaving each shape out in turn: the effect models refitted without that object type, judged on the goals of
-   step 3 whose object is of that type, from the same start (the oracle's verdict says which are feasible).
-5. Multi-step: episodes of TapAffordanceGoal-v1 (targets 10-25 cm away, 3 cm tolerance, at most 5
-   interactions), re-planning after each interaction with a search over two interactions
-   (:meth:`~affordance_learning.planner.Planner.toward`, the behaviours' workspaces saying where a second one can
-   act), against random actions and a direction heuristic. Where no candidate is feasible the planner stops
-   (``gave_up``) rather than run an interaction it knows would fail.
-6. Calibration of P(goal) over every action executed in step 3 (expected calibration error over 10 bins, AUROC).
+   Success is reported on every goal, on the feasible goals, and on the goals the oracle or the planner reached.
+4. Leaving each shape out: on the goals of step 3 whose object is of that shape, the planner of the models fitted
+   without it, from the same snapshot (the oracle's verdict says which goals are feasible).
+5. Multi-step: episodes of the goal env (its targets, its tolerance, at most ``GOAL_MAX_EPISODE_STEPS``
+   interactions), re-planning after each interaction with :meth:`~affordance_learning.planner.Planner.toward`'s
+   defaults (a search over two interactions, the behaviours' workspaces saying where a second one can act),
+   against random actions and a direction heuristic. Where no candidate is feasible the planner stops
+   (``gave_up``) rather than run an interaction it knows would fail; an action that failed to reach is not chosen
+   again from where it failed. Targets toward the robot (within 45 degrees of +x from the object) are counted
+   apart.
+6. Calibration of P(goal) on the planner's chosen actions of step 3 (expected calibration error over 10 bins,
+   AUROC), and, beside it, pooled over every action of the oracle's set for every goal.
 
-Every number is measured in this run; fractions are in [0, 1], distances in metres.
+The goals of one object are judged against the same outcomes, so they are not independent: the Wilson intervals
+treat them as if they were, and the report gives the number of objects beside them. Every number is measured in
+this run; fractions are in [0, 1], distances in metres, times in seconds.
 """
 
 from __future__ import annotations
 
+import inspect
+import itertools
+import math
 import os
 import threading
 import time
@@ -47,9 +62,9 @@ import pandas as pd
 
 from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
 from affordance_learning.effect_model import ActionEffectModel
-from affordance_learning.goals import Goal, Lift, Move, Place, Roll, goal_from_dict
+from affordance_learning.goals import Goal, Lift, Move, Place, Roll
 from affordance_learning.outcomes import model_inputs, outcome_table
-from affordance_learning.planner import Planner, candidate_params
+from affordance_learning.planner import Planner
 
 BEHAVIORS = BEHAVIOR_NAMES
 GOAL_KINDS = ("roll", "lift", "move", "place")
@@ -58,23 +73,62 @@ POLICIES = ("planner", "random", "best_fixed", "canonical_choice", "som_categori
 MULTI_POLICIES = ("planner", "direction", "random")
 #: Goals: Move's distance [m], Place's distance from the object [m] and tolerance [m].
 MOVE_DISTANCE, PLACE_DISTANCE, PLACE_TOLERANCE = 0.05, (0.05, 0.15), 0.03
+#: The goals drawn for every object of the single-step evaluation, in this order: one roll, one lift, a move in
+#: each of the 8 directions (every 45 degrees), and places 5-15 cm away in uniform directions.
+GOALS_PER_OBJECT: dict[str, int] = {"roll": 1, "lift": 1, "move": 8, "place": 10}
 #: Seeds of the evaluation's objects: SeedSequence([seed, EVAL_STREAM, part, i]), apart from the training's.
 EVAL_STREAM = 7919
+#: The levels of the oracle's grid along each parameter: 4 x 4 x 4 = 64 actions per behaviour, with the canonical.
+ORACLE_LEVELS = (-0.75, -0.25, 0.25, 0.75)
+
+
+def oracle_params() -> np.ndarray:
+    """(65, 3) the oracle's actions, the same for every behaviour and object: the canonical action (zeros), then
+    the 4 x 4 x 4 grid of :data:`ORACLE_LEVELS` (each parameter's range cut in four, at the quarters' centres),
+    in lexicographic order. Not the planner's candidates (a Sobol sequence), so that the oracle says what the
+    actions can do, not what the planner's own candidates can."""
+    grid = np.array(list(itertools.product(ORACLE_LEVELS, repeat=3)), dtype=np.float64)
+    return np.vstack([np.zeros((1, 3)), grid])
 
 
 @dataclass(frozen=True)
 class PlanSettings:
-    """The sizes of an ``affordance plan`` run (the defaults fit in 10 minutes on 2 cores). ``oracle_candidates``:
-    parameter vectors per behaviour the oracle tries after the canonical actions."""
+    """The sizes of an ``affordance plan`` run.
 
-    episodes: int = 1000
+    Attributes:
+        episodes: Goal episodes collected at first; the collection is extended in rounds until every behaviour
+            has ``max_per_behavior`` interactions, up to ``max_episodes``.
+        max_per_behavior: Training interactions per behaviour (the first of each).
+        max_episodes: The most goal episodes collected.
+        objects: Held-out objects of the single-step evaluation, the shapes in turn; each gets
+            :data:`GOALS_PER_OBJECT` goals, judged against the oracle's 65 actions per behaviour.
+        multi_episodes: Multi-step episodes per policy.
+        candidates: The planner's parameter vectors per behaviour.
+        threshold: The planner abstains below this P(goal).
+        som_clusters: Effect categories of the ``som_categories`` baseline.
+
+    Sizing (measured on TapAffordanceGoal-v1, 4 behaviours, one core each): an object's oracle costs 20-25 s (65
+    actions x 4-5 behaviours; a grasp 0.15 s, a stroke 0.02-0.03 s), its 20 goals 2-3 s more; a collected
+    interaction 0.18 s (``feasible`` draws included). In the v1 data 34 % of the goals were feasible, 15 % of a
+    box's: 32 objects give about 220 feasible goals (but about 24 of boxes, under the 30 a verdict needs). With
+    1000 interactions of every behaviour to collect (about 6000-7500 interactions, the grasp the scarcest), the
+    collection alone is about 9-11 minutes on 2 cores, the single step about 7: more than the 15 minutes, unless the
+    interactions get cheaper.
+    """
+
+    episodes: int = 2000
     max_per_behavior: int = 1000
-    goals: int = 160
-    multi_episodes: int = 40
-    oracle_candidates: int = 8
+    max_episodes: int = 4000
+    objects: int = 32
+    multi_episodes: int = 80
     candidates: int = 64
     threshold: float = 0.5
     som_clusters: int = 6
+
+    @property
+    def goals(self) -> int:
+        """Single-step goals: :data:`GOALS_PER_OBJECT` per object."""
+        return self.objects * sum(GOALS_PER_OBJECT.values())
 
 
 # --- outcomes measured by the simulator ------------------------------------------------------------------------
@@ -95,17 +149,34 @@ def reached(goal: Goal, info: Mapping[str, Any]) -> bool:
     return bool(goal.reached(measured_outcome(info), np.asarray(info["object"]["initial_pose"])[:2])[0])
 
 
-def draw_goal(kind: str, start_xy: np.ndarray, rng: np.random.Generator) -> Goal:
-    """A goal of ``kind`` for an object seen at ``start_xy``."""
+def reach_failure(info: Mapping[str, Any]) -> bool:
+    """Whether an interaction failed to reach (``"ik: ..."`` or ``"reach: ..."``): what ``feasible`` promised."""
+    return bool(info["failure"]) and info["failure"].split(":")[0] in ("ik", "reach")
+
+
+def draw_goal(kind: str, start_xy: np.ndarray, rng: np.random.Generator, direction: int | None = None) -> Goal:
+    """A goal of ``kind`` for an object seen at ``start_xy``; a move goes along ``direction`` (0-7, every 45
+    degrees from +x), else one drawn."""
     if kind == "roll":
         return Roll()
     if kind == "lift":
         return Lift()
-    angle = rng.integers(8) * np.pi / 4 if kind == "move" else rng.uniform(-np.pi, np.pi)
-    direction = np.array([np.cos(angle), np.sin(angle)])
     if kind == "move":
-        return Move(tuple(np.round(direction, 12)), MOVE_DISTANCE)
-    return Place(tuple(start_xy + rng.uniform(*PLACE_DISTANCE) * direction), PLACE_TOLERANCE)
+        angle = (rng.integers(8) if direction is None else direction) * np.pi / 4
+    else:
+        angle = rng.uniform(-np.pi, np.pi)
+    unit = np.array([np.cos(angle), np.sin(angle)])
+    if kind == "move":
+        return Move(tuple(np.round(unit, 12)), MOVE_DISTANCE)
+    return Place(tuple(start_xy + rng.uniform(*PLACE_DISTANCE) * unit), PLACE_TOLERANCE)
+
+
+def draw_goals(start_xy: np.ndarray, rng: np.random.Generator) -> list[Goal]:
+    """The goals of one object of the single-step evaluation (:data:`GOALS_PER_OBJECT`)."""
+    goals = []
+    for kind, n in GOALS_PER_OBJECT.items():
+        goals += [draw_goal(kind, start_xy, rng, i if kind == "move" else None) for i in range(n)]
+    return goals
 
 
 # --- training --------------------------------------------------------------------------------------------------
@@ -149,7 +220,7 @@ class SomBaseline:
 
     def choose(self, features: np.ndarray, goal: Goal, start_xy: np.ndarray) -> tuple[str, float]:
         """The behaviour whose predicted category reached ``goal`` most often in training, and that share."""
-        best = ("tap", -1.0)
+        best = (next(iter(self.models)), -1.0)
         for b, model in self.models.items():
             x = pd.DataFrame(np.asarray(features, dtype=np.float64)[None], columns=model.feature_names_in_)
             category = int(model.predict(x)[0])
@@ -175,116 +246,156 @@ def _env(camera: tuple[int, int]):
     return _worker.env
 
 
-def _feasible_from(env, state) -> Callable[[str, np.ndarray], bool]:
-    """``feasible(behavior, params)`` of the world in ``state``, whatever the env ran since."""
+def feasible_at(env, state) -> Callable[[str, np.ndarray], bool]:
+    """``feasible(behavior, params)`` of the world in snapshot ``state``, whatever the env ran since: the env's
+    ``feasible(behavior, params, state=state)`` where it takes a state, else the snapshot put back first."""
+    if "state" in inspect.signature(env.feasible).parameters:
+        return lambda behavior, params: bool(env.feasible(behavior, params, state=state))
+
     def feasible(behavior: str, params: np.ndarray) -> bool:
         env.set_state(state)
-        return env.feasible(behavior, params)
+        return bool(env.feasible(behavior, params))
     return feasible
 
 
-def _run(env, state, behavior: str, params: np.ndarray) -> dict[str, Any]:
-    env.set_state(state)
-    *_, info = env.step({"behavior": behavior, "params": np.asarray(params, dtype=np.float32)})
-    return info
+def _trimmed(info: Mapping[str, Any]) -> dict[str, Any]:
+    """What the evaluation reads of a step's ``info`` (:func:`measured_outcome`, :func:`reached`)."""
+    obj = info["object"]
+    return {"failure": info["failure"], "rolled": info["rolled"], "outcome": info["outcome"],
+            "behavior": info.get("behavior"), "success": info["success"],
+            "effect": np.asarray(info["effect"], dtype=np.float64),
+            "object": {"initial_pose": np.asarray(obj["initial_pose"]), "final_pose": np.asarray(obj["final_pose"])}}
 
 
-def evaluate_single(item: Mapping[str, Any], planner: Planner, som: SomBaseline | None, settings: PlanSettings,
-                    camera: tuple[int, int]) -> dict[str, Any] | None:
-    """Every policy on one object and goal (``item``: reset ``seed``, ``kind``, ``options``); None if the object was
-    not seen at the start."""
+class Outcomes:
+    """The interactions run on one object from one snapshot, each once: ``run(behavior, params)`` runs it the
+    first time and returns what it did (a trimmed step ``info``) every time after (the env repeats an interaction
+    bit for bit from a snapshot)."""
+
+    def __init__(self, env, state) -> None:
+        self.env, self.state = env, state
+        self.done: dict[tuple[str, bytes], dict[str, Any]] = {}
+
+    def run(self, behavior: str, params: np.ndarray) -> dict[str, Any]:
+        params = np.asarray(params, dtype=np.float32)
+        key = (behavior, params.tobytes())
+        if key not in self.done:
+            self.env.set_state(self.state)
+            *_, info = self.env.step({"behavior": behavior, "params": params})
+            self.done[key] = _trimmed(info)
+        return self.done[key]
+
+
+def _decide(planner: Planner, features, goal: Goal, start, feasible, outcomes: Outcomes
+            ) -> tuple[Any, bool, dict[str, Any] | None, float]:
+    """The planner's choice for ``goal``, whether its action reached it, what it did, and the decision's time
+    [s]; an action that failed to reach is remembered (:meth:`~affordance_learning.planner.Planner.note_failure`).
+    """
+    t = time.perf_counter()
+    choice = planner.choose(features, goal, start, feasible=feasible)
+    seconds = time.perf_counter() - t
+    if not choice.behavior:
+        return choice, False, None, seconds
+    info = outcomes.run(choice.behavior, choice.params)
+    if reach_failure(info):
+        planner.note_failure(choice.behavior, choice.params, start)
+    return choice, reached(goal, info), info, seconds
+
+
+def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: Mapping[str, Planner],
+                    som: SomBaseline | None, camera: tuple[int, int]) -> list[dict[str, Any]] | None:
+    """Every policy on the goals of one object (``item``: reset ``seed``, ``rng``, ``shape``): a record per goal;
+    None if the object was not seen at the start. ``shape_planners``: per shape, the planner fitted without it."""
     env = _env(camera)
     rng = np.random.default_rng(item["rng"])
-    obs, info = env.reset(seed=item["seed"], options=item.get("options"))
+    obs, info = env.reset(seed=item["seed"], options={"object_type": item["shape"]})
     if not info["visible"]:
         return None
     start = np.asarray(obs["achieved_goal"], dtype=np.float64)
     features = np.asarray(obs["observation"]["features"], dtype=np.float64)
-    goal = draw_goal(item["kind"], start, rng)
     state = env.get_state()
-
-    feasible = _feasible_from(env, state)
-
-    executed: list[tuple[float, bool]] = []  # (model P, reached) of every action run: the calibration's data
-
-    def act(behavior: str, params: np.ndarray) -> tuple[bool, dict[str, Any]]:
-        info = _run(env, state, behavior, params)
-        ok = reached(goal, info)
-        x = np.hstack([features, params])[None]
-        executed.append((float(planner.models[behavior].goal_probability(x, goal, start)[0]), ok))
-        return ok, info
-
-    record: dict[str, Any] = {"kind": item["kind"], "type": info["object"]["type"], "goal": goal.to_dict(),
-                              "item": dict(item)}
-    choice = planner.choose(features, goal, start, feasible=feasible)
-    record["planner"], record["planner_p"], record["planner_behavior"] = False, choice.probability, choice.behavior
-    if choice.behavior:
-        record["planner"], done = act(choice.behavior, choice.params)
-        if isinstance(goal, Place):
+    feasible = feasible_at(env, state)
+    outcomes = Outcomes(env, state)
+    oracle_set = oracle_params()
+    tried = [(b, k, outcomes.run(b, params)) for b in BEHAVIORS for k, params in enumerate(oracle_set)]
+    # Every oracle action's P(goal) is read from its predictive weights, computed once for the object.
+    X = np.hstack([np.repeat(features[None], len(oracle_set), axis=0), oracle_set])
+    weights = {b: planner.models[b].predictive_weights(X, as_sparse=True) for b in BEHAVIORS}
+    frames = {b: planner.models[b].outcome_frame() for b in BEHAVIORS}
+    canonical_pick = Planner(planner.models, n_candidates=1, threshold=planner.threshold)
+    left_out = shape_planners.get(item["shape"])
+    for p in (planner, left_out):
+        if p is not None:
+            p.forget_failures()
+    shape = info["object"]["type"]
+    records = []
+    for j, goal in enumerate(draw_goals(start, rng)):
+        record: dict[str, Any] = {"kind": goal.kind, "type": shape, "goal": goal.to_dict(), "object": item["index"],
+                                  "item": {**dict(item), "goal": j}}
+        choice, ok, done, seconds = _decide(planner, features, goal, start, feasible, outcomes)
+        record.update(planner=ok, planner_p=choice.probability, planner_behavior=choice.behavior,
+                      decision_s=seconds, planner_reach_failure=bool(done and reach_failure(done)))
+        if done is not None and isinstance(goal, Place):
             end = np.asarray(done["object"]["final_pose"][:2])
             record["placement_error"] = float(np.linalg.norm(end - np.asarray(goal.target_xy)))
-    record["random"] = act(BEHAVIORS[int(rng.integers(4))], rng.uniform(-1, 1, 3))[0]
-    record["canonical"] = {b: act(b, np.zeros(3))[0] for b in BEHAVIORS}
-    pick = Planner(planner.models, n_candidates=1, threshold=planner.threshold).choose(features, goal, start,
-                                                                                        feasible=feasible)
-    record["canonical_choice"] = bool(pick.behavior and record["canonical"][pick.behavior])
-    if som is not None:
-        record["som_categories"] = record["canonical"][som.choose(features, goal, start)[0]]
-    oracle = any(record["canonical"].values()) or record["planner"]
-    candidates = candidate_params(settings.oracle_candidates + 1, item["seed"] % 2**31)[1:]
-    for b in BEHAVIORS:
-        for params in candidates:
-            if oracle:
-                break
-            if feasible(b, params):
-                oracle = act(b, params)[0]
-    record["oracle"] = bool(oracle)
-    record["executed"] = executed
-    return record
-
-
-def evaluate_planner(record: Mapping[str, Any], planner: Planner, camera: tuple[int, int]) -> bool:
-    """Whether ``planner`` reaches the goal of an evaluated ``record`` from the same start (the same reset)."""
-    env = _env(camera)
-    obs, _ = env.reset(seed=record["item"]["seed"], options=record["item"].get("options"))
-    goal = goal_from_dict(record["goal"])
-    start = np.asarray(obs["achieved_goal"], dtype=np.float64)
-    state = env.get_state()
-
-    feasible = _feasible_from(env, state)
-
-    choice = planner.choose(obs["observation"]["features"], goal, start, feasible=feasible)
-    return bool(choice.behavior) and reached(goal, _run(env, state, choice.behavior, choice.params))
+        if left_out is not None:
+            record["planner_left_out"] = _decide(left_out, features, goal, start, feasible, outcomes)[1]
+        hits = {(b, k): reached(goal, info) for b, k, info in tried}
+        pick = int(rng.integers(len(BEHAVIORS))), int(rng.integers(len(oracle_set)))
+        record["random"] = hits[(BEHAVIORS[pick[0]], pick[1])]
+        record["canonical"] = {b: hits[(b, 0)] for b in BEHAVIORS}
+        best = canonical_pick.choose(features, goal, start, feasible=feasible)
+        record["canonical_choice"] = bool(best.behavior and record["canonical"][best.behavior])
+        if som is not None:
+            record["som_categories"] = record["canonical"][som.choose(features, goal, start)[0]]
+        record["oracle"] = any(hits.values())
+        p = np.concatenate([np.asarray(weights[b] @ goal.reached(frames[b], start).astype(np.float64)).ravel()
+                            for b in BEHAVIORS])
+        record["pooled"] = (p, np.array([hits[(b, k)] for b in BEHAVIORS for k in range(len(oracle_set))]))
+        records.append(record)
+    return records
 
 
 def _direction_heuristic(start: np.ndarray, target: np.ndarray) -> str:
-    """The behaviour that moves an object the way the target lies: push away (-x), tap to -y, tap back to +y."""
+    """The behaviour that moves an object the way the target lies: push away (-x), draw toward the robot (+x)
+    where the env has it, tap to -y, tap back to +y."""
     d = target - start
-    if -d[0] > abs(d[1]):
+    if -d[0] > abs(d[1]) and "push" in BEHAVIORS:
         return "push"
+    if d[0] > abs(d[1]) and "draw" in BEHAVIORS:
+        return "draw"
     return "tap" if d[1] < 0 else "tap_back"
+
+
+def toward_robot(start_xy, target_xy) -> bool:
+    """Whether the target lies toward the robot from the object: within 45 degrees of +x."""
+    need = np.asarray(target_xy, dtype=float) - np.asarray(start_xy, dtype=float)
+    return bool(need[0] > abs(need[1]))
 
 
 def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, camera: tuple[int, int],
                      frames: list | None = None) -> dict[str, Any]:
     """One multi-step episode of ``policy`` from reset seed ``item["seed"]``: reached, interactions, reach
-    failures, the final distance [m]."""
+    failures, the final distance [m], the planner's decision times [s]."""
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
-    from affordance_env.workspace import in_workspace
 
     env = _env(camera)
     rng = np.random.default_rng(item["rng"])
     obs, info = env.reset(seed=item["seed"])
     tolerance = env.goal_tolerance
-    steps, failures, success, gave_up = 0, [], False, False
+    steps, failures, success, gave_up, decisions = 0, [], False, False, []
     distance = initial = float(info["distance"])
     start_xy, target_xy = (np.asarray(obs[key], dtype=float).tolist() for key in ("achieved_goal", "desired_goal"))
+    planner.forget_failures()
     for step in range(GOAL_MAX_EPISODE_STEPS):
         start, target = obs["achieved_goal"], obs["desired_goal"]
         if policy == "planner":
+            state = env.get_state()
+            t = time.perf_counter()
             choice = planner.toward(obs["observation"]["features"], start, target, tolerance,
-                                    feasible=lambda b, p: env.feasible(b, p),
-                                    steps_left=GOAL_MAX_EPISODE_STEPS - step, reachable=in_workspace)
+                                    feasible=feasible_at(env, state), steps_left=GOAL_MAX_EPISODE_STEPS - step)
+            decisions.append(time.perf_counter() - t)
+            env.set_state(state)  # feasible may have put it back: the same state, to be sure
             if choice.behavior is None:  # no candidate the arms reach: stop rather than run a failing one
                 gave_up = True
                 break
@@ -292,11 +403,13 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
         elif policy == "direction":
             behavior, params = _direction_heuristic(start, target), np.zeros(3)
         else:
-            behavior, params = BEHAVIORS[int(rng.integers(4))], rng.uniform(-1, 1, 3)
+            behavior, params = BEHAVIORS[int(rng.integers(len(BEHAVIORS)))], rng.uniform(-1, 1, 3)
         obs, _, terminated, _, info = env.step({"behavior": behavior, "params": np.asarray(params, np.float32)})
         steps += 1
-        if info["failure"] and info["failure"].split(":")[0] in ("ik", "reach"):
+        if reach_failure(info):
             failures.append(info["failure"])
+            if policy == "planner":
+                planner.note_failure(behavior, params, start)
         distance = float(info["distance"])
         if frames is not None:
             frames.append((f"{behavior}: {100 * distance:.1f} cm to go", env.render()))
@@ -305,7 +418,8 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
             break
     return {"policy": policy, "success": success, "steps": steps, "reach_failures": len(failures), "failures": failures,
             "final_distance": distance, "gave_up": gave_up, "type": info["object"]["type"],
-            "initial_distance": initial, "start_xy": start_xy, "target_xy": target_xy, "tolerance": tolerance}
+            "initial_distance": initial, "start_xy": start_xy, "target_xy": target_xy, "tolerance": tolerance,
+            "toward_robot": toward_robot(start_xy, target_xy), "decision_s": decisions}
 
 
 #: The directions of :func:`step_reach`: world +x (towards the robot), -x (away), +y (to its left), -y.
@@ -362,6 +476,8 @@ def calibration(p: np.ndarray, y: np.ndarray, bins: int = 10) -> dict[str, Any]:
     from sklearn.metrics import roc_auc_score
 
     p, y = np.asarray(p, dtype=float), np.asarray(y, dtype=bool)
+    if not len(p):
+        return {"ece": None, "auroc": None, "n": 0, "curve": []}
     index = np.clip((p * bins).astype(int), 0, bins - 1)
     curve, ece = [], 0.0
     for b in range(bins):
@@ -374,17 +490,33 @@ def calibration(p: np.ndarray, y: np.ndarray, bins: int = 10) -> dict[str, Any]:
     return {"ece": float(ece), "auroc": auroc, "n": int(len(p)), "curve": curve}
 
 
+def calibrations(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """The calibration of P(goal) on the planner's chosen actions (each goal it acted on: ``planner_p`` against
+    ``planner``), and beside it (``pooled``) over every action of the oracle's set for every goal (``pooled``: P
+    and reached per action)."""
+    acted = [r for r in records if r["planner_behavior"]]
+    pooled_p = np.concatenate([r["pooled"][0] for r in records]) if records else np.zeros(0)
+    pooled_y = np.concatenate([r["pooled"][1] for r in records]) if records else np.zeros(0, bool)
+    return {**calibration([r["planner_p"] for r in acted], [r["planner"] for r in acted]),
+            "basis": "the planner's chosen actions",
+            "pooled": {**calibration(pooled_p, pooled_y), "basis": "every action of the oracle's set, for every goal"}}
+
+
 def summarize(records: Sequence[Mapping[str, Any]], policies: Sequence[str]) -> dict[str, Any]:
-    """Success, success on feasible goals (those the oracle reached) and n, per policy, with Wilson intervals."""
+    """Per policy, with Wilson intervals: success on every goal, on the feasible goals (those the oracle reached),
+    and on the goals the oracle or the planner reached (``success_reached``)."""
     feasible = np.array([r["oracle"] for r in records], dtype=bool)
+    either = feasible | np.array([bool(r.get("planner", False)) for r in records], dtype=bool)
     out = {}
     for policy in policies:
         values = np.array([bool(r.get(policy, False)) for r in records], dtype=bool)
         n, k = len(values), int(values.sum())
         nf, kf = int(feasible.sum()), int(values[feasible].sum())
+        ne, ke = int(either.sum()), int(values[either].sum())
         out[policy] = {"success": k / n if n else None, "success_ci": wilson(k, n),
                        "success_feasible": kf / nf if nf else None, "success_feasible_ci": wilson(kf, nf), "n": n,
-                       "n_feasible": nf}
+                       "n_feasible": nf, "success_reached": ke / ne if ne else None,
+                       "success_reached_ci": wilson(ke, ne), "n_reached": ne}
     return out
 
 
@@ -401,14 +533,21 @@ def best_fixed(records: list[dict[str, Any]]) -> dict[str, str]:
     return choice
 
 
+def seconds_summary(seconds: Sequence[float]) -> dict[str, Any]:
+    """Median, 99th percentile and the most of decision times [s], and their n; None for no decision."""
+    s = np.asarray(seconds, dtype=float)
+    if not len(s):
+        return {"median": None, "p99": None, "max": None, "n": 0}
+    return {"median": float(np.median(s)), "p99": float(np.quantile(s, 0.99)), "max": float(s.max()), "n": len(s)}
+
+
 # --- the run ---------------------------------------------------------------------------------------------------
-def _items(seed: int, part: int, n: int, options: Callable[[int], dict | None] = lambda i: None) -> list[dict]:
+def _items(seed: int, part: int, n: int) -> list[dict]:
     items = []
     for i in range(n):
         ss = np.random.SeedSequence([seed, EVAL_STREAM, part, i])
         env_seed, rng_seed = (int(v) for v in ss.generate_state(2))
-        items.append({"seed": env_seed, "rng": rng_seed, "kind": GOAL_KINDS[i % len(GOAL_KINDS)],
-                      "options": options(i)})
+        items.append({"seed": env_seed, "rng": rng_seed, "index": i, "shape": SHAPES[i % len(SHAPES)]})
     return items
 
 
@@ -431,10 +570,33 @@ def _chunk(function, chunk: list, kwargs: dict) -> list:
     return [function(item, **kwargs) for item in chunk]
 
 
+def collect_training(out: Path, settings: PlanSettings, seed: int, workers: int, camera: tuple[int, int],
+                     say: Callable[[str], None] = print) -> pd.DataFrame:
+    """Goal episodes with random actions in ``out``, extended in rounds until every behaviour has
+    ``settings.max_per_behavior`` interactions or ``settings.max_episodes`` episodes were collected; the frame.
+    Each round asks for as many more episodes as the scarcest behaviour's share so far says it needs (and 5 %
+    more), in whole chunks."""
+    from affordance_env.dataset import collect, load_dataset
+
+    episodes, chunk = settings.episodes, 25
+    while True:
+        collect(out, episodes, seed=seed, workers=workers, action="random", env_id=GOAL_ENV_ID,
+                env_options={"position_range": "workspace", "camera_width": camera[0], "camera_height": camera[1]},
+                max_failure_share=1.0, chunk_size=chunk)
+        frame = load_dataset(out)
+        counts = {b: int((frame["behavior"] == b).sum()) for b in BEHAVIORS}
+        short = min(counts.values())
+        if short >= settings.max_per_behavior or episodes >= settings.max_episodes:
+            return frame
+        wanted = episodes * settings.max_per_behavior / max(short, 1) * 1.05
+        episodes = min(settings.max_episodes, max(episodes + chunk, math.ceil(wanted / chunk) * chunk))
+        say(f"      {', '.join(f'{b} {n}' for b, n in counts.items())} interactions: extending to {episodes} "
+            "episodes")
+
+
 def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: PlanSettings | None = None,
              camera: tuple[int, int] = (160, 120), say: Callable[[str], None] = print) -> dict[str, Any]:
     """Run the whole experiment into ``out`` (``dataset/``, ``results.json``); returns the results."""
-    from affordance_env.dataset import collect, load_dataset
     from affordance_env.goal_env import TapAffordanceGoalEnv  # noqa: F401  (fails early without the simulator)
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
 
@@ -443,48 +605,46 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
     out.mkdir(parents=True, exist_ok=True)
     timings: dict[str, float] = {}
     start = time.perf_counter()
-    say(f"[1/5] collecting {settings.episodes} goal episodes with random actions into {out / 'dataset'}")
-    collect(out / "dataset", settings.episodes, seed=seed, workers=workers, action="random",
-            env_id=GOAL_ENV_ID,
-            env_options={"position_range": "workspace", "camera_width": camera[0], "camera_height": camera[1]},
-            max_failure_share=1.0, chunk_size=25)
-    frame = load_dataset(out / "dataset")
+    say(f"[1/5] collecting goal episodes with random actions into {out / 'dataset'} until every behaviour has "
+        f"{settings.max_per_behavior} interactions (at most {settings.max_episodes} episodes)")
+    frame = collect_training(out / "dataset", settings, seed, workers, camera, say)
     frames = training_frames(frame, settings.max_per_behavior)
     timings["collect"] = time.perf_counter() - start
-    say("      " + ", ".join(f"{b} {len(f)}" for b, f in frames.items()) + " interactions for training")
+    say(f"      {frame['episode'].nunique()} episodes ({timings['collect']:.0f} s); "
+        + ", ".join(f"{b} {len(f)}" for b, f in frames.items()) + " interactions for training")
 
     t = time.perf_counter()
     models = fit_models(frames, seed, n_jobs=workers)
     planner = Planner(models, n_candidates=settings.candidates, threshold=settings.threshold, random_state=seed)
     som = SomBaseline.fit(frames, settings.som_clusters, seed)
+    shape_planners = {
+        shape: Planner(fit_models(training_frames(frame, settings.max_per_behavior, exclude_type=shape), seed,
+                                  n_jobs=workers),
+                       n_candidates=settings.candidates, threshold=settings.threshold, random_state=seed)
+        for shape in SHAPES}
     timings["fit"] = time.perf_counter() - t
-    say(f"[2/5] fitted the effect models and the paper's categories ({timings['fit']:.1f} s)")
+    say(f"[2/5] fitted the effect models, each shape's without it, and the paper's categories "
+        f"({timings['fit']:.1f} s)")
 
     t = time.perf_counter()
-    items = _items(seed, 0, settings.goals)
-    records = [r for r in _parallel(evaluate_single, items, workers, planner=planner, som=som,
-                                    settings=settings, camera=camera) if r is not None]
+    items = _items(seed, 0, settings.objects)
+    objects = _parallel(evaluate_object, items, workers, planner=planner, shape_planners=shape_planners, som=som,
+                        camera=camera)
+    records = [r for rs in objects if rs is not None for r in rs]
     fixed_choice = best_fixed(records)
     timings["single_step"] = time.perf_counter() - t
     single = summarize(records, POLICIES)
-    say(f"[3/5] single step on {len(records)} held-out objects ({timings['single_step']:.0f} s): "
+    n_objects = sum(rs is not None for rs in objects)
+    say(f"[3/5] single step: {len(records)} goals on {n_objects} held-out objects ({timings['single_step']:.0f} s): "
         + ", ".join(f"{p} {share_text(single[p]['success'], single[p]['n'], single[p]['success_ci'])}"
                     for p in POLICIES)
         + f"; {single['oracle']['n_feasible']} goals feasible")
 
-    t = time.perf_counter()
     loso: dict[str, Any] = {}
     for shape in SHAPES:
-        shape_records = [dict(r) for r in records if r["type"] == shape]
-        shape_planner = Planner(fit_models(training_frames(frame, settings.max_per_behavior, exclude_type=shape),
-                                           seed, n_jobs=workers),
-                                n_candidates=settings.candidates, threshold=settings.threshold, random_state=seed)
-        outcomes = _parallel(evaluate_planner, shape_records, workers, planner=shape_planner, camera=camera)
-        for r, ok in zip(shape_records, outcomes, strict=True):
-            r["planner"] = ok
+        shape_records = [{**r, "planner": r.get("planner_left_out", False)} for r in records if r["type"] == shape]
         loso[shape] = summarize(shape_records, ("planner", "best_fixed", "random", "oracle"))
-    timings["leave_one_shape_out"] = time.perf_counter() - t
-    say(f"[4/5] leaving each shape out ({timings['leave_one_shape_out']:.0f} s): "
+    say("[4/5] leaving each shape out (judged in step 3): "
         + ", ".join(f"{s} " + share_text(loso[s]["planner"]["success_feasible"], loso[s]["planner"]["n_feasible"],
                                          loso[s]["planner"]["success_feasible_ci"], "feasible") for s in SHAPES))
 
@@ -498,15 +658,22 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
             planner_episodes = episodes
         n = len(episodes)
         k = sum(e["success"] for e in episodes)
+        toward = [e for e in episodes if e["toward_robot"]]
+        kt = sum(e["success"] for e in toward)
         interactions = sum(e["steps"] for e in episodes)
         multi[policy] = {"success": k / n if n else None, "success_ci": wilson(k, n), "n": n,
                          "reach_failures": sum(e["reach_failures"] for e in episodes) / max(interactions, 1),
                          "interactions": interactions, "gave_up": sum(e["gave_up"] for e in episodes),
-                         "median_final_distance_m": float(np.median([e["final_distance"] for e in episodes]))}
+                         "median_final_distance_m": float(np.median([e["final_distance"] for e in episodes])),
+                         "success_toward_robot": kt / len(toward) if toward else None,
+                         "success_toward_robot_ci": wilson(kt, len(toward)), "n_toward_robot": len(toward)}
     timings["multi_step"] = time.perf_counter() - t
     say(f"[5/5] multi-step on {settings.multi_episodes} episodes ({timings['multi_step']:.0f} s): "
         + ", ".join(f"{p} {share_text(multi[p]['success'], multi[p]['n'], multi[p]['success_ci'])}"
-                    for p in MULTI_POLICIES))
+                    for p in MULTI_POLICIES)
+        + "; toward the robot: planner " + share_text(multi["planner"]["success_toward_robot"],
+                                                       multi["planner"]["n_toward_robot"],
+                                                       multi["planner"]["success_toward_robot_ci"]))
 
     multi["planner"]["by_type"] = {
         shape: {"n": len(eps), "success": sum(e["success"] for e in eps) / len(eps)}
@@ -516,33 +683,45 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
                                                                                   GOAL_MAX_EPISODE_STEPS)
     multi["planner"]["episodes"] = [
         {**{k: e[k] for k in ("type", "start_xy", "target_xy", "initial_distance", "final_distance", "steps",
-                              "success", "gave_up", "reach_failures", "failures")},
+                              "success", "gave_up", "reach_failures", "failures", "toward_robot")},
          "within_reach": e["type"] in reach and within_reach(e["start_xy"], e["target_xy"], reach[e["type"]],
                                                              tolerance, GOAL_MAX_EPISODE_STEPS)}
         for e in planner_episodes]
     inside = [e for e in multi["planner"]["episodes"] if e["within_reach"]]
     multi["planner"]["within_reach"] = {"n": len(inside), "success": (sum(e["success"] for e in inside) / len(inside)
                                                                       if inside else None)}
-    executed = [e for r in records for e in r["executed"]]
+    acted = [r for r in records if r["planner_behavior"]]
     placement = [r["placement_error"] for r in records if "placement_error" in r]
     oracle = single["oracle"]["success"] or 0.0
+    choose_s = [r["decision_s"] for r in records]
+    toward_s = [s for e in planner_episodes for s in e["decision_s"]]
+    timings["total"] = time.perf_counter() - start
     results = {
-        "format": "tap-affordance-plan-results", "version": 1, "seed": seed, "settings": asdict(settings),
+        "format": "tap-affordance-plan-results", "version": 2, "seed": seed, "settings": asdict(settings),
         "units": {"fractions": "[0, 1]", "distances": "m", "times": "s"},
         "training": {b: len(f) for b, f in frames.items()},
+        "training_episodes": int(frame["episode"].nunique()),
+        "workers": workers, "cpu_count": os.cpu_count(),
+        "oracle": {"actions_per_behavior": len(oracle_params()), "levels": list(ORACLE_LEVELS),
+                   "objects": n_objects, "goals_per_object": dict(GOALS_PER_OBJECT),
+                   "objects_per_shape": {s: len({r["object"] for r in records if r["type"] == s}) for s in SHAPES}},
         "single_step": single,
         "single_step_by_goal": {kind: summarize([r for r in records if r["kind"] == kind], POLICIES)
                                 for kind in GOAL_KINDS},
         "best_fixed_behavior": fixed_choice,
         "planner_over_oracle": (single["planner"]["success"] / oracle) if oracle else None,
+        "single_step_reach_failures": {"n": len(acted),
+                                       "failures": sum(r["planner_reach_failure"] for r in acted)},
         "leave_one_shape_out": loso,
         "multi_step": multi,
         "placement_error_median_m": float(np.median(placement)) if placement else None,
         "placement_error_n": len(placement),  # the place goals the planner acted on: the median's n
-        "calibration": calibration([p for p, _ in executed], [y for _, y in executed]),
-        "timings_s": {**timings, "total": time.perf_counter() - start},
-        "goals": [{k: r[k] for k in ("kind", "type", "goal", "planner", "planner_p", "planner_behavior", "oracle")}
-                  for r in records],
+        "calibration": calibrations(records),
+        "decision_seconds": {**seconds_summary(choose_s + toward_s), "choose": seconds_summary(choose_s),
+                             "toward": seconds_summary(toward_s)},
+        "timings_s": timings,
+        "goals": [{k: r[k] for k in ("kind", "type", "object", "goal", "planner", "planner_p", "planner_behavior",
+                                     "oracle")} for r in records],
     }
     import json
 
@@ -578,4 +757,4 @@ def record_episode(out: str | os.PathLike, results: Mapping[str, Any], seed: int
 
 
 __all__ = ["PlanSettings", "run_plan", "record_episode", "measured_outcome", "reached", "calibration", "wilson",
-           "share_text"]
+           "share_text", "oracle_params", "feasible_at", "seconds_summary"]

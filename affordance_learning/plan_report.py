@@ -24,10 +24,15 @@ TARGETS: dict[str, tuple[str, float]] = {
     "single-step success over the oracle's": (">=", 0.95),
     "median placement error [m]": ("<=", 0.02),
     "each left-out shape, success on its feasible goals": (">=", 0.75),
+    "each left-out shape, planner minus best fixed behaviour": (">=", 0.0),
     "calibration ECE": ("<=", 0.05),
     "calibration AUROC": (">=", 0.95),
     "multi-step targets reached": (">=", 0.85),
-    "multi-step reach failures per interaction": ("<=", 0.02),
+    "multi-step targets toward the robot reached": (">=", 0.75),
+    "multi-step reach failures per interaction": ("<=", 0.01),
+    "decision time, median [s]": ("<=", 0.1),
+    "decision time, 99th percentile [s]": ("<=", 1.0),
+    "affordance plan's time [min]": ("<=", 15.0),
 }
 
 # The least data a verdict is given on; below it the verdict is "too few (n=...)". A share's Wilson 95 % interval
@@ -40,22 +45,32 @@ MIN_FEASIBLE_PER_SHAPE = 30
 #: Place goals the planner acted on, for the median placement error: at 30 the median's 95 % interval already spans
 #: the 10th to the 21st of the sorted errors; with fewer it is set by a handful of goals.
 MIN_PLACEMENTS = 30
-#: Actions executed, for the calibration: the ECE over 10 bins is biased upwards by sampling alone (a perfectly
-#: calibrated model shows up to about 0.8 x sqrt(2.5 / n)); from 1000 actions that is 0.04, under the 0.05 bound.
-MIN_CALIBRATION_ACTIONS = 1000
+#: The planner's chosen actions, for the calibration: the ECE over 10 bins is biased upwards by sampling alone (a
+#: perfectly calibrated model shows up to about 0.8 x sqrt(2.5 / n)); from 400 actions that is 0.06 at most, and
+#: far less where most chosen actions sit in one or two bins near P = 1, as a good planner's do.
+MIN_CALIBRATION_ACTIONS = 400
 #: Multi-step episodes: a share near the 85 % target is then known within +-9 points. The reach failures per
 #: interaction are judged on the same episodes (the interactions of one episode are not independent).
 MIN_EPISODES = 60
+#: Multi-step episodes whose target lies toward the robot: around 75 %, +-19 points.
+MIN_TOWARD_ROBOT = 15
+#: Planner decisions, for their median and 99th percentile: from 100, the 99th percentile is the second largest.
+MIN_DECISIONS = 100
 #: The minimum n of each target's verdict.
 MIN_N: dict[str, int] = {
     "single-step success on feasible goals": MIN_FEASIBLE_GOALS,
     "single-step success over the oracle's": MIN_FEASIBLE_GOALS,
     "median placement error [m]": MIN_PLACEMENTS,
     "each left-out shape, success on its feasible goals": MIN_FEASIBLE_PER_SHAPE,
+    "each left-out shape, planner minus best fixed behaviour": MIN_FEASIBLE_PER_SHAPE,
     "calibration ECE": MIN_CALIBRATION_ACTIONS,
     "calibration AUROC": MIN_CALIBRATION_ACTIONS,
     "multi-step targets reached": MIN_EPISODES,
+    "multi-step targets toward the robot reached": MIN_TOWARD_ROBOT,
     "multi-step reach failures per interaction": MIN_EPISODES,
+    "decision time, median [s]": MIN_DECISIONS,
+    "decision time, 99th percentile [s]": MIN_DECISIONS,
+    "affordance plan's time [min]": 1,
 }
 
 MET, MISSED, TOO_FEW, NOT_MEASURED = "met", "missed", "too few", "not measured"
@@ -103,6 +118,20 @@ def _worst_shape(results: PlanResults) -> Measured:
     return worst._replace(n=fewest.n, unit=fewest.unit, ci=None, detail=detail)
 
 
+def _shape_gap(results: PlanResults) -> Measured:
+    """The smallest margin of the left-out planner over the best fixed behaviour on a shape's feasible goals
+    (a difference of shares), with the fewest feasible goals of the shapes as n."""
+    gaps = {s: (r["planner"].feasible, r["best_fixed"].feasible) for s, r in results.leave_one_shape_out.items()}
+    measured = {s: (p.value - b.value, p.n) for s, (p, b) in gaps.items() if p.value is not None}
+    detail = "; ".join(f"{s} {100 * g:+.1f} points (n={n} feasible goals)" for s, (g, n) in measured.items())
+    if not measured:
+        return Measured(None, 0, "feasible goals of any shape", detail=detail or None)
+    worst = min(measured, key=lambda s: measured[s][0])
+    fewest = min(n for _, n in measured.values())
+    return Measured(measured[worst][0], fewest, f"feasible goals of the fewest shape (worst: {worst})",
+                    detail=detail)
+
+
 def _measured(share: Share, unit: str) -> Measured:
     """A target's share, with its n and interval."""
     return Measured(share.value, share.n, unit, share.ci)
@@ -134,13 +163,26 @@ def measured_targets(results: PlanResults | Mapping[str, Any]) -> dict[str, Meas
         "median placement error [m]": Measured(results.placement_error_median_m, results.placement_error_n,
                                                "place goals acted on"),
         "each left-out shape, success on its feasible goals": _worst_shape(results),
-        "calibration ECE": Measured(calibration.ece, calibration.n, "actions"),
-        "calibration AUROC": Measured(calibration.auroc, calibration.n, "actions"),
+        "each left-out shape, planner minus best fixed behaviour": _shape_gap(results),
+        "calibration ECE": Measured(calibration.ece, calibration.n, _actions(calibration)),
+        "calibration AUROC": Measured(calibration.auroc, calibration.n, _actions(calibration)),
         "multi-step targets reached": _measured(multi.reached, "episodes"),
+        "multi-step targets toward the robot reached": _measured(multi.toward_robot, "episodes toward the robot"),
         "multi-step reach failures per interaction": Measured(
             multi.reach_failures if multi.interactions else None, multi.reached.n,
             f"episodes, {multi.interactions} interactions", wilson(multi.reach_failure_count, multi.interactions)),
+        "decision time, median [s]": Measured(results.decision_seconds.median, results.decision_seconds.n,
+                                              "decisions"),
+        "decision time, 99th percentile [s]": Measured(results.decision_seconds.p99, results.decision_seconds.n,
+                                                       "decisions"),
+        "affordance plan's time [min]": Measured(results.total_time_s / 60, 1,
+                                                 f"run on {results.workers or '?'} workers"),
     }
+
+
+def _actions(calibration) -> str:
+    """What the calibration's n counts."""
+    return "chosen actions" if "chosen" in calibration.basis else "actions (pooled)"
 
 
 def target_verdict(name: str, measured: Measured) -> str:
@@ -178,9 +220,28 @@ def _value_text(name: str, measured: Measured) -> str:
         return share_text(None, measured.n, unit=measured.unit)
     if "[m]" in name:
         return f"{100 * measured.value:.1f} cm (n={measured.n} {measured.unit})"
+    if "[s]" in name:
+        return f"{1000 * measured.value:.0f} ms (n={measured.n} {measured.unit})"
+    if "[min]" in name:
+        return f"{measured.value:.1f} min ({measured.unit})"
     if name.startswith("calibration"):
         return f"{measured.value:.3f} (n={measured.n} {measured.unit})"
     return share_text(measured.value, measured.n, measured.ci, measured.unit, digits=1)
+
+
+def _bound_text(name: str, bound: float) -> str:
+    """A target's bound as the report shows it."""
+    if "[m]" in name:
+        return f"{100 * bound:.0f} cm"
+    if "[s]" in name:
+        return f"{1000 * bound:.0f} ms"
+    if "[min]" in name:
+        return f"{bound:.0f} min"
+    if name.startswith("calibration"):
+        return f"{bound}"
+    if "minus" in name:
+        return f"{100 * bound:.0f} points"
+    return f"{100 * bound:.0f} %"
 
 
 def _reached(outcomes: Mapping[str, Any], policy: str) -> Share:
@@ -202,6 +263,19 @@ def _why(name: str, results: PlanResults) -> str:
         place = _reached(single.get("place", {}), "oracle")
         return (f"place goals are reached in {_share(place)} of cases even by the oracle: most "
                 "targets 5-15 cm away are beyond what one interaction does to the object")
+    if name.startswith("decision time"):
+        return ("a decision scores every candidate of every behaviour and asks the kinematics (``feasible``, "
+                "2-70 ms a call) about the best ones; the slowest are those whose best candidates are out of reach")
+    if name.startswith("affordance plan"):
+        timings = results.timings_s
+        parts = ", ".join(f"{k} {v / 60:.1f} min" for k, v in timings.items() if k != "total")
+        return f"the stages took {parts}"
+    if name.startswith("multi-step targets toward"):
+        multi = results.multi_step.policy("planner")
+        towards = [e for e in multi.episodes if e.toward_robot]
+        beyond = sum(not e.within_reach for e in towards)
+        return (f"{beyond} of the {len(towards)} targets toward the robot lay further than the episode's "
+                "interactions took any object of their type toward it in training")
     if name.startswith("each left-out"):
         loso = results.leave_one_shape_out
         parts = [f"{s}: {_share(loso[s]['planner'].feasible, 'feasible')} (best fixed "
@@ -273,27 +347,37 @@ def write_plan_report(results: PlanResults | Mapping[str, Any], out: str | os.Pa
               + ", ".join(f"{b} {n}" for b, n in results.training.items())
               + f" (random actions from {results.episodes} goal episodes, objects over the workspaces). "
               f"Total time {results.total_time_s / 60:.1f} min.", ""]
+    oracle = results.oracle
+    if oracle:
+        lines += [f"Single step: {oracle.get('objects')} held-out objects ("
+                  + ", ".join(f"{n} {s}" for s, n in oracle.get("objects_per_shape", {}).items())
+                  + f"), {sum(oracle.get('goals_per_object', {}).values())} goals each ("
+                  + ", ".join(f"{n} {k}" for k, n in oracle.get("goals_per_object", {}).items())
+                  + f"). The oracle runs {oracle.get('actions_per_behavior')} actions per behaviour on every object "
+                  f"from its snapshot, the same fixed set for all (the canonical action and the grid of levels "
+                  f"{oracle.get('levels')} along each parameter), and every goal of the object is judged against "
+                  "those outcomes: a goal is *feasible* when one of them reached it. The goals of one object are "
+                  "not independent; the intervals treat them as if they were.", ""]
     lines += ["## Targets", "",
               "A target is judged only on enough data, else it is *too few* (a share of nothing is *not measured*): "
               f"at least {MIN_FEASIBLE_GOALS} feasible single-step goals, {MIN_FEASIBLE_PER_SHAPE} feasible goals "
-              f"of each left-out shape, {MIN_PLACEMENTS} place goals acted on, {MIN_CALIBRATION_ACTIONS} actions "
-              f"for the calibration and {MIN_EPISODES} multi-step episodes. Shares carry their Wilson 95 % interval "
-              "and n.", "",
+              f"of each left-out shape, {MIN_PLACEMENTS} place goals acted on, {MIN_CALIBRATION_ACTIONS} chosen "
+              f"actions for the calibration, {MIN_EPISODES} multi-step episodes ({MIN_TOWARD_ROBOT} toward the "
+              f"robot) and {MIN_DECISIONS} decisions. Shares carry their Wilson 95 % interval and n.", "",
               "| target | bound | measured | verdict | why not |", "|---|---|---|---|---|"]
     for name, measured in measured_targets(results).items():
         direction, bound = TARGETS[name]
         verdict = target_verdict(name, measured)
-        bound_text = f"{100 * bound:.0f} cm" if "[m]" in name else (f"{bound}" if name.startswith("calibration")
-                                                                     else f"{100 * bound:.0f} %")
-        lines.append(f"| {name} | {direction} {bound_text} | {_value_text(name, measured)} | "
+        lines.append(f"| {name} | {direction} {_bound_text(name, bound)} | {_value_text(name, measured)} | "
                      f"**{verdict_text(name, measured)}** | {_why(name, results) if verdict == MISSED else ''} |")
     single = results.single_step
-    lines += ["", f"## Single step ({_policy(single, 'planner', 'single-step').reached.n} held-out objects, one goal "
-              f"each; {_policy(single, 'oracle', 'single-step').feasible.n} feasible)", "",
-              "| policy | success [95 % CI] | on feasible goals [95 % CI] |", "|---|---|---|"]
+    lines += ["", f"## Single step ({_policy(single, 'planner', 'single-step').reached.n} goals; "
+              f"{_policy(single, 'oracle', 'single-step').feasible.n} feasible)", "",
+              "| policy | success [95 % CI] | on feasible goals [95 % CI] | on goals the oracle or the planner "
+              "reached [95 % CI] |", "|---|---|---|---|"]
     for p in POLICIES:
         r = _policy(single, p, "single-step")
-        lines.append(f"| {p} | {_share(r.reached)} | {_share(r.feasible)} |")
+        lines.append(f"| {p} | {_share(r.reached)} | {_share(r.feasible)} | {_share(r.reached_any)} |")
     lines += ["", "Per goal kind (success [95 % CI]):", "", "| goal | " + " | ".join(POLICIES) + " |",
               "|---|" + "---|" * len(POLICIES)]
     for kind, by in results.single_step_by_goal.items():
@@ -305,22 +389,38 @@ def write_plan_report(results: PlanResults | Mapping[str, Any], out: str | os.Pa
     for shape, r in results.leave_one_shape_out.items():
         lines.append(f"| {shape} | {_share(r['planner'].feasible)} | "
                      f"{_share(r['best_fixed'].feasible)} | {_share(r['random'].reached)} |")
-    lines += ["", "## Multi-step", "", "| policy | targets reached [95 % CI] | reach failures per interaction "
-              "[95 % CI] | median final distance |", "|---|---|---|---|"]
+    lines += ["", "## Multi-step", "", "| policy | targets reached [95 % CI] | toward the robot [95 % CI] | reach "
+              "failures per interaction [95 % CI] | median final distance |", "|---|---|---|---|---|"]
     for p in MULTI_POLICIES:
         r = results.multi_step.policy(p)
-        lines.append(f"| {p} | {_share(r.reached, unit='episodes')} | "
+        lines.append(f"| {p} | {_share(r.reached, unit='episodes')} | {_share(r.toward_robot, unit='episodes')} | "
                      + share_text(r.reach_failures, r.interactions, wilson(r.reach_failure_count, r.interactions),
                                   "interactions", digits=1)
                      + f" | {100 * r.median_final_distance_m:.1f} cm (n={r.reached.n} episodes) |")
     cal = results.calibration
-    auroc = "-" if cal.auroc is None else f"{cal.auroc:.3f}"
-    lines += ["", "## Calibration", "",
-              f"Over the {cal.n} actions executed in the single-step evaluation: ECE {cal.ece:.3f}, AUROC "
-              f"{auroc}.", "",
-              "![success](success.png)", "![reliability](reliability.png)", "![episode](episode.png)", ""]
+    lines += ["", "## Calibration", "", f"On {cal.basis} ({cal.n}): {_calibration_text(cal)}."]
+    if cal.pooled is not None:
+        lines += ["", f"Pooled over {cal.pooled.basis} ({cal.pooled.n}), most of them at P near 0: "
+                  f"{_calibration_text(cal.pooled)}. The pooled figure says how well the model ranks actions in "
+                  "general; the chosen actions' says whether the planner's P(goal) can be believed."]
+    if cal.curve:
+        lines += ["", "| predicted P | observed | n |", "|---|---|---|"]
+        lines += [f"| {c.p:.2f} | {c.observed:.2f} | {c.n} |" for c in cal.curve]
+    times = results.decision_seconds
+    if times.n:
+        lines += ["", "## Decision time", "",
+                  f"{times.n} decisions (single step and multi-step, ``feasible``'s calls included, measured in the "
+                  f"workers of the run): median {1000 * times.median:.0f} ms, 99th percentile "
+                  f"{1000 * times.p99:.0f} ms."]
+    lines += ["", "![success](success.png)", "![reliability](reliability.png)", "![episode](episode.png)", ""]
     (out / "REPORT.md").write_text("\n".join(lines))
     return out / "REPORT.md"
+
+
+def _calibration_text(cal) -> str:
+    ece = "-" if cal.ece is None else f"{cal.ece:.3f}"
+    auroc = "-" if cal.auroc is None else f"{cal.auroc:.3f}"
+    return f"ECE {ece}, AUROC {auroc}"
 
 
 def write_plan_figures(results: PlanResults | Mapping[str, Any], out: str | os.PathLike,
@@ -359,7 +459,7 @@ def write_plan_figures(results: PlanResults | Mapping[str, Any], out: str | os.P
     ax.scatter([c.p for c in curve], [c.observed for c in curve], s=[10 + c.n / 2 for c in curve])
     ax.set_xlabel("predicted P(goal)")
     ax.set_ylabel("observed share reached")
-    ax.set_title(f"Reliability (ECE {results.calibration.ece:.3f})")
+    ax.set_title(f"Reliability on chosen actions ({_calibration_text(results.calibration)})")
     fig.tight_layout()
     fig.savefig(out / "reliability.png", dpi=100)
     plt.close(fig)

@@ -8,7 +8,7 @@ are in metres, times in seconds.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
@@ -51,10 +51,13 @@ class PolicyOutcome:
     Attributes:
         reached: Its share of all the goals.
         feasible: Its share of the feasible goals (those the oracle reached).
+        reached_any: Its share of the goals the oracle or the planner reached (:data:`NOTHING` in results written
+            before it was recorded).
     """
 
     reached: Share
     feasible: Share
+    reached_any: Share = NOTHING
 
 
 @dataclass(frozen=True)
@@ -70,6 +73,7 @@ class Episode:
             (:func:`~affordance_learning.plan_experiment.within_reach`).
         gave_up: Whether the planner stopped where no candidate action was reachable.
         failures: The messages of its interactions that failed to reach.
+        toward_robot: Whether its target lay toward the robot (within 45 degrees of +x from the object).
     """
 
     type: str
@@ -79,6 +83,7 @@ class Episode:
     within_reach: bool
     gave_up: bool
     failures: tuple[str, ...] = ()
+    toward_robot: bool = False
 
 
 @dataclass(frozen=True)
@@ -95,6 +100,8 @@ class MultiStepOutcome:
         episodes: Its episodes (the planner's only).
         within_reach: Its share of the episodes reached among those whose target was within reach (the
             planner's only; :data:`NOTHING` otherwise).
+        toward_robot: Its share of the episodes reached among those whose target lay toward the robot (within 45
+            degrees of +x; :data:`NOTHING` in results written before it was recorded).
     """
 
     reached: Share
@@ -104,6 +111,7 @@ class MultiStepOutcome:
     by_type: Mapping[str, Share]
     episodes: tuple[Episode, ...] = ()
     within_reach: Share = NOTHING
+    toward_robot: Share = NOTHING
 
     @property
     def reach_failure_count(self) -> int:
@@ -148,14 +156,27 @@ class CalibrationBin:
 
 @dataclass(frozen=True)
 class Calibration:
-    """How well the planner's predicted probabilities match what happened, over the actions executed in the
-    single-step evaluation: expected calibration error (a fraction), AUROC (None with a single outcome), the
-    actions, and the reliability curve."""
+    """How well the planner's predicted probabilities match what happened: expected calibration error (a
+    fraction; None without actions), AUROC (None with a single outcome), the actions, the reliability curve, what
+    the actions are (``basis``: the planner's chosen actions of the single-step evaluation; results written before
+    it pooled every executed action), and the same pooled over every action tried (``pooled``, or None)."""
 
-    ece: float
+    ece: float | None
     auroc: float | None
     n: int
     curve: tuple[CalibrationBin, ...]
+    basis: str = "every action executed in the single-step evaluation"
+    pooled: Calibration | None = None
+
+
+@dataclass(frozen=True)
+class DecisionTimes:
+    """How long the planner's decisions took [s], ``feasible``'s calls included: median, 99th percentile and n
+    (None without decisions)."""
+
+    median: float | None
+    p99: float | None
+    n: int
 
 
 @dataclass(frozen=True)
@@ -179,6 +200,11 @@ class PlanResults:
         placement_error_n: How many place goals the planner acted on (counted from the goals in results written
             before it was recorded).
         calibration: The calibration of the planner's predicted probabilities.
+        decision_seconds: The planner's decision times, single-step and multi-step together (n 0 in results
+            written before they were recorded).
+        workers: The worker processes of the run (None when not recorded).
+        oracle: How the single-step evaluation was made: ``objects``, ``objects_per_shape``, ``goals_per_object``,
+            ``actions_per_behavior``, ``levels`` (empty in results written before it was recorded).
     """
 
     seed: int
@@ -194,6 +220,9 @@ class PlanResults:
     placement_error_median_m: float | None
     placement_error_n: int
     calibration: Calibration
+    decision_seconds: DecisionTimes = DecisionTimes(None, None, 0)
+    workers: int | None = None
+    oracle: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
 
     @classmethod
     def from_dict(cls, results: PlanResults | Mapping[str, Any]) -> PlanResults:
@@ -229,6 +258,9 @@ class PlanResults:
             placement_error_median_m=_number(top["placement_error_median_m"], ("placement_error_median_m",), True),
             placement_error_n=_placements(top),
             calibration=_calibration(top["calibration"], ("calibration",)),
+            decision_seconds=_decisions(top.get("decision_seconds"), ("decision_seconds",)),
+            workers=None if top.get("workers") is None else _count(top["workers"], ("workers",)),
+            oracle=MappingProxyType(dict(_mapping(top.get("oracle", {}), ("oracle",)))),
         )
 
     @property
@@ -278,7 +310,9 @@ def _outcomes(value: Any, path: _Path) -> Mapping[str, PolicyOutcome]:
         entry = _entry(entry, where, ("success", "success_ci", "n", "success_feasible", "success_feasible_ci",
                                       "n_feasible"))
         return PolicyOutcome(_share(entry, where),
-                             _share(entry, where, "success_feasible", "n_feasible", "success_feasible_ci"))
+                             _share(entry, where, "success_feasible", "n_feasible", "success_feasible_ci"),
+                             _share(entry, where, "success_reached", "n_reached", "success_reached_ci")
+                             if "n_reached" in entry else NOTHING)
 
     return _by_name(value, path, outcome)
 
@@ -295,7 +329,8 @@ def _episode(value: Any, path: _Path) -> Episode:
     return Episode(type=_text(entry["type"], (*path, "type")), start_xy=_xy(entry["start_xy"], (*path, "start_xy")),
                    target_xy=_xy(entry["target_xy"], (*path, "target_xy")), success=bool(entry["success"]),
                    within_reach=bool(entry["within_reach"]), gave_up=bool(entry["gave_up"]),
-                   failures=tuple(str(f) for f in _list(entry.get("failures", []), (*path, "failures"))))
+                   failures=tuple(str(f) for f in _list(entry.get("failures", []), (*path, "failures"))),
+                   toward_robot=bool(entry.get("toward_robot", False)))
 
 
 #: The entries of ``multi_step`` that describe the evaluation, not a policy.
@@ -321,6 +356,8 @@ def _multi_step(value: Any, path: _Path) -> MultiStep:
                            for i, e in enumerate(_list(entry.get("episodes", []), (*where, "episodes")))),
             within_reach=(NOTHING if entry.get("within_reach") is None
                           else _share(entry["within_reach"], (*where, "within_reach"), ci=None)),
+            toward_robot=(_share(entry, where, "success_toward_robot", "n_toward_robot", "success_toward_robot_ci")
+                          if "n_toward_robot" in entry else NOTHING),
         )
     reach = _by_name(section.get("step_reach_p90_m", {}), (*path, "step_reach_p90_m"),
                      lambda v, p: _by_name(v, p, _number))
@@ -338,9 +375,20 @@ def _calibration(value: Any, path: _Path) -> Calibration:
         curve.append(CalibrationBin(_number(entry["p"], (*where, "p")),
                                     _number(entry["observed"], (*where, "observed")),
                                     _count(entry["n"], (*where, "n"))))
-    return Calibration(ece=_number(section["ece"], (*path, "ece")),
+    pooled = section.get("pooled")
+    return Calibration(ece=_number(section["ece"], (*path, "ece"), True),
                        auroc=_number(section["auroc"], (*path, "auroc"), True),
-                       n=_count(section["n"], (*path, "n")), curve=tuple(curve))
+                       n=_count(section["n"], (*path, "n")), curve=tuple(curve),
+                       basis=_text(section.get("basis", Calibration.basis), (*path, "basis")),
+                       pooled=None if pooled is None else _calibration(pooled, (*path, "pooled")))
+
+
+def _decisions(value: Any, path: _Path) -> DecisionTimes:
+    if value is None:
+        return DecisionTimes(None, None, 0)
+    section = _entry(value, path, ("median", "p99", "n"))
+    return DecisionTimes(_number(section["median"], (*path, "median"), True),
+                         _number(section["p99"], (*path, "p99"), True), _count(section["n"], (*path, "n")))
 
 
 def _placements(results: Mapping[str, Any]) -> int:
@@ -353,5 +401,5 @@ def _placements(results: Mapping[str, Any]) -> int:
                for i, g in enumerate(goals))
 
 
-__all__ = ["NOTHING", "PLAN_RESULTS_FORMAT", "Calibration", "CalibrationBin", "Episode", "MultiStep",
+__all__ = ["NOTHING", "PLAN_RESULTS_FORMAT", "Calibration", "CalibrationBin", "DecisionTimes", "Episode", "MultiStep",
            "MultiStepOutcome", "PlanResults", "PolicyOutcome", "Share"]

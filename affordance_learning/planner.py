@@ -3,10 +3,16 @@
 :class:`Planner` scores candidate actions, every behaviour with ``n_candidates`` parameter vectors (the canonical
 action and a scrambled Sobol sequence over [-1, 1]^3), by P(goal) under each behaviour's
 :class:`~affordance_learning.effect_model.ActionEffectModel`, and takes the most likely one that the arm can
-reach (``feasible``, asked from the most likely down, so that the kinematics is asked a few times, not for every
-candidate). Below ``threshold`` it abstains. :meth:`Planner.toward` chooses the next interaction of a multi-step
-episode towards a place on the table: the action most likely to end within the tolerance, or, when none is
-likely enough, the one whose predicted outcomes end nearest on average (re-planned after every interaction).
+reach: ``feasible`` (the kinematics, tens of milliseconds a call) is asked from the most likely down, at most
+``max_checks`` times per decision, so that a decision costs a few calls, not one per candidate. Candidates of equal
+P (every one near 0 for a goal out of reach) are ranked by how far their predicted outcomes go towards the goal,
+then candidate by candidate across the behaviours. Below ``threshold`` it abstains. :meth:`Planner.toward` chooses
+the next interaction of a multi-step episode towards a place on the table: by default a search over two
+interactions, where the behaviours' workspaces say a second one can act (re-planned after every interaction).
+
+The planner remembers the actions that failed to reach (:meth:`Planner.note_failure`): an action that failed on
+an object where it is (within ``FAILURE_RADIUS``) is not chosen there again, unchanged; :meth:`forget_failures`
+clears what it remembers (a new episode or object).
 """
 
 from __future__ import annotations
@@ -21,23 +27,31 @@ from affordance_env.scene import table_extent
 from affordance_learning.behaviors import BEHAVIORS
 from affordance_learning.effect_model import ActionEffectModel
 from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.goals import Goal, Place, check_goal, check_start
+from affordance_learning.goals import Goal, Move, Place, check_goal, check_start
 
 #: An outcome that leaves the table counts as this far from any place [m] when actions are ranked by distance.
 OFF_TABLE_DISTANCE = 1.0
 #: The search over two interactions (:meth:`Planner.toward`): first actions looked at (the nearest on average,
 #: and half as many of the most likely), predicted outcomes followed from each, and parameter vectors per
-#: behaviour for the second interaction (the first of the planner's candidates).
-LOOKAHEAD_ROOTS, LOOKAHEAD_OUTCOMES, LOOKAHEAD_SECOND = 16, 8, 8
+#: behaviour for the second interaction (the first of the planner's candidates). 8 and 4 instead of 16 and 8 make
+#: the same first choice in 39 of 40 decisions on ``affordance plan``'s models of seed 0, in half the time.
+LOOKAHEAD_ROOTS, LOOKAHEAD_OUTCOMES, LOOKAHEAD_SECOND = 8, 4, 8
 #: A first action is chosen for its value over two interactions when that value is at least this.
 MIN_SEQUENCE_VALUE = 0.1
+#: Calls to ``feasible`` per decision at most: the candidates asked, from the best down. Each costs 2-70 ms (the
+#: grasp's the most); 8 keep a decision under a second where the most likely candidates are out of reach.
+MAX_CHECKS = 8
+#: An action that failed to reach is not chosen again on an object that is still within this distance [m] of
+#: where it failed (:meth:`Planner.note_failure`); an object that moved further is a new situation.
+FAILURE_RADIUS = 0.01
 
 
-def _ends(model: ActionEffectModel, start: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Where each training outcome of ``model`` leaves an object that was at ``start`` [m], and whether it left
-    the table."""
-    frame = model.outcome_frame()
-    return start + frame[["dx", "dy"]].to_numpy(), frame["off_table"].to_numpy(bool)
+def in_workspace(behavior: str, xy: np.ndarray) -> np.ndarray:
+    """Whether each point ``xy`` (n, 2) [m] lies in the workspace of ``behavior``
+    (:func:`affordance_env.workspace.in_workspace`): :meth:`Planner.toward`'s default ``reachable``."""
+    from affordance_env.workspace import in_workspace as inside
+
+    return np.asarray(inside(behavior, np.asarray(xy, dtype=np.float64)), dtype=bool)
 
 
 def _reached_by_any(reachable: Callable[[str, np.ndarray], np.ndarray], names: list[str], xy: np.ndarray
@@ -80,7 +94,7 @@ class Choice:
             to reach the place: still P(within tolerance)).
         abstained: P(goal) was below the threshold.
         expected_distance: For :meth:`Planner.toward`: the mean predicted distance to the place [m]; else NaN.
-        checked: How many candidates the kinematics was asked about.
+        checked: How many candidates the kinematics was asked about (at most the planner's ``max_checks``).
         value: For :meth:`Planner.toward`: P(within the tolerance) after this interaction and, where more are
             left, after the best second one (:meth:`Planner.toward`); else NaN.
     """
@@ -104,6 +118,8 @@ class Planner:
         n_candidates: Parameter vectors scored per behaviour.
         threshold: Abstain below this P(goal).
         random_state: Seed of the candidates.
+        max_checks: Calls to ``feasible`` per decision at most (:data:`MAX_CHECKS`); when none of the candidates
+            asked is feasible the choice is None (``behavior`` None, abstained).
 
     Every method checks its inputs before any work: ``features`` must have as many values as the models take
     (ValueError), the goal must be a goal of :mod:`affordance_learning.goals` (TypeError), a
@@ -112,11 +128,13 @@ class Planner:
     """
 
     def __init__(self, models: Mapping[str, ActionEffectModel], n_candidates: int = 64, threshold: float = 0.5,
-                 random_state: int = 0) -> None:
+                 random_state: int = 0, max_checks: int = MAX_CHECKS) -> None:
         if not models:
             raise InvalidValueError("models must map at least one behaviour name to its fitted ActionEffectModel.")
         if not (isinstance(threshold, int | float) and 0.0 <= threshold <= 1.0):
             raise InvalidValueError(f"threshold must be a probability in [0, 1], got {threshold!r}.")
+        if isinstance(max_checks, bool) or not isinstance(max_checks, int | np.integer) or max_checks < 1:
+            raise InvalidValueError(f"max_checks must be an integer >= 1, got {max_checks!r}.")
         unknown = [name for name in models if name not in BEHAVIORS]
         if unknown:
             raise InvalidValueError(f"Unknown behavior(s) {', '.join(map(repr, unknown))} in models. Valid behaviors: "
@@ -129,10 +147,44 @@ class Planner:
             raise InvalidValueError(f"the models must take the same inputs, got {inputs} input columns per behaviour.")
         self.models = dict(models)
         self.threshold = float(threshold)
+        self.max_checks = int(max_checks)
         self.params = candidate_params(n_candidates, random_state)
         #: How many feature values each method's ``features`` must have: the models' inputs but the parameters.
         self.n_features = next(iter(inputs.values())) - self.params.shape[1]
+        # Each model's training outcomes, read once: every decision judges its goal on them.
+        self._frames = {name: model.outcome_frame() for name, model in self.models.items()}
+        #: The actions that failed to reach, each (behaviour, params, where the object was (x, y) or None, its
+        #: features): :meth:`note_failure`.
+        self.failures: list[tuple[str, np.ndarray, np.ndarray | None, np.ndarray]] = []
 
+    # --- what failed ---------------------------------------------------------------------------------------------
+    def note_failure(self, behavior: str, params, start_xy=None, features=None) -> None:
+        """Remember that ``behavior`` with ``params`` failed to reach the object at ``start_xy`` [m] (or, without
+        a position, seen with ``features``): no later decision on that object there chooses it again."""
+        where = None if start_xy is None else _check_start(start_xy)
+        seen = np.zeros(0) if features is None else np.asarray(features, dtype=np.float64).ravel()
+        self.failures.append((str(behavior), np.asarray(params, dtype=np.float64).ravel().copy(), where, seen))
+
+    def forget_failures(self) -> None:
+        """Forget every failure noted (:meth:`note_failure`): for a new object or episode."""
+        self.failures.clear()
+
+    def _excluded(self, features: np.ndarray, start: np.ndarray | None) -> set[tuple[str, int]]:
+        """The candidates (behaviour, index) that failed on this object where it is now."""
+        out = set()
+        for name, params, where, seen in self.failures:
+            if name not in self.models:
+                continue
+            if where is not None and start is not None:
+                here = np.linalg.norm(where - start) <= FAILURE_RADIUS
+            else:
+                here = seen.shape == features.shape and np.allclose(seen, features, rtol=1e-3, atol=1e-6)
+            if here:
+                same = np.flatnonzero(np.all(np.abs(self.params - params) <= 1e-6, axis=1))
+                out.update((name, int(k)) for k in same)
+        return out
+
+    # --- scoring -------------------------------------------------------------------------------------------------
     def _inputs(self, features: np.ndarray) -> np.ndarray:
         x = np.asarray(features, dtype=np.float64)
         if x.size != self.n_features or x.ndim > 2:
@@ -145,60 +197,105 @@ class Planner:
             raise InvalidValueError("features must be finite (the object must have been seen).")
         return np.hstack([np.repeat(x[None], len(self.params), axis=0), self.params])
 
+    def _progress(self, name: str, goal: Goal, start: np.ndarray | None) -> np.ndarray | None:
+        """Per training outcome of ``name``, how far it goes towards ``goal`` (higher is better): along a
+        :class:`Move`'s direction, minus the distance to a :class:`Place`'s target [m]; None for other goals."""
+        frame = self._frames[name]
+        off = frame["off_table"].to_numpy(bool)
+        if isinstance(goal, Move):
+            along = frame["dx"].to_numpy() * goal.direction[0] + frame["dy"].to_numpy() * goal.direction[1]
+            return np.where(off, -OFF_TABLE_DISTANCE, along)
+        if isinstance(goal, Place):
+            end = start + frame[["dx", "dy"]].to_numpy()
+            return -np.where(off, OFF_TABLE_DISTANCE, np.linalg.norm(end - np.asarray(goal.target_xy), axis=1))
+        return None
+
+    def _score(self, features: np.ndarray, goal: Goal, start_xy) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """Per behaviour, every candidate's P(goal) and expected progress towards it (:meth:`_progress`, 0 where
+        the goal has no distance)."""
+        check_goal(goal)
+        start = _check_start(start_xy) if isinstance(goal, Place) else None
+        X = self._inputs(features)
+        out = {}
+        for name, model in self.models.items():
+            W = model.predictive_weights(X, as_sparse=True)
+            frame = self._frames[name]
+            p = np.asarray(W @ goal.reached(frame, start).astype(np.float64)).ravel()
+            progress = self._progress(name, goal, start)
+            out[name] = (p, np.zeros(len(p)) if progress is None else np.asarray(W @ progress).ravel())
+        return out
+
     def scores(self, features: np.ndarray, goal: Goal, start_xy=None) -> dict[str, np.ndarray]:
         """P(goal) of every candidate, per behaviour: {behaviour: (n_candidates,)}."""
-        check_goal(goal)
-        if isinstance(goal, Place):
-            _check_start(start_xy)
-        X = self._inputs(features)
-        return {name: model.goal_probability(X, goal, start_xy) for name, model in self.models.items()}
+        return {name: p for name, (p, _) in self._score(features, goal, start_xy).items()}
 
-    def _first_feasible(self, ranked: list[tuple[float, str, int]], feasible: Callable[[str, np.ndarray], bool] | None
-                        ) -> tuple[tuple[float, str, int] | None, int]:
-        checked = 0
+    def _first_feasible(self, ranked, feasible, excluded: set[tuple[str, int]], asked: dict[tuple[str, int], bool]):
+        """The first entry of ``ranked`` (each ending with behaviour and candidate index) that is not ``excluded``
+        and that ``feasible`` accepts, asking at most ``max_checks`` times per decision over all rankings
+        (``asked`` holds the answers so far); None when none is found within that."""
         for entry in ranked:
+            key = (entry[-2], entry[-1])
+            if key in excluded:
+                continue
             if feasible is None:
-                return entry, checked
-            checked += 1
-            if feasible(entry[1], self.params[entry[2]]):
-                return entry, checked
-        return None, checked
+                return entry
+            if key not in asked:
+                if len(asked) >= self.max_checks:
+                    return None
+                asked[key] = bool(feasible(key[0], self.params[key[1]]))
+            if asked[key]:
+                return entry
+        return None
 
     def choose(self, features: np.ndarray, goal: Goal, start_xy=None,
                feasible: Callable[[str, np.ndarray], bool] | None = None) -> Choice:
-        """The most likely feasible action for ``goal`` on the object seen with ``features`` at ``start_xy``."""
-        scores = self.scores(features, goal, start_xy)
-        ranked = sorted(((float(p), name, k) for name, ps in scores.items() for k, p in enumerate(ps)),
-                        key=lambda e: (-e[0], e[1], e[2]))
-        best, checked = self._first_feasible(ranked, feasible)
+        """The most likely feasible action for ``goal`` on the object seen with ``features`` at ``start_xy``, not
+        one that failed there (:meth:`note_failure`). Ties in P(goal) go to the candidate whose outcomes go
+        furthest towards the goal on average, then to the earlier candidate (the canonical action first),
+        behaviour after behaviour; ``feasible`` is asked at most ``max_checks`` times, and where none of those is
+        feasible the choice is None."""
+        scores = self._score(features, goal, start_xy)
+        names = list(scores)
+        ranked = sorted(((float(p), float(g), k, i, name) for i, name in enumerate(names)
+                         for k, (p, g) in enumerate(zip(*scores[name], strict=True))),
+                        key=lambda e: (-e[0], -e[1], e[2], e[3]))
+        ranked = [(p, g, name, k) for p, g, k, _, name in ranked]
+        start = None if start_xy is None else _check_start(start_xy)
+        asked: dict[tuple[str, int], bool] = {}
+        best = self._first_feasible(ranked, feasible, self._excluded(self._inputs(features)[0, : self.n_features],
+                                                                      start), asked)
         if best is None:
-            return Choice(None, np.zeros(3), 0.0, True, checked=checked)
-        p, name, k = best
-        return Choice(name, self.params[k].copy(), p, p < self.threshold, checked=checked)
+            return Choice(None, np.zeros(3), 0.0, True, checked=len(asked))
+        p, _, name, k = best
+        return Choice(name, self.params[k].copy(), p, p < self.threshold, checked=len(asked))
 
     def toward(self, features: np.ndarray, start_xy, target_xy, tolerance: float,
-               feasible: Callable[[str, np.ndarray], bool] | None = None, steps_left: int = 1,
-               reachable: Callable[[str, np.ndarray], np.ndarray] | None = None) -> Choice:
+               feasible: Callable[[str, np.ndarray], bool] | None = None, steps_left: int | None = None,
+               reachable: Callable[[str, np.ndarray], np.ndarray] | None = in_workspace) -> Choice:
         """The next interaction towards ``target_xy`` [m], a place on the table top (:func:`table_extent`; another
         is a ValueError), re-planned after every interaction.
 
-        With ``steps_left`` 1 (this interaction is the last): the feasible action most likely to end within
-        ``tolerance``, if that is at least the threshold, else the one whose predicted outcomes end nearest on
-        average. With 2 or more, a search over sequences of two interactions: an action's value is its
-        P(within) plus the share of its predicted outcomes that neither end within nor leave the table times the
-        best P(within) of a second interaction from there, averaged over the most likely of those outcomes (the
-        object where the outcome leaves it, seen with the initial features plus the outcome's perceptual
-        effect). An action likely enough to end within is taken at once; else the most valuable one, if its value
-        reaches ``MIN_SEQUENCE_VALUE``; else the nearest.
+        By default (``steps_left`` None: more interactions may follow) a search over sequences of two
+        interactions: an action's value is its P(within ``tolerance``) plus the share of its predicted outcomes
+        that neither end within nor leave the table times the best P(within) of a second interaction from there,
+        averaged over the most likely of those outcomes (the object where the outcome leaves it, seen with the
+        initial features plus the outcome's perceptual effect, or unchanged where the models have none). An action
+        likely enough to end within (the threshold) is taken at once; else the most valuable one, if its value
+        reaches ``MIN_SEQUENCE_VALUE``;
+        else the one whose predicted outcomes end nearest on average. With ``steps_left`` 1 (this interaction is
+        the last) only the first and the last of these. Actions that failed on the object where it is
+        (:meth:`note_failure`) are left out, and ``feasible`` is asked at most ``max_checks`` times.
 
         Args:
-            reachable: ``reachable(behavior, xy)``, (n, 2) [m] -> (n,) bool: where a behaviour can act (for
-                example :func:`affordance_env.workspace.in_workspace`). A second interaction counts only where its
+            steps_left: Interactions left in the episode, this one included; None: more than one.
+            reachable: ``reachable(behavior, xy)``, (n, 2) [m] -> (n,) bool: where a behaviour can act; by default
+                the behaviours' workspaces (:func:`in_workspace`). A second interaction counts only where its
                 behaviour reaches, and outcomes that leave the object where no behaviour reaches count as
                 ``OFF_TABLE_DISTANCE`` away when actions are ranked by distance. None: everywhere.
         """
-        if isinstance(steps_left, bool) or not isinstance(steps_left, int | np.integer) or steps_left < 1:
-            raise InvalidValueError(f"steps_left must be an integer >= 1, got {steps_left!r}.")
+        if steps_left is not None and (isinstance(steps_left, bool) or not isinstance(steps_left, int | np.integer)
+                                       or steps_left < 1):
+            raise InvalidValueError(f"steps_left must be None or an integer >= 1, got {steps_left!r}.")
         goal = Place(target_xy, tolerance)
         target = np.asarray(goal.target_xy)
         _check_on_table("target_xy", target_xy, target)
@@ -209,30 +306,33 @@ class Planner:
         weights, p1, distance, ends = {}, {}, {}, {}
         for name, model in self.models.items():
             W = model.predictive_weights(X, as_sparse=True)
-            W.sum_duplicates()
-            end, off = _ends(model, start)
-            within = goal.reached(model.outcome_frame(), start).astype(np.float64)
+            frame = self._frames[name]
+            end, off = start + frame[["dx", "dy"]].to_numpy(), frame["off_table"].to_numpy(bool)
+            within = goal.reached(frame, start).astype(np.float64)
             dist = np.where(off, OFF_TABLE_DISTANCE, np.linalg.norm(end - target, axis=1))
             if reachable is not None:
                 stuck = ~_reached_by_any(reachable, names, end) & (within == 0)
                 dist = np.where(stuck, OFF_TABLE_DISTANCE, dist)
             weights[name], ends[name] = W, (end, off, within)
-            p1[name], distance[name] = W @ within, W @ dist
+            p1[name], distance[name] = np.asarray(W @ within).ravel(), np.asarray(W @ dist).ravel()
         value = {name: p1[name].copy() for name in names}
-        if steps_left >= 2:
+        if steps_left is None or steps_left >= 2:
             self._look_ahead(features, goal, weights, ends, p1, distance, value, reachable)
         entries = [(float(value[n][k]), float(p1[n][k]), float(distance[n][k]), n, k)
-                   for n in names for k in range(len(self.params))]
-        finish = sorted((e for e in entries if e[1] >= self.threshold), key=lambda e: (-e[1], e[2], e[3], e[4]))
-        sequence = sorted((e for e in entries if e[0] >= MIN_SEQUENCE_VALUE), key=lambda e: (-e[0], e[2], e[3], e[4]))
-        nearest = sorted(entries, key=lambda e: (e[2], -e[0], e[3], e[4]))
-        checked = 0
+                   for k in range(len(self.params)) for n in names]
+        finish = sorted((e for e in entries if e[1] >= self.threshold), key=lambda e: (-e[1], e[2]))
+        sequence = sorted((e for e in entries if e[0] >= MIN_SEQUENCE_VALUE), key=lambda e: (-e[0], e[2]))
+        nearest = sorted(entries, key=lambda e: (e[2], -e[0]))
+        excluded = self._excluded(features, start)
+        asked: dict[tuple[str, int], bool] = {}
         for ranked in (finish, sequence, nearest):
-            for v, p, d, name, k in ranked:
-                checked += feasible is not None
-                if feasible is None or feasible(name, self.params[k]):
-                    return Choice(name, self.params[k].copy(), p, p < self.threshold, d, checked, v)
-        return Choice(None, np.zeros(3), 0.0, True, float("nan"), checked, 0.0)
+            found = self._first_feasible(ranked, feasible, excluded, asked)
+            if found is not None:
+                v, p, d, name, k = found
+                return Choice(name, self.params[k].copy(), p, p < self.threshold, d, len(asked), v)
+            if feasible is not None and len(asked) >= self.max_checks:
+                break
+        return Choice(None, np.zeros(3), 0.0, True, float("nan"), len(asked), 0.0)
 
     def _look_ahead(self, features, goal, weights, ends, p1, distance, value, reachable) -> None:
         """Add to ``value`` (P(within) of each first action) the chance of a second interaction (see
@@ -252,6 +352,7 @@ class Planner:
         links: list[tuple[str, int, float, list[tuple[int, float]]]] = []
         for name, k in roots:
             row = weights[name].getrow(k)
+            row.sum_duplicates()  # a training outcome once, with its whole weight
             end, off, within = ends[name]
             open_ = ~within[row.indices].astype(bool) & ~off[row.indices]
             if not open_.any():
@@ -265,19 +366,25 @@ class Planner:
             return
         keys = list(states)
         for name in {n for n, _ in keys}:
-            if len(self.models[name].effect_columns_) != len(features):
+            if len(self.models[name].effect_columns_) not in (0, len(features)):
                 raise InvalidValueError(
                     f"the model of {name!r} has {len(self.models[name].effect_columns_)} effect columns "
                                  f"for {len(features)} features: looking ahead needs models fitted on outcome tables "
-                                 "with the perceptual effect (affordance_learning.outcomes.outcome_table).")
+                                 "with the perceptual effect (affordance_learning.outcomes.outcome_table), or none.")
+
+        def effect(name: str, j: int) -> np.ndarray | float:  # a model without the perceptual effect: unchanged
+            columns = self.models[name].effect_columns_
+            return self.models[name].outcomes_[j, columns] if len(columns) else 0.0
+
         xy = np.array([ends[n][0][j] for n, j in keys])
-        seen = np.array([features + self.models[n].outcomes_[j, self.models[n].effect_columns_] for n, j in keys])
+        seen = np.array([features + effect(n, j) for n, j in keys])
         second = self.params[: LOOKAHEAD_SECOND]
         best = np.zeros(len(keys))
         for name, model in self.models.items():
             X2 = np.hstack([np.repeat(seen, len(second), axis=0), np.tile(second, (len(keys), 1))])
             W2 = model.predictive_weights(X2, as_sparse=True)
-            end2, off2 = _ends(model, np.zeros(2))  # displacements; each state adds its own start below
+            frame = self._frames[name]  # displacements; each state adds its own start below
+            end2, off2 = frame[["dx", "dy"]].to_numpy(), frame["off_table"].to_numpy(bool)
             hits = (np.linalg.norm(xy[:, None, :] + end2[None] - np.asarray(goal.target_xy), axis=2)
                     <= goal.tolerance) & ~off2[None]
             query = np.repeat(np.arange(W2.shape[0]), np.diff(W2.indptr))

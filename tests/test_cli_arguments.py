@@ -19,7 +19,7 @@ BAD_VALUES = [
     (["demo", "--episodes", "-1"], "--episodes", "-1", "an integer >= 1"),
     (["demo", "--episodes", "0"], "--episodes", "0", "an integer >= 1"),
     (["demo", "--seed", "-1"], "--seed", "-1", "an integer >= 0"),
-    ([*PLAN, "--goals", "-2"], "--goals", "-2", "an integer >= 1"),
+    ([*PLAN, "--objects", "-2"], "--objects", "-2", "an integer >= 1"),
     ([*PLAN, "--episodes", "0"], "--episodes", "0", "an integer >= 1"),
     ([*PLAN, "--multi-episodes", "0"], "--multi-episodes", "0", "an integer >= 1"),
     ([*PLAN, "--workers", "0"], "--workers", "0", "an integer >= 1"),
@@ -111,8 +111,8 @@ def test_plan_takes_the_sizes_given_and_plan_settings_defaults_otherwise(no_work
 
     assert PLAN_DEFAULTS == {name: getattr(PlanSettings(), name) for name in PLAN_DEFAULTS}  # the help says these
     with pytest.raises(WorkStarted) as started:
-        main(["plan", "--out", str(tmp_path / "out"), "--goals", "3"])
-    assert started.value.args[1]["settings"] == PlanSettings(goals=3)
+        main(["plan", "--out", str(tmp_path / "out"), "--objects", "3"])
+    assert started.value.args[1]["settings"] == PlanSettings(objects=3)
 
 
 def _manifest(directory, env_id="TapAffordance-v2", action="canonical", seed=0):
@@ -257,7 +257,7 @@ def test_the_id_is_checked_without_minari(monkeypatch):
 def test_a_command_line_mistake_imports_neither_the_simulator_nor_what_the_command_runs(tmp_path):
     collected = tmp_path / "taps"
     _manifest(collected)
-    mistakes = [["plan", "--out", str(tmp_path / "p"), "--goals", "-2"], ["demo", "--episodes", "-1"],
+    mistakes = [["plan", "--out", str(tmp_path / "p"), "--objects", "-2"], ["demo", "--episodes", "-1"],
                 ["demo", "--object", "cube"], ["plan", "--out", str(collected)],
                 ["collect", "--out", str(tmp_path / "c"), "--episodes", "3", "--size-range", "0.1", "0.05"],
                 ["export", str(collected), "--minari", "a/b-v0"]]

@@ -88,7 +88,7 @@ def test_the_planner_chooses_the_action_that_makes_the_goal_likely(model):
     assert flat.abstained and flat.probability < 0.5
     refused = planner.choose(features, Move((1.0, 0.0), 0.15), feasible=lambda name, params: params[1] <= 0)
     assert refused.params[1] <= 0 and refused.checked > 1  # the likely ones were out of reach
-    toward = planner.toward(features, (-0.3, 0.0), (-0.2, 0.0), 0.03)
+    toward = planner.toward(features, (-0.3, 0.0), (-0.2, 0.0), 0.03, steps_left=1, reachable=None)
     assert toward.params[0] > 0 and toward.expected_distance < 0.05
 
 
@@ -118,6 +118,62 @@ def test_toward_searches_over_two_interactions_where_the_nearest_first_step_is_a
     assert blocked.behavior == "push" and blocked.value == 0.0
     with pytest.raises(ValueError, match="steps_left"):
         planner.toward(features, start, target, 0.015, steps_left=0)
+    # By default toward looks ahead (more interactions may follow), as a multi-step episode wants.
+    default = planner.toward(features, start, target, 0.015, reachable=None)
+    assert default.behavior == "tap" and default.value == ahead.value
+
+
+def test_toward_by_default_looks_ahead_within_the_workspaces():
+    import inspect
+
+    from affordance_learning.planner import in_workspace
+
+    parameters = inspect.signature(Planner.toward).parameters
+    assert parameters["steps_left"].default is None and parameters["reachable"].default is in_workspace
+    np.testing.assert_array_equal(in_workspace("tap", np.array([[-0.3, 0.0], [-0.7, 0.4]])), [True, False])
+
+
+def test_the_planner_never_chooses_again_an_action_that_failed_where_the_object_still_is(model):
+    planner = Planner({"push": model}, n_candidates=32)
+    features, start, goal = np.array([-0.3, 1.0, 0.0]), np.array([-0.3, 0.0]), Move((1.0, 0.0), 0.15)
+    first = planner.choose(features, goal, start)
+    planner.note_failure(first.behavior, first.params, start)
+    second = planner.choose(features, goal, start + 0.004)  # moved 4 mm by the failed reach: the same situation
+    assert second.behavior and not np.array_equal(second.params, first.params)
+    planner.note_failure(second.behavior, second.params, start)
+    third = planner.choose(features, goal, start)
+    assert not any(np.array_equal(third.params, c.params) for c in (first, second))
+    # elsewhere, the action may work: it is a candidate again; and a new object forgets every failure
+    assert np.array_equal(planner.choose(features, goal, start + 0.05).params, first.params)
+    toward = planner.toward(features, start, (-0.2, 0.0), 0.03, steps_left=1, reachable=None)
+    planner.note_failure(toward.behavior, toward.params, start)
+    again = planner.toward(features, start, (-0.2, 0.0), 0.03, steps_left=1, reachable=None)
+    assert not np.array_equal(again.params, toward.params)
+    planner.forget_failures()
+    assert np.array_equal(planner.choose(features, goal, start).params, first.params)
+
+
+def test_a_decision_asks_feasible_at_most_max_checks_times_and_breaks_ties_by_progress(model):
+    calls = []
+
+    def never(name, params):
+        calls.append(params)
+        return False
+
+    planner = Planner({"push": model}, n_candidates=64, max_checks=5)
+    features = np.array([-0.3, 0.0, 0.0])  # a box: moving it 40 cm is out of reach, P = 0 for every candidate
+    goal = Move((1.0, 0.0), 0.40)
+    none = planner.choose(features, goal, feasible=never)
+    assert none.behavior is None and none.checked == 5 == len(calls)
+    calls.clear()
+    assert planner.toward(features, (-0.3, 0.0), (-0.2, 0.0), 0.03, feasible=never, steps_left=1,
+                          reachable=None).behavior is None
+    assert len(calls) == 5
+    # every P is 0: the tie goes to the candidate that moves the object furthest along the goal's direction
+    best = planner.choose(features, goal)
+    assert best.probability == 0.0 and best.params[0] > 0.8
+    with pytest.raises(ValueError, match="max_checks"):
+        Planner({"push": model}, max_checks=0)
 
 
 def test_goal_probabilities_from_sparse_weights_equal_the_dense_ones(model):
@@ -158,6 +214,45 @@ def test_candidates_and_errors():
     assert set(MOTION_COLUMNS) == {"dx", "dy", "rolled", "off_table", "lifted"}
 
 
+def test_the_oracle_tries_a_fixed_set_of_at_least_64_actions_per_behaviour():
+    from affordance_learning.plan_experiment import oracle_params
+
+    params = oracle_params()
+    assert params.shape[0] >= 64 + 1 and params.shape[1] == 3 and np.all(np.abs(params) <= 1)
+    assert np.all(params[0] == 0)  # the canonical action first: the fixed baselines read it
+    assert len(np.unique(params, axis=0)) == len(params)  # distinct actions
+    np.testing.assert_array_equal(params, oracle_params())  # the same for every object and run
+    for j in range(3):  # each parameter's range covered evenly
+        np.testing.assert_array_equal(np.unique(params[1:, j]), [-0.75, -0.25, 0.25, 0.75])
+
+
+def test_calibration_is_measured_on_the_chosen_actions_with_pooled_beside_it():
+    from affordance_learning.plan_experiment import calibrations
+
+    # The planner picks actions it believes at 0.9 and half of them reach the goal; every other action tried is at
+    # P near 0 and never reaches it: pooled, the 0.4-point miscalibration is drowned in the many right zeros.
+    records = [{"planner_behavior": "tap", "planner_p": 0.9, "planner": i % 2 == 0,
+                "pooled": (np.r_[0.9, np.full(99, 0.01)], np.r_[i % 2 == 0, np.zeros(99, bool)])} for i in range(40)]
+    records.append({"planner_behavior": None, "planner_p": 0.0, "planner": False,
+                    "pooled": (np.full(100, 0.01), np.zeros(100, bool))})  # abstained: not a chosen action
+    cal = calibrations(records)
+    assert cal["n"] == 40 and cal["ece"] == pytest.approx(0.4) and cal["basis"] == "the planner's chosen actions"
+    assert cal["pooled"]["n"] == 4100 and cal["pooled"]["ece"] < 0.02
+
+
+def test_success_is_reported_on_feasible_goals_and_on_those_the_oracle_or_the_planner_reached():
+    from affordance_learning.plan_experiment import seconds_summary, summarize
+
+    records = ([{"oracle": True, "planner": True}] * 6 + [{"oracle": True, "planner": False}] * 2
+               + [{"oracle": False, "planner": True}] * 2 + [{"oracle": False, "planner": False}] * 10)
+    planner = summarize(records, ("planner",))["planner"]
+    assert (planner["n"], planner["n_feasible"], planner["n_reached"]) == (20, 8, 10)
+    assert planner["success_feasible"] == 0.75 and planner["success_reached"] == 0.8
+    times = seconds_summary([0.01] * 98 + [0.5, 2.0])
+    assert times["median"] == 0.01 and times["n"] == 100 and 0.5 < times["p99"] < 2.0 and times["max"] == 2.0
+    assert seconds_summary([])["median"] is None
+
+
 def test_calibration_and_wilson_intervals():
     from affordance_learning.plan_experiment import calibration, wilson
 
@@ -170,6 +265,7 @@ def test_calibration_and_wilson_intervals():
     assert bad["ece"] > 0.15
     low, high = wilson(45, 50)
     assert low < 0.9 < high and 0.75 < low and high < 0.97
+    assert wilson(8, 10) == pytest.approx((0.4902, 0.9433), abs=1e-4)  # Wilson's 95 % interval, z = 1.96
     assert wilson(0, 0) == (0.0, 1.0)
 
 
@@ -194,12 +290,21 @@ def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     from affordance_learning.plan_experiment import PlanSettings, run_plan
     from affordance_learning.plan_report import TARGETS, write_plan_figures, write_plan_report
 
-    settings = PlanSettings(episodes=40, goals=8, multi_episodes=2, oracle_candidates=2,
-                            candidates=8, som_clusters=2)
+    settings = PlanSettings(episodes=40, max_episodes=40, objects=2, multi_episodes=2, candidates=8,
+                            som_clusters=2)
     results = run_plan(tmp_path, seed=1, workers=1, settings=settings, camera=(40, 30), say=lambda text: None)
     for policy in ("planner", "random", "best_fixed", "som_categories", "oracle"):
         entry = results["single_step"][policy]
         assert 0 <= entry["success"] <= 1 and entry["n"] >= 1
+        assert entry["n_reached"] >= entry["n_feasible"]
+    assert results["single_step"]["planner"]["n"] == settings.goals == 40  # 20 goals on each of the 2 objects
+    assert results["single_step"]["oracle"]["success"] == results["single_step"]["oracle"]["success_feasible"] or \
+        results["single_step"]["oracle"]["n_feasible"] < 40
+    assert results["calibration"]["basis"] == "the planner's chosen actions"
+    assert results["calibration"]["n"] <= 40 < results["calibration"]["pooled"]["n"]
+    times = results["decision_seconds"]
+    assert times["n"] >= 40 and 0 < times["median"] <= times["p99"]
+    assert "success_toward_robot" in results["multi_step"]["planner"]
     assert set(results["leave_one_shape_out"]) == {"sphere", "box", "horizontal_cylinder", "vertical_cylinder"}
     for policy in ("planner", "direction", "random"):
         assert 0 <= results["multi_step"][policy]["reach_failures"] <= 1
