@@ -126,8 +126,11 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
                      help="depth noise of the range camera (default: none)")
     env.add_argument("--position-range", default=None, choices=POSITION_RANGES,
                      help="where objects are placed: within +-3 cm of the paper's spot (canonical), or uniformly "
-                          "over the behaviour's workspace (workspace; for TapAffordanceGoal-v2, the union of the "
-                          "four) (default canonical)")
+                          "over the behaviour's workspace (workspace; for TapAffordanceGoal-v2, the workspace of a "
+                          "behaviour drawn uniformly) (default canonical)")
+    env.add_argument("--two-arms", action="store_const", const=True, default=None,
+                     help="the scene with both arms, the other arm rigid at its home pose (the scene of "
+                          f"{GOAL_ENV_ID}; default: the acting arm alone)")
     parser.set_defaults(func=run_collect)
     return parser
 

@@ -130,7 +130,8 @@ class TapAffordanceGoalEnv(gym.Env):
     ## Arguments
     ``object_types``, ``size_range``, ``camera_width``, ``camera_height``, ``camera_fovy``, ``roll_threshold``,
     ``settle_timeout``, ``range_noise``: as TapAffordance-v2. ``position_range``: ``"canonical"`` (as
-    TapAffordance-v2) or ``"workspace"``: objects placed uniformly over the union of the behaviours' workspaces.
+    TapAffordance-v2) or ``"workspace"``: objects placed uniformly over the workspace of a behaviour drawn
+    uniformly, so that each behaviour can act on as many of them.
     ``goal_tolerance`` (0.03 m): the goal is reached
     within it. ``reward_type``: ``"sparse"`` or ``"dense"``. ``render_mode``: ``"rgb_array"`` or None.
 
@@ -144,7 +145,8 @@ class TapAffordanceGoalEnv(gym.Env):
     ## Version History
     * v2: five behaviours: ``draw`` (the right hand drags the object toward the robot) is new, and the grasp is pick
       and place (its first two parameters name where the object is put down). Goals may lie toward the robot (the
-      draw's workspace joins the union goals are drawn in). Data of v1 are not comparable.
+      draw's workspace joins the union goals are drawn in); ``position_range="workspace"`` places objects in the
+      workspace of a behaviour drawn uniformly (not uniformly over the union). Data of v1 are not comparable.
     * v1: the motors of TapAffordance-v2 (each with its torque-speed curve) and its hand's controller (a finger's
       target kept within its servo's reach of the finger); the put-down lowers a held object at 2 cm/s, carries it
       along a straight line to above where it goes, and stops where fingertips under it meet the table first. Data
@@ -183,11 +185,12 @@ class TapAffordanceGoalEnv(gym.Env):
         options = EnvOptions(object_types=object_types, size_range=size_range, camera_width=camera_width,
                              camera_height=camera_height, camera_fovy=camera_fovy, roll_threshold=roll_threshold,
                              settle_timeout=settle_timeout, range_noise=range_noise,
-                             position_range=position_range)  # checked and normalised
-        #: The data options, checked (:class:`~affordance_env.options.EnvOptions`; ``behavior`` is not used).
+                             position_range=position_range, two_arms=True)  # checked and normalised
+        #: The data options, checked (:class:`~affordance_env.options.EnvOptions`; ``behavior`` is not used, and
+        #: both arms are always in the scene).
         self.options = options
         #: Where objects are placed: ``"canonical"`` as in TapAffordance-v2, or ``"workspace"``: uniform over the
-        #: union of the behaviours' workspaces.
+        #: workspace of a behaviour drawn uniformly (:func:`~affordance_env.workspace.sample_in_workspace`).
         self.position_range = options.position_range
         #: The world, with both arms: every behaviour acts in it.
         self.world = World(BEHAVIORS, two_arms=True, camera_width=options.camera_width,

@@ -22,7 +22,7 @@ from affordance_env.registry import check_behavior_name
 
 #: Where objects are placed: ``"canonical"``, uniform within +-3 cm of the paper's spot in front of the robot;
 #: ``"workspace"``, uniform over the workspace of the behaviour (:mod:`affordance_env.workspace`; in
-#: TapAffordanceGoal-v2, the union of the behaviours' workspaces).
+#: TapAffordanceGoal-v2, the workspace of a behaviour drawn uniformly).
 POSITION_RANGES = ("canonical", "workspace")
 
 
@@ -44,6 +44,7 @@ class EnvOptions:
     settle_timeout: float = 3.0
     range_noise: str | None = None
     position_range: str = "canonical"
+    two_arms: bool = False
 
     def __post_init__(self) -> None:
         check_behavior_name(self.behavior)
@@ -77,6 +78,8 @@ class EnvOptions:
         check_range_noise(self.range_noise)
         if self.position_range not in POSITION_RANGES:
             raise InvalidValueError(f"position_range must be one of {POSITION_RANGES}, got {self.position_range!r}.")
+        if not isinstance(self.two_arms, bool):
+            raise InvalidValueError(f"two_arms must be True or False, got {self.two_arms!r}.")
         for name, value in normalised.items():
             object.__setattr__(self, name, value)
 

@@ -272,12 +272,13 @@ class TapAffordanceEnv(gym.Env):
         render_mode: str | None = None,
         render_width: int = 480,
         render_height: int = 360,
-        two_arms: bool = False,
+        two_arms: bool = EnvOptions.two_arms,
     ) -> None:
         options = EnvOptions(behavior=behavior, object_types=object_types, size_range=size_range,
                              camera_width=camera_width, camera_height=camera_height, camera_fovy=camera_fovy,
                              roll_threshold=roll_threshold, settle_timeout=settle_timeout,
-                             range_noise=range_noise, position_range=position_range)  # checked and normalised
+                             range_noise=range_noise, position_range=position_range,
+                             two_arms=two_arms)  # checked and normalised
         if render_mode not in (None, *self.metadata["render_modes"]):
             raise InvalidValueError(f"render_mode must be None or one of {self.metadata['render_modes']}, got "
                                     f"{render_mode!r}.")
@@ -288,7 +289,7 @@ class TapAffordanceEnv(gym.Env):
         self.reward_fn = default_reward if reward_fn is None else reward_fn
         self.render_mode = render_mode
         #: The world the behaviour acts in: the robot, the table, the object, the camera.
-        self.world = World((options.behavior,), two_arms=two_arms, camera_width=options.camera_width,
+        self.world = World((options.behavior,), two_arms=options.two_arms, camera_width=options.camera_width,
                            camera_height=options.camera_height, camera_fovy=options.camera_fovy,
                            range_noise=options.range_noise, roll_threshold=options.roll_threshold,
                            settle_timeout=options.settle_timeout, typical_size=float(np.mean(options.size_range)),

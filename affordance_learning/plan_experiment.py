@@ -107,20 +107,19 @@ class PlanSettings:
         threshold: The planner abstains below this P(goal).
         som_clusters: Effect categories of the ``som_categories`` baseline.
 
-    Sizing (measured on TapAffordanceGoal-v1, 4 behaviours, one core each): an object's oracle costs 20-25 s (65
-    actions x 4-5 behaviours; a grasp 0.15 s, a stroke 0.02-0.03 s), its 20 goals 2-3 s more; a collected
-    interaction 0.18 s (``feasible`` draws included). In the v1 data 34 % of the goals were feasible, 15 % of a
-    box's: 32 objects give about 220 feasible goals (but about 24 of boxes, under the 30 a verdict needs). With
-    1000 interactions of every behaviour to collect (about 6000-7500 interactions, the grasp the scarcest), the
-    collection alone is about 9-11 minutes on 2 cores, the single step about 7: more than the 15 minutes, unless the
-    interactions get cheaper.
+    Sizing (TapAffordanceGoal-v2, five behaviours, one core each): an object's oracle costs about 20-30 s (65
+    actions x 5 behaviours; a grasp 0.2-0.3 s, a stroke or a draw 0.02-0.06 s), its 20 goals a few seconds more; a
+    collected goal-episode interaction about 0.17 s (``feasible`` draws included), a top-up one about 0.1 s. The
+    grasp gets about a fifth of the goal episodes' interactions: 1000 of them take about 1500 episodes, the
+    collection's largest part. Half of the goals were feasible in a reduced run (a third of a box's): 24 objects
+    give about 240 feasible goals, 6 objects of each shape.
     """
 
-    episodes: int = 2000
+    episodes: int = 1500
     max_per_behavior: int = 1000
-    max_episodes: int = 4000
-    objects: int = 32
-    multi_episodes: int = 80
+    max_episodes: int = 1800
+    objects: int = 24
+    multi_episodes: int = 64
     candidates: int = 64
     threshold: float = 0.5
     som_clusters: int = 6
@@ -570,28 +569,59 @@ def _chunk(function, chunk: list, kwargs: dict) -> list:
     return [function(item, **kwargs) for item in chunk]
 
 
+#: Top-up interactions are collected this many times what is missing (some fail, and are not rows) ...
+TOP_UP_MARGIN = 1.15
+#: ... and numbered from this episode on, after every goal episode.
+TOP_UP_EPISODES = 1_000_000
+
+
 def collect_training(out: Path, settings: PlanSettings, seed: int, workers: int, camera: tuple[int, int],
                      say: Callable[[str], None] = print) -> pd.DataFrame:
-    """Goal episodes with random actions in ``out``, extended in rounds until every behaviour has
-    ``settings.max_per_behavior`` interactions or ``settings.max_episodes`` episodes were collected; the frame.
-    Each round asks for as many more episodes as the scarcest behaviour's share so far says it needs (and 5 %
-    more), in whole chunks."""
+    """Goal episodes with random actions in ``out``, extended in rounds until the grasp (every behaviour that only
+    the goal env runs as it does) has ``settings.max_per_behavior`` interactions or ``settings.max_episodes``
+    episodes were collected; each round asks for as many more episodes as the scarcest such behaviour's share so
+    far says it needs (and 5 % more), in whole chunks. A behaviour TapAffordance-v2 runs as the goal env does (the
+    strokes, the draw) that is still short is topped up with random interactions of TapAffordance-v2 in the
+    scene with both arms, objects over its workspace (in ``out`` beside the goal episodes, named after it): the
+    draw, which reaches only objects near the robot, gets a tenth of the goal episodes' interactions. The frame of
+    both."""
+    from affordance_env.behaviors import get_behavior
     from affordance_env.dataset import collect, load_dataset
 
     episodes, chunk = settings.episodes, 25
+    camera_options = {"camera_width": camera[0], "camera_height": camera[1]}
+    # The behaviours TapAffordance-v2 runs as the goal env does (all but the grasp, which the goal env runs as pick
+    # and place): their interactions in its scene with both arms are the goal env's, and cost no goal episode.
+    same = [b for b in BEHAVIORS if get_behavior(b) is get_behavior(b, goal=True)]
     while True:
         collect(out, episodes, seed=seed, workers=workers, action="random", env_id=GOAL_ENV_ID,
-                env_options={"position_range": "workspace", "camera_width": camera[0], "camera_height": camera[1]},
-                max_failure_share=1.0, chunk_size=chunk)
+                env_options={"position_range": "workspace", **camera_options}, max_failure_share=1.0,
+                chunk_size=chunk)
         frame = load_dataset(out)
         counts = {b: int((frame["behavior"] == b).sum()) for b in BEHAVIORS}
-        short = min(counts.values())
+        short = min(n for b, n in counts.items() if b not in same)
         if short >= settings.max_per_behavior or episodes >= settings.max_episodes:
-            return frame
+            break
         wanted = episodes * settings.max_per_behavior / max(short, 1) * 1.05
         episodes = min(settings.max_episodes, max(episodes + chunk, math.ceil(wanted / chunk) * chunk))
         say(f"      {', '.join(f'{b} {n}' for b, n in counts.items())} interactions: extending to {episodes} "
             "episodes")
+    frames = [frame]
+    for behavior in same:  # topped up with single interactions over the behaviour's own workspace
+        missing = settings.max_per_behavior - counts[behavior]
+        if missing <= 0:
+            continue
+        wanted = math.ceil(missing * TOP_UP_MARGIN / chunk) * chunk
+        say(f"      {behavior}: {counts[behavior]} interactions in the goal episodes, {wanted} more of "
+            f"TapAffordance-v2 in the same scene")
+        top_up = collect(out.parent / f"{out.name}-{behavior}", wanted, seed=seed, workers=workers, action="random",
+                         env_options={"behavior": behavior, "two_arms": True, "position_range": "workspace",
+                                      **camera_options}, max_failure_share=1.0, chunk_size=chunk)
+        extra = load_dataset(top_up)
+        # after the goal episodes, in their order: each an episode of one step
+        extra = extra.assign(episode=extra["episode"] + TOP_UP_EPISODES, step=0)
+        frames.append(extra)
+    return pd.concat(frames, ignore_index=True)
 
 
 def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: PlanSettings | None = None,

@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 from affordance_env.dataset import DatasetError, collect
-from affordance_env.dataset.collect import GOAL_ACTION_DRAWS, _goal_episode_rows
+from affordance_env.dataset.collect import PARAM_DRAWS, _goal_episode_rows, goal_step_actions
 from affordance_env.dataset.format import chunk_metadata, chunk_name
 from affordance_env.goal_env import TapAffordanceGoalEnv
+from affordance_env.registry import BEHAVIOR_NAMES
 
 SMALL = {"camera_width": 32, "camera_height": 24}
 SETTINGS = {"seed": 5, "action": "random", "save_images": False}
@@ -65,7 +66,7 @@ def test_a_goal_episode_without_a_feasible_action_ends_there_truncated(rows_as_s
     rows, failure, truncation = _goal_episode_rows(env, SETTINGS, 0)
     assert len(env.run) == 2 and len(rows) == 2 and failure is None
     assert truncation.startswith("infeasible:") and "step 2" in truncation
-    assert len(env.asked) == 2 + GOAL_ACTION_DRAWS  # a bounded search, then the end
+    assert len(env.asked) == 2 + PARAM_DRAWS * len(BEHAVIOR_NAMES)  # every behaviour tried, then the end
 
 
 def test_a_goal_episode_ends_where_the_head_does_not_see_the_object(rows_as_steps):
@@ -116,3 +117,17 @@ def test_the_head_finds_an_object_on_the_far_part_of_the_table():
         physics.set_object_pose(pose)
         seen = env.world.observe(env.np_random)
         assert seen.visible and seen.attention.success, start
+
+
+def test_every_behaviour_is_tried_at_each_step_each_first_as_often():
+    firsts = []
+    for episode in range(200):
+        actions = list(goal_step_actions(0, episode, 0, "random"))
+        behaviors = [a["behavior"] for a in actions]
+        assert sorted(set(behaviors)) == list(range(len(BEHAVIOR_NAMES)))  # all of them, the draw's too
+        assert all(behaviors.count(b) == PARAM_DRAWS for b in set(behaviors))
+        firsts.append(behaviors[0])
+    counts = np.bincount(firsts, minlength=len(BEHAVIOR_NAMES))
+    assert counts.min() > 200 / len(BEHAVIOR_NAMES) / 2  # none neglected
+    same = [a["params"] for a in goal_step_actions(0, 7, 2, "random")]
+    np.testing.assert_array_equal(same, [a["params"] for a in goal_step_actions(0, 7, 2, "random")])

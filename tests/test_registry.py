@@ -66,7 +66,7 @@ def test_every_env_takes_the_data_options_with_their_defaults(env_class):
     env = {"TapAffordanceEnv": TapAffordanceEnv, "TapAffordanceGoalEnv": TapAffordanceGoalEnv}[env_class]
     parameters = inspect.signature(env).parameters
     for field in dataclasses.fields(EnvOptions):
-        if field.name == "behavior" and env is TapAffordanceGoalEnv:  # it runs every behaviour
+        if field.name in ("behavior", "two_arms") and env is TapAffordanceGoalEnv:  # every behaviour, both arms
             assert field.name not in parameters
             continue
         assert parameters[field.name].default == field.default, field.name

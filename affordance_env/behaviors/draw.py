@@ -64,7 +64,6 @@ from affordance_env.behaviors.stroke import (
     HAND_BELOW_PALM,
     MAX_OBJECT_MOVED_BEFORE,
     MAX_START_ERROR,
-    MIN_PALM_HEIGHT,
     StrokeOutcome,
     StrokePlan,
     approach_posture,

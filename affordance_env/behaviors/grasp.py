@@ -336,13 +336,15 @@ def grasp_reachable(motion: MotionExecutor, plan: GraspPlan) -> bool:
     the pose above and the grasp pose, and the lift rises from there: the lifts from both ends are checked."""
     above, at, lifted = grasp_poses(motion, plan)
     hand = hand_target(plan)
+    place = motion.ik(np.array([plan.p_place[0], plan.p_place[1], plan.p_grasp[2] + PLACE_APPROACH]), lifted.q,
+                      hand)
+    if not ik_verdict([above, at, lifted, place])[0]:  # a pose out of reach: the lines are not solved
+        return False
     descent = motion.line(plan.p_above, plan.p_grasp, hand, GUARDED_SPEED, q_start=above.q)
     lift = motion.line(plan.p_grasp, plan.p_lift, hand, LIFT_SPEED, q_start=at.q)
     high_lift = motion.line(plan.p_above, plan.p_above + (plan.p_lift - plan.p_grasp), hand, LIFT_SPEED,
                             q_start=above.q)
-    place = motion.ik(np.array([plan.p_place[0], plan.p_place[1], plan.p_grasp[2] + PLACE_APPROACH]), lifted.q,
-                      hand)
-    return ik_verdict([above, at, lifted, *descent.results, *lift.results, *high_lift.results, place])[0]
+    return ik_verdict([*descent.results, *lift.results, *high_lift.results])[0]
 
 
 def finger_of(name: str) -> str:

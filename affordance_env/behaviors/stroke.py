@@ -249,15 +249,19 @@ def plan_approach(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray 
     return above, start
 
 
+def stroke_line(motion: MotionExecutor, plan: StrokePlan, start: IKResult) -> LinePath:
+    """The stroke's line from the pre-stroke pose ``start``, every waypoint's IK solved (the joint speeds along
+    the whole line cap the stroke's speed)."""
+    length = dot(plan.p_end - plan.p_start, plan.direction)
+    return LinePath(motion, plan.p_start, plan.direction, length, hand_target(plan), plan.speed, start.q,
+                    ramp=plan.ramp, to_rest=plan.to_rest)
+
+
 def plan_stroke_path(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None
                      ) -> tuple[IKResult | None, IKResult, LinePath]:
     """The stroke's IK, solved before any move: the poses of :func:`plan_approach` and the stroke's line."""
     above, start = plan_approach(motion, plan, posture)
-    length = dot(plan.p_end - plan.p_start, plan.direction)
-    # The joint speeds along the whole line cap the stroke's speed.
-    path = LinePath(motion, plan.p_start, plan.direction, length, hand_target(plan), plan.speed, start.q,
-                    ramp=plan.ramp, to_rest=plan.to_rest)
-    return above, start, path
+    return above, start, stroke_line(motion, plan, start)
 
 
 def reach_trajectory(motion: MotionExecutor, above: IKResult | None, start: IKResult) -> JointTrajectory:
@@ -272,8 +276,10 @@ def stroke_reachable(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarr
     """Whether :func:`run_stroke` will find every pose of ``plan`` within the IK's tolerances, and its reach keeps
     the arm ``REACH_CLEARANCE`` from the object and out of the table beyond ``REACH_TABLE_PENETRATION``;
     kinematics only."""
-    above, start, path = plan_stroke_path(motion, plan, posture)
-    if not ik_verdict([start, *path.results])[0]:
+    above, start = plan_approach(motion, plan, posture)
+    if not ik_verdict([start])[0]:  # out of reach already at the pre-stroke pose: the line is not solved
+        return False
+    if not ik_verdict(stroke_line(motion, plan, start).results)[0]:
         return False
     samples = reach_trajectory(motion, above, start).q[::REACH_SWEEP_STRIDE]
     if motion.physics.sweep_clearance(samples, REACH_CLEARANCE) < REACH_CLEARANCE:

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import itertools
 import json
 import os
 import signal
@@ -61,6 +60,7 @@ from affordance_env.dataset.format import (
 from affordance_env.exceptions import InvalidValueError, MissingDependencyError
 from affordance_env.options import EnvOptions
 from affordance_env.progress import progress_bar, show_progress  # noqa: F401  (show_progress: re-exported)
+from affordance_env.registry import BEHAVIOR_NAMES
 
 ACTIONS = ("canonical", "random")
 SCHEDULERS = ("joblib", "dask")
@@ -81,25 +81,32 @@ def interaction_action(seed: int, episode: int, action: str) -> np.ndarray:
     return rng.uniform(-1.0, 1.0, ACTION_DIM).astype(np.float32)
 
 
-#: A goal episode's action is drawn again, up to this many times, until the arm can reach it (``feasible``).
-GOAL_ACTION_DRAWS = 50
+#: A goal episode's step draws, for each behaviour, up to this many parameter vectors until the arm can reach one
+#: (``feasible``; :func:`goal_step_actions`).
+PARAM_DRAWS = 10
 #: How goal episodes are collected, recorded in the settings of every goal dataset (a dataset collected otherwise
 #: is not resumed with it): only feasible actions are run; an episode ends where none is drawn or the head does
 #: not see the object.
-GOAL_EPISODE_RULE = (f"feasible actions only, {GOAL_ACTION_DRAWS} draws per step; truncated where none is or the "
-                     "object is not seen")
+GOAL_EPISODE_RULE = (f"feasible actions only, the behaviours in a random order, {PARAM_DRAWS} draws each per step; "
+                     "truncated where none is or the object is not seen")
 
 
-def goal_episode_actions(seed: int, episode: int, action: str) -> Iterator[dict[str, Any]]:
-    """The actions of goal episode ``episode``, step after step: a behaviour uniform over the four, and its
-    parameters zeros (``"canonical"``) or uniform in [-1, 1]^3, all from ``SeedSequence([seed, episode, 1])``."""
+def goal_step_actions(seed: int, episode: int, step: int, action: str) -> Iterator[dict[str, Any]]:
+    """The actions drawn for step ``step`` of goal episode ``episode``, in the order they are tried: the behaviours
+    (:data:`~affordance_env.registry.BEHAVIOR_NAMES`) in a random order, each with ``PARAM_DRAWS`` parameter
+    vectors, zeros (``"canonical"``) or uniform in [-1, 1]^3, all from ``SeedSequence([seed, episode, 1, step])``.
+
+    The collector runs the first feasible one: every behaviour is tried before a step is given up, and each is the
+    first tried as often as the others, so that a behaviour whose parameters are rarely feasible where the object
+    is (the grasp, the push, the draw far from the robot) still gets its share of the interactions."""
     if action not in ACTIONS:
         raise InvalidValueError(f"action must be one of {ACTIONS}, got {action!r}.")
-    rng = np.random.default_rng(np.random.SeedSequence([seed, episode, 1]))
-    while True:
-        behavior = int(rng.integers(4))
-        params = rng.uniform(-1.0, 1.0, ACTION_DIM).astype(np.float32)
-        yield {"behavior": behavior, "params": params if action == "random" else np.zeros(ACTION_DIM, np.float32)}
+    rng = np.random.default_rng(np.random.SeedSequence([seed, episode, 1, step]))
+    for behavior in rng.permutation(len(BEHAVIOR_NAMES)):
+        for _ in range(PARAM_DRAWS):
+            params = rng.uniform(-1.0, 1.0, ACTION_DIM).astype(np.float32)
+            yield {"behavior": int(behavior),
+                   "params": params if action == "random" else np.zeros(ACTION_DIM, np.float32)}
 
 
 # --- a worker: interactions -> one chunk file --------------------------------------------------------------
@@ -126,23 +133,23 @@ def _goal_episode_rows(env, settings: dict, episode: int) -> tuple[list[dict], s
     """The rows of goal episode ``episode`` (one per interaction, until the episode ends), the reason of its failed
     interaction (the last one run, left out), or None, and why the episode was cut short (truncated), or None.
 
-    Only actions that ``env.feasible`` accepts are run: at each step up to ``GOAL_ACTION_DRAWS`` are drawn, the
-    first feasible one is run, and an episode where none is ends before that step (``"infeasible: ..."``). An
+    Only actions that ``env.feasible`` accepts are run: at each step the actions of :func:`goal_step_actions` are
+    drawn, the first feasible one is run, and an episode where none is ends before that step
+    (``"infeasible: ..."``). An
     episode whose object the head does not see ends there too (``"lost: ..."``): its next interaction would fail."""
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
 
     env_seed = interaction_seed(settings["seed"], episode)
     visible = env.reset(seed=env_seed)[1]["visible"]
     rows: list[dict] = []
-    actions = goal_episode_actions(settings["seed"], episode, settings["action"])
     for step in range(GOAL_MAX_EPISODE_STEPS):
         if not visible:  # hidden behind an arm, or out of every view of the head
             return rows, None, f"lost: the head did not find the object for step {step}"
-        action = next((a for a in itertools.islice(actions, GOAL_ACTION_DRAWS)
-                       if env.feasible(a["behavior"], a["params"])), None)
+        actions = goal_step_actions(settings["seed"], episode, step, settings["action"])
+        action = next((a for a in actions if env.feasible(a["behavior"], a["params"])), None)
         if action is None:
-            return rows, None, (f"infeasible: none of {GOAL_ACTION_DRAWS} actions drawn for step {step} is "
-                                "feasible")
+            return rows, None, (f"infeasible: none of the {PARAM_DRAWS} actions drawn for each behaviour for step "
+                                f"{step} is feasible")
         obs, _, terminated, _, info = env.step(action)
         result = env.last_result
         if result.failure is not None:
@@ -215,15 +222,18 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) ->
 def _full_options(env_options: dict[str, Any], env_id: str = ENV_IDS[0]) -> dict[str, Any]:
     """The env options with every default filled in, as JSON values, so that equal settings compare equal;
     checked (:class:`~affordance_env.options.EnvOptions`) without building an env or importing the simulator.
-    TapAffordanceGoal-v2 chooses the behaviour at every step: it has no ``behavior`` option."""
-    if env_id == GOAL_ENV_ID and "behavior" in env_options:
-        raise InvalidValueError(f"{GOAL_ENV_ID} chooses among all the behaviours at every step: drop the behavior "
-                         f"option (--behavior), got {env_options['behavior']!r}.")
+    TapAffordanceGoal-v2 chooses the behaviour at every step and always has both arms: it has no ``behavior`` and
+    no ``two_arms`` option."""
+    if env_id == GOAL_ENV_ID:
+        for name, flag in (("behavior", "--behavior"), ("two_arms", "--two-arms")):
+            if name in env_options:
+                raise InvalidValueError(f"{GOAL_ENV_ID} chooses among all the behaviours at every step, with both "
+                                        f"arms: drop the {name} option ({flag}), got {env_options[name]!r}.")
     EnvOptions.checked(**env_options)
     full = {f.name: f.default for f in dataclasses.fields(EnvOptions)}
     full.update(env_options)
     if env_id == GOAL_ENV_ID:
-        del full["behavior"]
+        del full["behavior"], full["two_arms"]
     return json.loads(json.dumps(full, default=list))
 
 
@@ -283,17 +293,16 @@ def collect(
             zstd-compressed; read them with ``load_dataset(out, with_images=True)`` and :func:`images`.
         max_failure_share: Stop with :class:`FailureShareError` once more than this share of the interactions
             collected so far were marked failed by the environment, in [0, 1] (1 accepts any).
-        env_id: ``"TapAffordance-v2"`` (one interaction per episode, a row each) or ``"TapAffordanceGoal-v2"``:
-            goal episodes of up to 5 interactions (``GOAL_MAX_EPISODE_STEPS``), each a behaviour drawn uniformly
-            with its parameters by ``action``, drawn again (up to ``GOAL_ACTION_DRAWS`` times) until the arm can
-            reach it (``feasible``), one row per interaction with its ``step`` and the goal columns. An action that
-            ``feasible`` refuses is never run: a step for which none of the draws is feasible ends the episode
-            before it, as does an object the head does not see (hidden behind an arm, or out of every view of the
-            head), whose interaction would fail. Such an episode keeps its rows and counts as truncated, not failed:
-            the chunk's metadata records why (``"truncated"``: episode -> ``"infeasible: ..."`` or ``"lost: ..."``).
-            An episode is recorded up to its first failed interaction (left out; the episode counts as failed).
-            The rule is part of the dataset's settings (``goal_episodes``): a dataset collected otherwise is not
-            resumed with it.
+        env_id: ``"TapAffordance-v2"`` (one interaction per episode, a row each) or ``"TapAffordanceGoal-v2"``: goal
+            episodes of up to 5 interactions (``GOAL_MAX_EPISODE_STEPS``), each the first action the arm can reach
+            (``feasible``) among the behaviours in a random order, each with ``PARAM_DRAWS`` parameter vectors by
+            ``action`` (:func:`goal_step_actions`), one row per interaction with its ``step`` and the goal columns. An
+            action that ``feasible`` refuses is never run: a step for which none of the draws is feasible ends the
+            episode before it, as does an object the head does not see (hidden behind an arm, or out of every view of
+            the head), whose interaction would fail. Such an episode keeps its rows and counts as truncated, not failed:
+            the chunk's metadata records why (``"truncated"``: episode -> ``"infeasible: ..."`` or ``"lost: ..."``). An
+            episode is recorded up to its first failed interaction (left out; the episode counts as failed). The rule is
+            part of the dataset's settings (``goal_episodes``): a dataset collected otherwise is not resumed with it.
 
     Returns:
         The dataset directory.

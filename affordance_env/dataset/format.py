@@ -79,7 +79,7 @@ GOAL_COLUMNS = ("goal_x", "goal_y", "achieved_x", "achieved_y", "goal_distance",
 #: Settings added after the first datasets, with the value every dataset made before had: a dataset that lacks
 #: one was made with that value.
 LATER_SETTINGS = {"env_id": "TapAffordance-v2"}
-LATER_ENV_OPTIONS = {"position_range": "canonical"}
+LATER_ENV_OPTIONS = {"position_range": "canonical", "two_arms": False}
 
 
 def arrow_schema(save_images: bool = False, goal: bool = False) -> pa.Schema:
