@@ -27,9 +27,9 @@ Two departures from Saponaro's module, both set by this scene:
 
 Over 200 canonical draws (``python benchmarks/draw.py``) 4 fail (2 %, all "reach": boxes of 9.6-10 cm that the arm
 nudges 3.2-3.9 mm on its way behind them, over the 3 mm a stroke allows); the others move the object a median 9.2 cm
-toward the robot (6.7 cm for the smallest third of sizes, 10.3 for the largest), every one at least 2 cm, and
-0.7 cm across; one ball rolled on over the table's edge. Balls of 4-4.5 cm move only 2.1-2.7 cm: the palm, tilted
-toward the table, rides over them once they are under its lower edge.
+toward the robot (5.0 cm for the smallest third of sizes, 10.3 for the largest), 99.5 % of them at least 2 cm,
+and 0.6 cm across; one ball rolled on over the table's edge. Balls of 4-5 cm move only 1.7-3.0 cm: the palm, tilted
+toward the table and 4 cm above it at least, rides over them once they are under its lower edge.
 
 The action is three numbers in [-1, 1]; 0 is the canonical draw:
 
@@ -42,8 +42,8 @@ index       meaning                                                          ran
             what the arm's joint speed limits allow
 ==========  ===============================================================  ======================
 
-The palm centre is a little above the object's centre (DRAW_HEIGHT), and at least DRAW_MIN_PALM_HEIGHT (2.5 cm)
-above the table: Saponaro's 3 cm, where the tilted hand's lowest point is 1 cm above the table. An object moves
+The palm centre is a little above the object's centre (DRAW_HEIGHT), and at least DRAW_MIN_PALM_HEIGHT (4 cm)
+above the table, where the tilted hand's lowest point clears it by 4 mm. An object moves
 about as far as the palm travels after touching it: the drag length plus its own half size and the palm's
 thickness (5-8 cm for the canonical draw), plus what it rolls on.
 """
@@ -64,6 +64,7 @@ from affordance_env.behaviors.stroke import (
     HAND_BELOW_PALM,
     MAX_OBJECT_MOVED_BEFORE,
     MAX_START_ERROR,
+    MIN_PALM_HEIGHT,
     StrokeOutcome,
     StrokePlan,
     approach_posture,
@@ -93,10 +94,10 @@ PALM_OFFSET = 0.012
 #: 9-10 cm tall; at 1.4, 1). A ball is taken at its centre's height: the palm, facing the table too, would press it
 #: down from above its equator instead of pulling it (at 1.4, balls moved a median 3.6 cm instead of 9).
 DRAW_HEIGHT = 1.4
-#: The palm centre's lowest height above the table [m]. At the strokes' 4 cm (their upright hand reaches 3.3 cm
-#: below its centre) balls of 4-5 cm moved 1.7-3.0 cm: the tilted palm passes over them; at 2.5 cm, 2.1-2.6 cm for
-#: 4-4.5 cm and 7-8 cm for 5 cm and more. At 2 cm the hand meets the table.
-DRAW_MIN_PALM_HEIGHT = 0.025
+#: The palm centre's lowest height above the table [m]: the strokes' 4 cm. The tilted hand's lowest point is then
+#: 4 mm above the table (its servo targets; 3.6 cm below the palm centre). Lower, the targets go into the table:
+#: at 2.5 cm, 8-11 mm, and the hand drags on it (which the reach's table check refuses).
+DRAW_MIN_PALM_HEIGHT = MIN_PALM_HEIGHT
 #: The palm starts this far beyond the object's far side [m].
 DRAW_GAP = 0.05
 #: The canonical line ends with the palm centre this far past the object's centre toward the robot [m].
