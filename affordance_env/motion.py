@@ -383,15 +383,19 @@ class MotionExecutor:
         n_steps = self.steps_per_tick
         dt = physics.model.opt.timestep
         direction = path.direction
+        e0, e1, e2 = direction.tolist()
         p_touch, time, speed = p_start, float("nan"), 0.0
+        t0 = t1 = t2 = 0.0  # p_touch as Python floats, once touched
         touched_yet = False
         for q_led, qdd in self._line_ticks(path):
             if touched is None:
                 physics.step_toward(q_led, qdd, n_steps)
                 continue
             physics.set_targets_toward(q_led, qdd)
-            if per_step and (touched_yet or physics.hand_object_distance(CONTACT_WATCH_DISTANCE)
-                             < CONTACT_WATCH_DISTANCE):  # step by step: the touch and the follow-through, to the step
+            # hand_object_distance(d) < d, answered as arm_near_object does: the geoms whose bounding spheres are
+            # farther than d from the object's are not measured, and the first one nearer than d ends the search
+            if per_step and (touched_yet or physics.arm_near_object(CONTACT_WATCH_DISTANCE)):
+                # step by step: the touch and the follow-through, to the step
                 for _ in range(n_steps):
                     if not touched_yet:
                         p_before = palm.copy()
@@ -399,9 +403,14 @@ class MotionExecutor:
                     if not touched_yet and touched():
                         touched_yet, time, p_touch = True, float(physics.data.time), palm.copy()
                         speed = norm(palm - p_before) / dt
-                    if touched_yet and dot(palm - p_touch, direction) >= follow_through:
-                        self.stop()
-                        return LineResult(True, time, speed, p_touch)
+                        t0, t1, t2 = p_touch.tolist()
+                    if touched_yet:
+                        # dot(palm - p_touch, direction) in Python floats, bit for bit: the differences, then
+                        # einsum's sum of three contiguous products, (x + z) + y, from +0 (see camera._to_camera)
+                        a0, a1, a2 = palm.tolist()
+                        if (((a0 - t0) * e0 + (a2 - t2) * e2) + (a1 - t1) * e1) + 0.0 >= follow_through:
+                            self.stop()
+                            return LineResult(True, time, speed, p_touch)
                 continue  # past the touch, the last step's follow-through was just measured: short of it
             p_before = palm.copy()  # whole ticks: the touch to the tick
             physics.step(n_steps)
