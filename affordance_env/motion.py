@@ -280,7 +280,12 @@ class MotionExecutor:
         # physics.step_toward's two calls, bound once: this loop runs every control tick of every move
         aim, step, n_steps = physics.set_targets_toward, physics.step, self.steps_per_tick
         led = trajectory.q + physics.servo_lead * trajectory.qd  # the velocity feedforward of every tick
-        for q_tick, qdd_tick in zip(led, trajectory.qdd, strict=True):
+        accelerations = physics.tick_accelerations(trajectory.qdd)  # every tick's, as MuJoCo's vectors, at once
+        if accelerations is None:
+            accelerations = trajectory.qdd
+        else:
+            aim = physics.set_targets_toward_rows
+        for q_tick, qdd_tick in zip(led, accelerations, strict=True):
             aim(q_tick, qdd_tick)  # and the inertial feedforward of the tick's configuration
             step(n_steps)
             if until is not None and until():
@@ -387,11 +392,18 @@ class MotionExecutor:
         p_touch, time, speed = p_start, float("nan"), 0.0
         t0 = t1 = t2 = 0.0  # p_touch as Python floats, once touched
         touched_yet = False
-        for q_led, qdd in self._line_ticks(path):
+        aim, ticks = physics.set_targets_toward, self._line_ticks(path)
+        if trajectory is not None:  # every tick's accelerations as MuJoCo's vectors at once (see follow)
+            accelerations = physics.tick_accelerations(trajectory.qdd)
+            if accelerations is not None:
+                aim = physics.set_targets_toward_rows
+                ticks = zip(trajectory.q + physics.servo_lead * trajectory.qd, accelerations, strict=True)
+        for q_led, qdd in ticks:
             if touched is None:
-                physics.step_toward(q_led, qdd, n_steps)
+                aim(q_led, qdd)  # physics.step_toward
+                physics.step(n_steps)
                 continue
-            physics.set_targets_toward(q_led, qdd)
+            aim(q_led, qdd)
             # hand_object_distance(d) < d, answered as arm_near_object does: the geoms whose bounding spheres are
             # farther than d from the object's are not measured, and the first one nearer than d ends the search
             if per_step and (touched_yet or physics.arm_near_object(CONTACT_WATCH_DISTANCE)):

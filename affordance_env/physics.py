@@ -253,6 +253,27 @@ class TapPhysics:
         np.add(q, lead, out=lead)
         np.minimum(np.maximum(lead, self.ctrl_low, out=lead), self.ctrl_high, out=ctrl)
 
+    def tick_accelerations(self, qdd: np.ndarray) -> np.ndarray | None:
+        """The accelerations ``qdd`` [rad/s^2] of a trajectory's ticks ((ticks, active joints)) as rows of the model's
+        whole acceleration vector ((ticks, nv), zero outside the robot's joints), for
+        :meth:`set_targets_toward_rows`; None where a control tick cannot take them so (see ``_tick_views``)."""
+        if self._tick_views is None:
+            return None
+        rows = np.zeros((len(qdd), self.model.nv))
+        rows[:, self._qvel] = qdd
+        return rows
+
+    def set_targets_toward_rows(self, q: np.ndarray, qacc: np.ndarray) -> None:
+        """:meth:`set_targets_toward` ``q`` with the inertial lead of a row of :meth:`tick_accelerations`: the same
+        arithmetic on the same numbers (the row is the vector set_targets_toward fills: the robot's part, zeros
+        elsewhere), without copying the accelerations into it at every tick."""
+        _, torque_robot, ctrl = self._tick_views
+        lead = self._lead
+        mujoco.mj_mulM(self.model, self.data, self._torque, qacc)
+        np.divide(torque_robot, self.servo_kp, out=lead)
+        np.add(q, lead, out=lead)
+        np.minimum(np.maximum(lead, self.ctrl_low, out=lead), self.ctrl_high, out=ctrl)
+
     def step_toward(self, q: np.ndarray, qdd: np.ndarray, n: int) -> None:
         """One control tick: :meth:`set_targets_toward` ``q`` with the inertial lead of ``qdd``, then :meth:`step`
         ``n`` times."""
