@@ -257,8 +257,10 @@ class World:
         # (k, 3) row-major array, without boolean indexing of the transposed view
         pixels = mask.ravel().nonzero()[0]
         points = image.p_world_points.reshape(-1, 3).T.take(pixels, axis=1).T.copy()
-        top = points[points[:, 2] >= points[:, 2].max() - TOP_DEPTH] if len(points) else points
-        seen = top[:, :2].mean(axis=0) if len(top) else np.full(2, np.nan)
+        # the highest points' mean x, y: what .max() and .mean(axis=0) compute (the same reductions of the same
+        # arrays, the sum divided by the count), without their Python layers
+        top = points[points[:, 2] >= np.maximum.reduce(points[:, 2]) - TOP_DEPTH] if len(points) else points
+        seen = np.add.reduce(top[:, :2], axis=0) / len(top) if len(top) else np.full(2, np.nan)
         ranges = np.where(np.isfinite(image.ranges), image.ranges, 0.0).astype(np.float32)
         return Snapshot(frozen_array(ranges), frozen_array(mask.astype(np.int8)), features,
                         frozen_array(physics.joint_positions().astype(np.float32)), frozen_array(seen))
