@@ -178,12 +178,14 @@ class LinePath:
         # Joint rates per metre of the palm [rad/m] over each span, all spans at once (elementwise, the same
         # numbers as span by span; the smallest of the spans' minima is the minimum over all of them).
         rates = np.abs(q_ik[1:] - q_ik[:-1]) / (self._s_ik[1 : spans + 1] - self._s_ik[:spans])[:, None]
-        cap = float(np.min(executor.planned_speed / np.maximum(rates, 1e-12)))
+        cap = float(np.minimum.reduce(executor.planned_speed / np.maximum(rates, 1e-12), axis=None))  # np.min
         #: Cruise speed of the palm [m/s]: the one asked for, or the most the joints allow.
         self.speed = min(float(speed), cap)
         profile = line_profile(length, self.speed, CONTROL_DT, ramp=ramp, to_rest=to_rest)
         self._s, self._v = profile[:, 0], profile[:, 1]
-        self._a = np.diff(self._v, prepend=0.0) / CONTROL_DT  # the palm's acceleration along the line [m/s^2]
+        # the palm's acceleration along the line [m/s^2]: np.diff(v, prepend=0.0), its subtraction written out
+        v0 = np.concatenate(((0.0,), self._v))
+        self._a = (v0[1:] - v0[:-1]) / CONTROL_DT
         self._trajectory: JointTrajectory | None = None
 
     def __len__(self) -> int:
