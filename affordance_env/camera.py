@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from affordance_env.exceptions import InvalidValueError
-from affordance_env.linalg import matmul
+from affordance_env.linalg import einsum, matmul
 from affordance_env.pinhole import Intrinsics
 
 #: The 8 corners of a box of half-sizes 1.
@@ -430,7 +430,7 @@ class RangeCamera:
             # order (x + z) + y in which einsum adds each ray's three contiguous products (see the note above
             # _to_camera), and in one pass over each plane instead of a loop over three products per pixel
             axis = np.array([c0 / distance, c2 / distance, c1 / distance])  # x, z, y
-            cosine = np.einsum("ijk,i->jk", self._d_camera_xzy[:, v0:v1, u0:u1], axis)
+            cosine = einsum("ijk,i->jk", self._d_camera_xzy[:, v0:v1, u0:u1], axis)  # np.einsum
             inside[v0:v1, u0:u1] |= cosine >= cos_cone
 
     def _rays_near(self, geoms: np.ndarray, data: mujoco.MjData, p_world_camera: np.ndarray,

@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from affordance_env.exceptions import InvalidValueError
-from affordance_env.linalg import matmul
+from affordance_env.linalg import einsum, matmul
 
 N_FEATURES = 49
 #: Bins of each normal histogram.
@@ -329,7 +329,7 @@ def _normal_histograms(
     sums += products[:, 2]
     n_sq = sums[0]
     # |t_u|^2 and |t_v|^2 by one einsum over both: the same sums as einsum("ij,ij->j") of each
-    lengths_sq = np.einsum("ijk,ijk->jk", tangents, tangents)
+    lengths_sq = einsum("ijk,ijk->jk", tangents, tangents)  # np.einsum, without its Python layer
     ok = n_sq > _MIN_SINE_TANGENTS**2 * (lengths_sq[0] * lengths_sq[1])
     n_normals = int(np.count_nonzero(ok))
     if n_normals == 0:

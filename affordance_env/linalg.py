@@ -42,6 +42,8 @@ def _c_einsum() -> Callable[..., Any]:
 
 
 _einsum = _c_einsum()
+#: ``np.einsum(subscripts, *operands)`` (no ``optimize``): the same loops and bits, without its Python layer.
+einsum = _einsum
 
 _SUBSCRIPTS = {(1, 1): "i,i->", (1, 2): "i,ij->j", (2, 1): "...ij,j->...i", (2, 2): "...ij,jk->...ik"}
 _FLOAT = np.float64
