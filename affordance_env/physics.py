@@ -148,6 +148,9 @@ class TapPhysics:
         if self._actuated is None and self._ctrl_view is not None and isinstance(self._qvel, slice) \
                 and self._fingers is None:
             self._tick_views = (self._qacc[self._qvel], self._torque[self._qvel], self._ctrl_view)
+        #: geom_xpos of the simulated state and every geom's bounding radius: views, current whatever the state
+        #: (set_state copies into the same arrays) or the object (set_object writes into the model's)
+        self._geom_xpos, self._geom_rbound = data.geom_xpos, model.geom_rbound
         self._object_p = data.qpos[self.object_qpos : self.object_qpos + 3]
         self._object_v = data.qvel[self.object_qvel : self.object_qvel + 3]
         self._object_w = data.cvel[self.object_body, :3]
@@ -392,9 +395,9 @@ class TapPhysics:
         ``norm(p_geoms - p_object, axis=1) - rbound_geoms - rbound_object`` (each row's squares summed left to right,
         then the correctly rounded square root), so the same bits, at a fraction of numpy's per-call cost."""
         obj = self.active_geom
-        xpos = data.geom_xpos
+        xpos = self._geom_xpos if data is self.data else data.geom_xpos
         ox, oy, oz = xpos[obj].tolist()
-        r_object = float(self.model.geom_rbound[obj])
+        r_object = self._geom_rbound.item(obj)  # a Python float, as float() of the element
         near = []
         for g, (x, y, z), r_geom in zip(self._hand_geom_list, xpos[self._hand_rows].tolist(), self._hand_rbound,
                                         strict=True):
