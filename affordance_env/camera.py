@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from affordance_env.exceptions import InvalidValueError
-from affordance_env.linalg import matmul
+from affordance_env.linalg import einsum, matmul
 from affordance_env.pinhole import Intrinsics
 
 #: The 8 corners of a box of half-sizes 1.
@@ -37,21 +37,39 @@ class RangeImage:
     Attributes:
         ranges: Distance along each pixel's ray [m], (H, W) float32; ``inf`` where nothing was hit.
         geom_ids: MuJoCo geom hit by each ray, (H, W) int32; -1 where nothing was hit.
-        p_world_points: Point hit by each ray in the world frame [m], (H, W, 3) float64; NaN where no hit.
+        p_world_points: Point hit by each ray in the world frame [m], (H, W, 3) float64; NaN where no hit. None
+            when captured with ``points=False``: :meth:`points_of` then computes the points of the pixels asked for.
         p_world_camera: Camera centre in the world frame [m], (3,).
         R_world_camera: Camera orientation (columns: camera x, y, z axes in the world frame), (3, 3).
         intrinsics: The pinhole intrinsics used.
         normals: Unit surface normal at each hit point in the world frame, (H, W, 3); NaN where no hit. Only
             when captured with ``normals=True`` (the range-noise model needs them), else None.
+        rays: With ``points=False``: each pixel's unit ray direction in the world frame as rows x, y, z, (3, H W);
+            else None.
+        distances: With ``points=False``: the distance along each ray [m] in float64, (H W,) (NaN or anything
+            where nothing was hit); else None.
     """
 
     ranges: np.ndarray
     geom_ids: np.ndarray
-    p_world_points: np.ndarray
+    p_world_points: np.ndarray | None
     p_world_camera: np.ndarray
     R_world_camera: np.ndarray
     intrinsics: Intrinsics
     normals: np.ndarray | None = None
+    rays: np.ndarray | None = None
+    distances: np.ndarray | None = None
+
+    def points_of(self, pixels: np.ndarray) -> np.ndarray:
+        """The points hit at ``pixels`` (flat indices ``v * width + u``) [m], world frame, as rows x, y, z, (3, k):
+        ``p_world_points`` there, bit for bit (computed as capture computes every pixel's, p + d * distance, when
+        the image was captured without its points)."""
+        if self.p_world_points is not None:
+            return self.p_world_points.reshape(-1, 3).T.take(pixels, axis=1)
+        points = self.rays.take(pixels, axis=1)
+        points *= self.distances.take(pixels)
+        points += self.p_world_camera[:, None]
+        return points
 
     def mask_of(self, geom_id: int) -> np.ndarray:
         """Boolean (H, W) mask of the pixels that see geom ``geom_id``."""
@@ -412,7 +430,7 @@ class RangeCamera:
             # order (x + z) + y in which einsum adds each ray's three contiguous products (see the note above
             # _to_camera), and in one pass over each plane instead of a loop over three products per pixel
             axis = np.array([c0 / distance, c2 / distance, c1 / distance])  # x, z, y
-            cosine = np.einsum("ijk,i->jk", self._d_camera_xzy[:, v0:v1, u0:u1], axis)
+            cosine = einsum("ijk,i->jk", self._d_camera_xzy[:, v0:v1, u0:u1], axis)  # np.einsum
             inside[v0:v1, u0:u1] |= cosine >= cos_cone
 
     def _rays_near(self, geoms: np.ndarray, data: mujoco.MjData, p_world_camera: np.ndarray,
@@ -483,7 +501,7 @@ class RangeCamera:
         return pixels, points.T.copy()  # (k, 3), row-major like p_world_points[mask]
 
     def capture(self, data: mujoco.MjData, normals: bool = False,
-                occluded: int | np.ndarray | None = None, window: bool = False) -> RangeImage:
+                occluded: int | np.ndarray | None = None, window: bool = False, points: bool = True) -> RangeImage:
         """Cast one ray per pixel from the camera's current pose and return the range snapshot.
 
         Args:
@@ -495,6 +513,8 @@ class RangeCamera:
                 only ones that can see them, and report no hit elsewhere: the mask of those geoms, and their
                 pixels' ranges and points, are those of the whole image (what looking for the object needs;
                 :meth:`locate` gives just those).
+            points: Compute every pixel's point (``p_world_points``); False: leave them to
+                :meth:`RangeImage.points_of` for the pixels that need them (the image keeps the rays and distances).
         """
         n = self._n_rays
         p_world_camera, R_world_camera = self.pose(data)
@@ -534,10 +554,12 @@ class RangeCamera:
                 normal[miss] = np.nan
         else:
             ranges = dist.astype(np.float32)
-        points = d_world
-        points *= dist
-        points += p_world_camera[:, None]  # (3, n); its transpose is the (n, 3) view below
-        return self._image(ranges, geom_ids, points, p_world_camera, R_world_camera, normal)
+        if not points:
+            return self._image(ranges, geom_ids, None, p_world_camera, R_world_camera, normal, d_world, dist)
+        hits = d_world
+        hits *= dist
+        hits += p_world_camera[:, None]  # (3, n); its transpose is the (n, 3) view below
+        return self._image(ranges, geom_ids, hits, p_world_camera, R_world_camera, normal)
 
     def _window_image(self, data: mujoco.MjData, p_world_camera: np.ndarray, R_world_camera: np.ndarray,
                       d_world: np.ndarray, occluded: int | np.ndarray, targets: np.ndarray,
@@ -564,17 +586,21 @@ class RangeCamera:
             normal[pixels] = window_normal[hit]
         return self._image(ranges, geom_ids, points, p_world_camera, R_world_camera, normal)
 
-    def _image(self, ranges: np.ndarray, geom_ids: np.ndarray, points: np.ndarray, p_world_camera: np.ndarray,
-               R_world_camera: np.ndarray, normal: np.ndarray | None) -> RangeImage:
+    def _image(self, ranges: np.ndarray, geom_ids: np.ndarray, points: np.ndarray | None,
+               p_world_camera: np.ndarray, R_world_camera: np.ndarray, normal: np.ndarray | None,
+               rays: np.ndarray | None = None, distances: np.ndarray | None = None) -> RangeImage:
         """The :class:`RangeImage` of per-ray arrays: ranges (n,) float32 [m], geom ids (n,), points (3, n) [m]
-        (handed out as the (H, W, 3) view of their transpose), normals (n, 3) or None."""
+        (handed out as the (H, W, 3) view of their transpose) or None, normals (n, 3) or None, and without points
+        the rays (3, n) and distances (n,) [m]."""
         K = self.intrinsics
         return RangeImage(
             ranges=ranges.reshape(K.height, K.width),
             geom_ids=geom_ids.reshape(K.height, K.width),
-            p_world_points=points.T.reshape(K.height, K.width, 3),
+            p_world_points=None if points is None else points.T.reshape(K.height, K.width, 3),
             p_world_camera=p_world_camera,
             R_world_camera=R_world_camera,
             intrinsics=K,
             normals=None if normal is None else normal.reshape(K.height, K.width, 3),
+            rays=rays,
+            distances=distances,
         )

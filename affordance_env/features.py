@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from affordance_env.exceptions import InvalidValueError
-from affordance_env.linalg import matmul
+from affordance_env.linalg import einsum, matmul
 
 N_FEATURES = 49
 #: Bins of each normal histogram.
@@ -200,16 +200,50 @@ def compute_features(
     image_index = mask.ravel().nonzero()[0]
     if image_index.size == 0:
         return Features(NOT_VISIBLE_VALUES.copy(), visible=False, n_pixels=0)
-    v_obj, u_obj = np.divmod(image_index, mask.shape[1])
+    # (3, k), gathered along the pixel axis (contiguous when the camera hands out its (3, n) points transposed)
+    p_world_obj = np.ascontiguousarray(points.reshape(-1, 3).T.take(image_index, axis=1), dtype=np.float64)
+    return _object_features(image_index, mask.shape[1], p_world_obj, ranges.reshape(-1).take(image_index),
+                            p_world_camera, p_world_hand, uv_hand)
+
+
+def object_features(
+    image_index: np.ndarray,
+    width: int,
+    p_world_obj: np.ndarray,
+    range_obj: np.ndarray,
+    p_world_camera: np.ndarray,
+    p_world_hand: np.ndarray,
+    uv_hand: np.ndarray,
+) -> Features:
+    """:func:`compute_features` from the object's pixels alone: their flat indices in an image ``width`` pixels
+    wide (``np.flatnonzero(mask)``, increasing), their points ((3, k) [m], world frame) and their ranges ((k,) [m]);
+    the same features, bit for bit, without the rest of the image. The other arguments as there."""
+    p_world_camera = _finite_vector("p_world_camera", p_world_camera, 3, MAX_ABS_METRES, "m")
+    p_world_hand = _finite_vector("p_world_hand", p_world_hand, 3, MAX_ABS_METRES, "m")
+    uv_hand = _finite_vector("uv_hand", uv_hand, 2, MAX_ABS_PIXELS, "pixels")
+    image_index = np.asarray(image_index)
+    if image_index.size == 0:
+        return Features(NOT_VISIBLE_VALUES.copy(), visible=False, n_pixels=0)
+    p_world_obj = np.ascontiguousarray(p_world_obj, dtype=np.float64)
+    if p_world_obj.shape != (3, image_index.size) or np.shape(range_obj) != (image_index.size,):
+        raise InvalidValueError(f"p_world_obj must be (3, k) and range_obj (k,) for k = {image_index.size} pixels, got "
+                                f"shapes {p_world_obj.shape} and {np.shape(range_obj)}.")
+    return _object_features(image_index, int(width), p_world_obj, np.asarray(range_obj), p_world_camera,
+                            p_world_hand, uv_hand)
+
+
+def _object_features(image_index: np.ndarray, width: int, p_world_obj: np.ndarray, range_obj: np.ndarray,
+                     p_world_camera: np.ndarray, p_world_hand: np.ndarray, uv_hand: np.ndarray) -> Features:
+    """The features of the object's pixels (flat indices, increasing), points (3, k) float64, contiguous, and
+    ranges (k,), the other arguments checked."""
+    v_obj, u_obj = np.divmod(image_index, width)
     # Bounding box of the object, padded by one non-object pixel so that every neighbour index exists: the
     # object's pixels in that padded crop, row-major (the full image's order), found from their rows and columns
     # instead of by copying the crop and searching it again.
     r0, c0, c1 = int(v_obj[0]), int(np.minimum.reduce(u_obj)), int(np.maximum.reduce(u_obj)) + 1
     grid_shape = (int(v_obj[-1]) + 1 - r0 + 2, c1 - c0 + 2)
     pixel_index = (v_obj - (r0 - 1)) * grid_shape[1] + (u_obj - (c0 - 1))
-    # (3, k), gathered along the pixel axis (contiguous when the camera hands out its (3, n) points transposed)
-    p_world_obj = np.ascontiguousarray(points.reshape(-1, 3).T.take(image_index, axis=1), dtype=np.float64)
-    range_obj = ranges.reshape(-1).take(image_index).astype(np.float64)
+    range_obj = range_obj.astype(np.float64)
     _check_on_mask(p_world_obj, range_obj)
     uv_obj = np.array((u_obj, v_obj), dtype=np.float64)
 
@@ -295,7 +329,7 @@ def _normal_histograms(
     sums += products[:, 2]
     n_sq = sums[0]
     # |t_u|^2 and |t_v|^2 by one einsum over both: the same sums as einsum("ij,ij->j") of each
-    lengths_sq = np.einsum("ijk,ijk->jk", tangents, tangents)
+    lengths_sq = einsum("ijk,ijk->jk", tangents, tangents)  # np.einsum, without its Python layer
     ok = n_sq > _MIN_SINE_TANGENTS**2 * (lengths_sq[0] * lengths_sq[1])
     n_normals = int(np.count_nonzero(ok))
     if n_normals == 0:

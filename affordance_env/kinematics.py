@@ -17,7 +17,7 @@ import numpy as np
 import pinocchio as pin
 
 from affordance_env.exceptions import InvalidValueError
-from affordance_env.linalg import matmul, norm, solve_spd
+from affordance_env.linalg import matmul, matmul_f64, norm, norm_f64, solve_spd
 from affordance_env.robot_model import (
     HAND_MOUNT_FRAME,
     HAND_MOUNT_POS,
@@ -116,7 +116,7 @@ class Kinematics:
 
     def _check_q(self, q: np.ndarray) -> np.ndarray:
         q = np.asarray(q, dtype=float)
-        if q.shape != (self.model.nq,) or not np.isfinite(q).all():
+        if q.shape != (self.model.nq,) or not np.logical_and.reduce(np.isfinite(q)):  # .all(), without its layer
             raise InvalidValueError(f"q must be {self.nq} finite joint angles in the {self.variant.name!r} variant's "
                              f"active-joint order, got {q!r}.")
         return q
@@ -222,7 +222,7 @@ class Kinematics:
                 a posture the solution must keep, e.g. a wrist angle that holds the forearm off the table.
         """
         p_target = np.asarray(p_world_target, dtype=float)
-        if p_target.shape != (3,) or not np.isfinite(p_target).all():
+        if p_target.shape != (3,) or not np.logical_and.reduce(np.isfinite(p_target)):
             raise InvalidValueError(f"p_world_target must be 3 finite coordinates [m], got {p_world_target!r}.")
         if R_world_target is not None:
             R_world_target = np.asarray(R_world_target, dtype=float)
@@ -252,18 +252,19 @@ class Kinematics:
             J = jacobian(model, data, q, frame, world_aligned)
             T_world_hand = placements[frame]
             np.subtract(p_target, T_world_hand.translation, out=error_position)
-            pos_err = norm(error_position)
+            # linalg's norm and matmul on the float64 arrays made here, without their conversions (the same bits)
+            pos_err = norm_f64(error_position)
             jac = J[:n_error, dofs]  # (its memory order, Fortran, decides einsum's loops below: kept as it is)
             if R_world_target is None:
                 rot_err = 0.0
             else:
-                e_rot = log3(matmul(R_world_target, T_world_hand.rotation.T))
-                rot_err = norm(e_rot)
+                e_rot = log3(matmul_f64(R_world_target, T_world_hand.rotation.T))
+                rot_err = norm_f64(e_rot)
                 np.multiply(orientation_weight, e_rot, out=error_rotation)
                 jac[3:] *= orientation_weight
             if pos_err <= position_tolerance and rot_err <= orientation_tolerance * 0.5:
                 break
-            step = matmul(solve_spd(matmul(jac, jac.T) + regulariser, error), jac)
+            step = matmul_f64(solve_spd(matmul_f64(jac, jac.T) + regulariser, error), jac)
             q[dofs] = np.minimum(np.maximum(q[dofs] + step, lower), upper)
         else:
             pin.framesForwardKinematics(model, data, q)

@@ -42,6 +42,8 @@ def _c_einsum() -> Callable[..., Any]:
 
 
 _einsum = _c_einsum()
+#: ``np.einsum(subscripts, *operands)`` (no ``optimize``): the same loops and bits, without its Python layer.
+einsum = _einsum
 
 _SUBSCRIPTS = {(1, 1): "i,i->", (1, 2): "i,ij->j", (2, 1): "...ij,j->...i", (2, 2): "...ij,jk->...ik"}
 _FLOAT = np.float64
@@ -60,6 +62,17 @@ def matmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return _einsum(subscripts, a, b)
 
 
+def matmul_f64(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """:func:`matmul` of a float64 matrix (or vector) ``a`` and a float64 matrix ``b``, without the conversions and
+    checks: the same einsum, so the same bits, for loops that call it many times with arrays they made."""
+    return _einsum("...ij,jk->...ik" if a.ndim == 2 else "i,ij->j", a, b)
+
+
+def norm_f64(v: np.ndarray) -> float:
+    """:func:`norm` of a 1-D float64 array, without the conversions: the same sum and root, so the same bits."""
+    return math.sqrt(_einsum("i,i->", v, v))
+
+
 def dot(a: np.ndarray, b: np.ndarray) -> float:
     """The dot product of two vectors, as a float."""
     # As matmul of the two raveled: the same contiguous float64 vectors, whichever of the two conversions comes first.
@@ -76,7 +89,8 @@ def solve_spd(A: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``x`` with ``A x = b`` for a symmetric positive definite ``A`` (Cholesky, Eigen's ``LLT``)."""
     A = np.asarray(A, dtype=_FLOAT)
     decomposition = eigenpy.LLT(A)
-    if decomposition.info() != _SUCCESS or not np.isfinite(A).all():
+    # np.isfinite(A).all(), without the method's Python layer
+    if decomposition.info() != _SUCCESS or not np.logical_and.reduce(np.isfinite(A), axis=None):
         # a numerical failure inside the simulation, not a user's value: numpy's own type for it
         raise np.linalg.LinAlgError(f"solve_spd needs a finite symmetric positive definite matrix, got {A!r}.")
     return np.asarray(decomposition.solve(np.asarray(b, dtype=_FLOAT)), dtype=_FLOAT)

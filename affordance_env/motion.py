@@ -178,12 +178,14 @@ class LinePath:
         # Joint rates per metre of the palm [rad/m] over each span, all spans at once (elementwise, the same
         # numbers as span by span; the smallest of the spans' minima is the minimum over all of them).
         rates = np.abs(q_ik[1:] - q_ik[:-1]) / (self._s_ik[1 : spans + 1] - self._s_ik[:spans])[:, None]
-        cap = float(np.min(executor.planned_speed / np.maximum(rates, 1e-12)))
+        cap = float(np.minimum.reduce(executor.planned_speed / np.maximum(rates, 1e-12), axis=None))  # np.min
         #: Cruise speed of the palm [m/s]: the one asked for, or the most the joints allow.
         self.speed = min(float(speed), cap)
         profile = line_profile(length, self.speed, CONTROL_DT, ramp=ramp, to_rest=to_rest)
         self._s, self._v = profile[:, 0], profile[:, 1]
-        self._a = np.diff(self._v, prepend=0.0) / CONTROL_DT  # the palm's acceleration along the line [m/s^2]
+        # the palm's acceleration along the line [m/s^2]: np.diff(v, prepend=0.0), its subtraction written out
+        v0 = np.concatenate(((0.0,), self._v))
+        self._a = (v0[1:] - v0[:-1]) / CONTROL_DT
         self._trajectory: JointTrajectory | None = None
 
     def __len__(self) -> int:
@@ -280,7 +282,12 @@ class MotionExecutor:
         # physics.step_toward's two calls, bound once: this loop runs every control tick of every move
         aim, step, n_steps = physics.set_targets_toward, physics.step, self.steps_per_tick
         led = trajectory.q + physics.servo_lead * trajectory.qd  # the velocity feedforward of every tick
-        for q_tick, qdd_tick in zip(led, trajectory.qdd, strict=True):
+        accelerations = physics.tick_accelerations(trajectory.qdd)  # every tick's, as MuJoCo's vectors, at once
+        if accelerations is None:
+            accelerations = trajectory.qdd
+        else:
+            aim = physics.set_targets_toward_rows
+        for q_tick, qdd_tick in zip(led, accelerations, strict=True):
             aim(q_tick, qdd_tick)  # and the inertial feedforward of the tick's configuration
             step(n_steps)
             if until is not None and until():
@@ -383,15 +390,26 @@ class MotionExecutor:
         n_steps = self.steps_per_tick
         dt = physics.model.opt.timestep
         direction = path.direction
+        e0, e1, e2 = direction.tolist()
         p_touch, time, speed = p_start, float("nan"), 0.0
+        t0 = t1 = t2 = 0.0  # p_touch as Python floats, once touched
         touched_yet = False
-        for q_led, qdd in self._line_ticks(path):
+        aim, ticks = physics.set_targets_toward, self._line_ticks(path)
+        if trajectory is not None:  # every tick's accelerations as MuJoCo's vectors at once (see follow)
+            accelerations = physics.tick_accelerations(trajectory.qdd)
+            if accelerations is not None:
+                aim = physics.set_targets_toward_rows
+                ticks = zip(trajectory.q + physics.servo_lead * trajectory.qd, accelerations, strict=True)
+        for q_led, qdd in ticks:
             if touched is None:
-                physics.step_toward(q_led, qdd, n_steps)
+                aim(q_led, qdd)  # physics.step_toward
+                physics.step(n_steps)
                 continue
-            physics.set_targets_toward(q_led, qdd)
-            if per_step and (touched_yet or physics.hand_object_distance(CONTACT_WATCH_DISTANCE)
-                             < CONTACT_WATCH_DISTANCE):  # step by step: the touch and the follow-through, to the step
+            aim(q_led, qdd)
+            # hand_object_distance(d) < d, answered as arm_near_object does: the geoms whose bounding spheres are
+            # farther than d from the object's are not measured, and the first one nearer than d ends the search
+            if per_step and (touched_yet or physics.arm_near_object(CONTACT_WATCH_DISTANCE)):
+                # step by step: the touch and the follow-through, to the step
                 for _ in range(n_steps):
                     if not touched_yet:
                         p_before = palm.copy()
@@ -399,9 +417,14 @@ class MotionExecutor:
                     if not touched_yet and touched():
                         touched_yet, time, p_touch = True, float(physics.data.time), palm.copy()
                         speed = norm(palm - p_before) / dt
-                    if touched_yet and dot(palm - p_touch, direction) >= follow_through:
-                        self.stop()
-                        return LineResult(True, time, speed, p_touch)
+                        t0, t1, t2 = p_touch.tolist()
+                    if touched_yet:
+                        # dot(palm - p_touch, direction) in Python floats, bit for bit: the differences, then
+                        # einsum's sum of three contiguous products, (x + z) + y, from +0 (see camera._to_camera)
+                        a0, a1, a2 = palm.tolist()
+                        if (((a0 - t0) * e0 + (a2 - t2) * e2) + (a1 - t1) * e1) + 0.0 >= follow_through:
+                            self.stop()
+                            return LineResult(True, time, speed, p_touch)
                 continue  # past the touch, the last step's follow-through was just measured: short of it
             p_before = palm.copy()  # whole ticks: the touch to the tick
             physics.step(n_steps)

@@ -148,6 +148,9 @@ class TapPhysics:
         if self._actuated is None and self._ctrl_view is not None and isinstance(self._qvel, slice) \
                 and self._fingers is None:
             self._tick_views = (self._qacc[self._qvel], self._torque[self._qvel], self._ctrl_view)
+        #: geom_xpos of the simulated state and every geom's bounding radius: views, current whatever the state
+        #: (set_state copies into the same arrays) or the object (set_object writes into the model's)
+        self._geom_xpos, self._geom_rbound = data.geom_xpos, model.geom_rbound
         self._object_p = data.qpos[self.object_qpos : self.object_qpos + 3]
         self._object_v = data.qvel[self.object_qvel : self.object_qvel + 3]
         self._object_w = data.cvel[self.object_body, :3]
@@ -192,7 +195,7 @@ class TapPhysics:
 
     def max_joint_speed(self) -> float:
         """Largest speed of the robot's joints [rad/s] (of :meth:`joint_velocities`, without copying them)."""
-        return float(np.abs(self.data.qvel[self._qvel]).max())
+        return float(np.maximum.reduce(np.abs(self.data.qvel[self._qvel])))  # .max(), without its Python layer
 
     def joint_torques(self) -> np.ndarray:
         """Motor torques at the robot's joints in active-joint order [N m], gravity compensation included (the
@@ -249,6 +252,27 @@ class TapPhysics:
         qacc_robot, torque_robot, ctrl = views
         qacc_robot[:] = qdd
         mujoco.mj_mulM(self.model, self.data, self._torque, self._qacc)
+        np.divide(torque_robot, self.servo_kp, out=lead)
+        np.add(q, lead, out=lead)
+        np.minimum(np.maximum(lead, self.ctrl_low, out=lead), self.ctrl_high, out=ctrl)
+
+    def tick_accelerations(self, qdd: np.ndarray) -> np.ndarray | None:
+        """The accelerations ``qdd`` [rad/s^2] of a trajectory's ticks ((ticks, active joints)) as rows of the model's
+        whole acceleration vector ((ticks, nv), zero outside the robot's joints), for
+        :meth:`set_targets_toward_rows`; None where a control tick cannot take them so (see ``_tick_views``)."""
+        if self._tick_views is None:
+            return None
+        rows = np.zeros((len(qdd), self.model.nv))
+        rows[:, self._qvel] = qdd
+        return rows
+
+    def set_targets_toward_rows(self, q: np.ndarray, qacc: np.ndarray) -> None:
+        """:meth:`set_targets_toward` ``q`` with the inertial lead of a row of :meth:`tick_accelerations`: the same
+        arithmetic on the same numbers (the row is the vector set_targets_toward fills: the robot's part, zeros
+        elsewhere), without copying the accelerations into it at every tick."""
+        _, torque_robot, ctrl = self._tick_views
+        lead = self._lead
+        mujoco.mj_mulM(self.model, self.data, self._torque, qacc)
         np.divide(torque_robot, self.servo_kp, out=lead)
         np.add(q, lead, out=lead)
         np.minimum(np.maximum(lead, self.ctrl_low, out=lead), self.ctrl_high, out=ctrl)
@@ -382,9 +406,9 @@ class TapPhysics:
         ``norm(p_geoms - p_object, axis=1) - rbound_geoms - rbound_object`` (each row's squares summed left to right,
         then the correctly rounded square root), so the same bits, at a fraction of numpy's per-call cost."""
         obj = self.active_geom
-        xpos = data.geom_xpos
+        xpos = self._geom_xpos if data is self.data else data.geom_xpos
         ox, oy, oz = xpos[obj].tolist()
-        r_object = float(self.model.geom_rbound[obj])
+        r_object = self._geom_rbound.item(obj)  # a Python float, as float() of the element
         near = []
         for g, (x, y, z), r_geom in zip(self._hand_geom_list, xpos[self._hand_rows].tolist(), self._hand_rbound,
                                         strict=True):

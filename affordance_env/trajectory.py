@@ -56,7 +56,7 @@ def _check_limits(velocity_limit: np.ndarray | float, n_joints: int) -> np.ndarr
     limit = np.asarray(velocity_limit, dtype=np.float64)
     if limit.shape != (n_joints,):  # a scalar (or a broadcastable array): broadcast; a vector as it is
         limit = np.broadcast_to(limit, (n_joints,))
-    if not (np.isfinite(limit) & (limit > 0)).all():
+    if not np.logical_and.reduce(np.isfinite(limit) & (limit > 0)):  # .all(), without its Python layer
         raise InvalidValueError(f"velocity_limit must be positive and finite for every joint, got {velocity_limit!r}.")
     return limit
 
@@ -96,12 +96,14 @@ def minimum_jerk(q_from: np.ndarray, waypoints: list[np.ndarray] | np.ndarray, v
     # np.diff(np.vstack([q_from, points]), axis=0), without the two wrappers: each row minus the one before
     stacked = np.concatenate((q_from[None, :], points))
     deltas = stacked[1:] - stacked[:-1]
-    lengths = np.maximum(max(min_duration, 1e-9), PEAK_SPEED_FACTOR * np.max(np.abs(deltas) / limit, axis=1))
+    # np.max and ndarray.any as the ufunc reductions they run, without their Python layers (here and below)
+    lengths = np.maximum(max(min_duration, 1e-9),
+                         PEAK_SPEED_FACTOR * np.maximum.reduce(np.abs(deltas) / limit, axis=1))
     starts = np.zeros(len(deltas))
     for k in range(1, len(deltas)):
         starts[k] = starts[k - 1] + lengths[k - 1] - blend * min(lengths[k - 1], lengths[k])
-    end = float(np.max(starts + lengths))
-    if not deltas.any():
+    end = float(np.maximum.reduce(starts + lengths))
+    if not np.logical_or.reduce(deltas, axis=None):
         return _hold(q_from, end, dt, duration)
 
     def grid(stretch: float) -> tuple[np.ndarray, float]:
@@ -120,13 +122,13 @@ def minimum_jerk(q_from: np.ndarray, waypoints: list[np.ndarray] | np.ndarray, v
     tau, time_scale = grid(1.0)
     qd = velocity(tau, time_scale)
     # Overlapping segments may add up, and rounding to whole samples shortens by up to half a sample.
-    stretch = max(1.0, float(np.max(np.abs(qd) / limit)))
+    stretch = max(1.0, float(np.maximum.reduce(np.abs(qd) / limit, axis=None)))
     if duration is not None:
         stretch = max(stretch, duration / end)
     if stretch > 1.0:
         tau, time_scale = grid(stretch)
         qd = velocity(tau, time_scale)
-        over = float(np.max(np.abs(qd) / limit))
+        over = float(np.maximum.reduce(np.abs(qd) / limit, axis=None))
         if over > 1.0:  # the rounding to whole samples: one sample more
             tau, time_scale = grid(stretch * over + dt / end)
             qd = velocity(tau, time_scale)

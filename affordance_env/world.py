@@ -28,7 +28,7 @@ from affordance_env.behaviors import ACTION_DIM, check_action, get_behavior
 from affordance_env.behaviors.base import Behavior
 from affordance_env.camera import RangeCamera
 from affordance_env.exceptions import IncompatibleStateError, InvalidValueError
-from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, Features, compute_features, effect_features
+from affordance_env.features import FEATURE_NAMES, NOT_VISIBLE_VALUES, Features, effect_features, object_features
 from affordance_env.kinematics import Kinematics
 from affordance_env.linalg import norm
 from affordance_env.motion import HOLD_MAX_TIME, HOLD_SPEED_TOLERANCE, MotionExecutor, ReachOutcome
@@ -243,22 +243,27 @@ class World:
         """A picture of the range camera as the world is now, with the joints (no attention, no wait); the range
         noise, if any, drawn from ``rng``."""
         physics, camera = self._acting.physics, self._acting.camera
-        image = camera.capture(physics.data, normals=self.range_noise is not None, occluded=physics.active_geom)
-        if self.range_noise is not None:
+        noise = self.range_noise is not None
+        # Without noise only the object's points are needed: the camera leaves the others uncomputed.
+        image = camera.capture(physics.data, normals=noise, occluded=physics.active_geom, points=noise)
+        if noise:
             image = add_kinect_noise(image, rng)
         mask = image.mask_of(physics.active_geom)
         p_world_hand = physics.hand_position()
         uv_hand = image.project(p_world_hand)
         if not np.all(np.isfinite(uv_hand)):  # hand behind the camera: no image position; use the image centre
             uv_hand = np.array([image.intrinsics.cx, image.intrinsics.cy])
-        features = compute_features(image.p_world_points, image.ranges, mask, image.p_world_camera, p_world_hand,
-                                    uv_hand)
-        # p_world_points[mask], gathered by the mask's pixel indices from the camera's (3, n) points: the same
-        # (k, 3) row-major array, without boolean indexing of the transposed view
+        # The object's pixels and their points ((3, k), as p_world_points[mask].T, the same bits): the features
+        # of compute_features(p_world_points, ranges, mask, ...), from them alone
         pixels = mask.ravel().nonzero()[0]
-        points = image.p_world_points.reshape(-1, 3).T.take(pixels, axis=1).T.copy()
-        top = points[points[:, 2] >= points[:, 2].max() - TOP_DEPTH] if len(points) else points
-        seen = top[:, :2].mean(axis=0) if len(top) else np.full(2, np.nan)
+        p_world_obj = image.points_of(pixels)
+        features = object_features(pixels, mask.shape[1], p_world_obj, image.ranges.reshape(-1).take(pixels),
+                                   image.p_world_camera, p_world_hand, uv_hand)
+        points = p_world_obj.T.copy()  # p_world_points[mask]: (k, 3), row-major
+        # the highest points' mean x, y: what .max() and .mean(axis=0) compute (the same reductions of the same
+        # arrays, the sum divided by the count), without their Python layers
+        top = points[points[:, 2] >= np.maximum.reduce(points[:, 2]) - TOP_DEPTH] if len(points) else points
+        seen = np.add.reduce(top[:, :2], axis=0) / len(top) if len(top) else np.full(2, np.nan)
         ranges = np.where(np.isfinite(image.ranges), image.ranges, 0.0).astype(np.float32)
         return Snapshot(frozen_array(ranges), frozen_array(mask.astype(np.int8)), features,
                         frozen_array(physics.joint_positions().astype(np.float32)), frozen_array(seen))
