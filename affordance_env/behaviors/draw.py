@@ -73,6 +73,7 @@ from affordance_env.behaviors.stroke import (
     stroke_reachable,
 )
 from affordance_env.behaviors.success import is_success
+from affordance_env.linalg import matmul
 from affordance_env.motion import HandTarget, MotionExecutor
 from affordance_env.objects import ObjectGeometry, object_geometry
 from affordance_env.outcome import Labels
@@ -240,7 +241,8 @@ def draw_orientation() -> np.ndarray:
     """
     fingers, normal = np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0])
     upright = np.column_stack([fingers, np.cross(normal, fingers), normal])
-    return (_rotation_z(-DRAW_HAND_TURN) @ _rotation_y(DRAW_HAND_TILT) @ _rotation_x(DRAW_HAND_ROLL)) @ upright
+    turn = matmul(matmul(_rotation_z(-DRAW_HAND_TURN), _rotation_y(DRAW_HAND_TILT)), _rotation_x(DRAW_HAND_ROLL))
+    return matmul(turn, upright)
 
 
 def _rotation_x(a: float) -> np.ndarray:
