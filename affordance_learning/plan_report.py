@@ -328,7 +328,7 @@ def multi_step_why(results: PlanResults | Mapping[str, Any]) -> str:
     return (f"{_share(multi.reached, unit='episodes')} reach the target (median final distance "
             f"{100 * multi.median_final_distance_m:.1f} cm). By type: {per_type}. {len(beyond)} of the "
             f"{len(missed)} missed targets lay further along an axis than {most} such interactions take the object "
-            f"({towards} of them towards the robot, where only rolling brings an object); on the "
+            f"({towards} of them towards the robot); on the "
             f"{inside.n} targets within that reach the planner reached "
             f"{share_text(inside.value, inside.n, digits=1)}. In "
             f"{gave_up} missed episodes the object ended where no candidate action was reachable")
