@@ -614,9 +614,11 @@ def collect_training(out: Path, settings: PlanSettings, seed: int, workers: int,
     draw, which reaches only objects near the robot, gets a tenth of the goal episodes' interactions. The frame of
     both."""
     from affordance_env.behaviors import get_behavior
-    from affordance_env.dataset import collect, load_dataset
+    from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
 
     episodes, chunk = settings.episodes, 25
+    if (out / MANIFEST).exists():  # an earlier collection, perhaps extended: resumed as far as it went
+        episodes = max(episodes, int(read_manifest(out)["episodes"]))
     camera_options = {"camera_width": camera[0], "camera_height": camera[1]}
     # The behaviours TapAffordance-v2 runs as the goal env does (all but the grasp, which the goal env runs as pick
     # and place): their interactions in its scene with both arms are the goal env's, and cost no goal episode.
@@ -634,7 +636,6 @@ def collect_training(out: Path, settings: PlanSettings, seed: int, workers: int,
         episodes = min(settings.max_episodes, max(episodes + chunk, math.ceil(wanted / chunk) * chunk))
         say(f"      {', '.join(f'{b} {n}' for b, n in counts.items())} interactions: extending to {episodes} "
             "episodes")
-    frames = [frame]
     for behavior in same:  # topped up with single interactions over the behaviour's own workspace
         missing = settings.max_per_behavior - counts[behavior]
         if missing <= 0:
@@ -642,13 +643,30 @@ def collect_training(out: Path, settings: PlanSettings, seed: int, workers: int,
         wanted = math.ceil(missing * TOP_UP_MARGIN / chunk) * chunk
         say(f"      {behavior}: {counts[behavior]} interactions in the goal episodes, {wanted} more of "
             f"TapAffordance-v2 in the same scene")
-        top_up = collect(out.parent / f"{out.name}-{behavior}", wanted, seed=seed, workers=workers, action="random",
-                         env_options={"behavior": behavior, "two_arms": True, "position_range": "workspace",
-                                      **camera_options}, max_failure_share=1.0, chunk_size=chunk)
-        extra = load_dataset(top_up)
-        # after the goal episodes, in their order: each an episode of one step
-        extra = extra.assign(episode=extra["episode"] + TOP_UP_EPISODES, step=0)
-        frames.append(extra)
+        collect(top_up_path(out, behavior), wanted, seed=seed, workers=workers, action="random",
+                env_options={"behavior": behavior, "two_arms": True, "position_range": "workspace",
+                             **camera_options}, max_failure_share=1.0, chunk_size=chunk)
+    return load_training(out)
+
+
+def top_up_path(out: Path, behavior: str) -> Path:
+    """Where :func:`collect_training` tops up ``behavior``'s interactions of the goal episodes in ``out``."""
+    return out.parent / f"{out.name}-{behavior}"
+
+
+def load_training(out: str | os.PathLike) -> pd.DataFrame:
+    """The training frame :func:`collect_training` collected into ``out`` (``affordance plan``'s
+    ``OUT/dataset``): its goal episodes, then each behaviour's top-up beside it (each interaction an episode of
+    one step, numbered from ``TOP_UP_EPISODES``)."""
+    from affordance_env.dataset import MANIFEST, load_dataset
+
+    out = Path(out)
+    frames = [load_dataset(out)]
+    for behavior in BEHAVIORS:
+        path = top_up_path(out, behavior)
+        if (path / MANIFEST).exists():
+            extra = load_dataset(path)
+            frames.append(extra.assign(episode=extra["episode"] + TOP_UP_EPISODES, step=0))
     return pd.concat(frames, ignore_index=True)
 
 

@@ -31,8 +31,9 @@ def main() -> None:
           f"{info['distance'] * 100:.1f} cm")
     for step in range(1, 6):
         state = world.get_state()
-        candidates = [(b, np.zeros(3, np.float32)) for b in range(4)]
-        candidates += [(int(rng.integers(4)), rng.uniform(-1, 1, 3).astype(np.float32)) for _ in range(args.candidates)]
+        candidates = [(b, np.zeros(3, np.float32)) for b in range(len(world.behaviors))]
+        candidates += [(int(rng.integers(len(world.behaviors))), rng.uniform(-1, 1, 3).astype(np.float32))
+                       for _ in range(args.candidates)]
         best, best_distance, tried = None, np.inf, 0
         for behavior, params in candidates:
             if not world.feasible(behavior, params):

@@ -14,10 +14,9 @@ import gymnasium as gym
 import numpy as np
 
 import affordance_env  # noqa: F401  (registers the environments)
-from affordance_env import load_dataset
 from affordance_env.workspace import in_workspace
 from affordance_learning.goals import Move, describe
-from affordance_learning.plan_experiment import fit_models, training_frames
+from affordance_learning.plan_experiment import fit_models, load_training, training_frames
 from affordance_learning.planner import Planner
 
 
@@ -26,7 +25,7 @@ def main() -> None:
     parser.add_argument("--dataset", default="plan/dataset", help="goal episodes (affordance plan's OUT/dataset)")
     parser.add_argument("--seed", type=int, default=3)
     args = parser.parse_args()
-    planner = Planner(fit_models(training_frames(load_dataset(args.dataset), 1000), random_state=0))
+    planner = Planner(fit_models(training_frames(load_training(args.dataset), 1000), random_state=0))
     env = gym.make("TapAffordanceGoal-v2")
     world = env.unwrapped
 

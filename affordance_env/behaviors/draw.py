@@ -57,25 +57,24 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from affordance_env.behaviors.action import ACTION_DIM, check_action
+from affordance_env.behaviors.action import check_action
 from affordance_env.behaviors.stroke import (
     CROSSING_CLEARANCE,
     FOREARM_RAISED,
     HAND_BELOW_PALM,
-    MAX_OBJECT_MOVED_BEFORE,
-    MAX_START_ERROR,
     MIN_PALM_HEIGHT,
     StrokeOutcome,
     StrokePlan,
-    approach_posture,
+    canonical_posture,
     half_extent_along,
+    reach_failure,
     run_stroke,
     stroke_reachable,
 )
 from affordance_env.behaviors.success import is_success
 from affordance_env.linalg import matmul
 from affordance_env.motion import HandTarget, MotionExecutor
-from affordance_env.objects import ObjectGeometry, object_geometry
+from affordance_env.objects import ObjectGeometry
 from affordance_env.outcome import Labels
 
 #: The draw's hand (:func:`draw_orientation`) [rad]: the palm tilted down from upright, turned about its normal, and
@@ -184,12 +183,7 @@ class DrawBehavior:
         return DRAW_DIRECTION.copy()
 
     def prepare(self, motion: MotionExecutor, placement_centre: np.ndarray, size: float) -> np.ndarray:
-        # Every approach's IK starts from the posture of the canonical draw of a sphere at the placement centre.
-        table_top = motion.physics.table_top
-        geometry = object_geometry("sphere", size)
-        centre = np.array([*placement_centre, table_top + geometry.half_height])
-        motion.physics.reset_home()
-        return approach_posture(motion, self.plan(geometry, centre, 0.0, table_top, np.zeros(ACTION_DIM)))
+        return canonical_posture(self, motion, placement_centre, size)
 
     def plan(self, geometry: ObjectGeometry, p_object: np.ndarray, yaw: float, table_top: float,
              action: np.ndarray) -> StrokePlan:
@@ -214,10 +208,9 @@ class DrawBehavior:
         return now  # the hand stopped at the line's end, at rest: the object is awaited from there
 
     def failure(self, outcome: StrokeOutcome) -> str | None:
-        if outcome.object_moved > MAX_OBJECT_MOVED_BEFORE:
-            return f"reach: the arm moved the object by {outcome.object_moved * 1e3:.1f} mm before the draw"
-        if outcome.start_error > MAX_START_ERROR:
-            return f"reach: the draw started {outcome.start_error * 1e3:.1f} mm from the planned pose"
+        reach = reach_failure(outcome, "draw")
+        if reach is not None:
+            return reach
         if not outcome.contact:
             return "draw: the hand never touched the object"
         return None

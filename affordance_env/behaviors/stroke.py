@@ -308,6 +308,27 @@ def run_stroke(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | N
                          travel, start_error, object_moved, None if above is None else above.q, path.speed)
 
 
+def canonical_posture(behavior: Any, motion: MotionExecutor, placement_centre: np.ndarray, size: float
+                      ) -> np.ndarray:
+    """The posture every approach's IK of a line behaviour (a stroke, the draw) starts from: that of its canonical
+    action on a sphere of ``size`` [m] at the centre of the placement region (:func:`approach_posture`)."""
+    table_top = motion.physics.table_top
+    geometry = object_geometry("sphere", size)
+    centre = np.array([*placement_centre, table_top + geometry.half_height])
+    motion.physics.reset_home()
+    return approach_posture(motion, behavior.plan(geometry, centre, 0.0, table_top, np.zeros(ACTION_DIM)))
+
+
+def reach_failure(outcome: StrokeOutcome, what: str) -> str | None:
+    """Why the reach to the line's start makes the interaction invalid (the arm moved the object before the line,
+    or the line started too far from its pose), naming the line ``what``; None if it did not."""
+    if outcome.object_moved > MAX_OBJECT_MOVED_BEFORE:
+        return f"reach: the arm moved the object by {outcome.object_moved * 1e3:.1f} mm before the {what}"
+    if outcome.start_error > MAX_START_ERROR:
+        return f"reach: the {what} started {outcome.start_error * 1e3:.1f} mm from the planned pose"
+    return None
+
+
 @dataclass(frozen=True)
 class StrokeBehavior:
     """A horizontal hand stroke: reach, stroke until contact and follow-through.
@@ -347,13 +368,7 @@ class StrokeBehavior:
             raise InvalidValueError(f"success_rule must be one of {SUCCESS_RULES}, got {self.success_rule!r}.")
 
     def prepare(self, motion: MotionExecutor, placement_centre: np.ndarray, size: float) -> np.ndarray:
-        # Every approach's IK starts from one posture: that of the canonical stroke of a sphere of the given size
-        # at the centre of the placement region.
-        table_top = motion.physics.table_top
-        geometry = object_geometry("sphere", size)
-        centre = np.array([*placement_centre, table_top + geometry.half_height])
-        motion.physics.reset_home()
-        return approach_posture(motion, self.plan(geometry, centre, 0.0, table_top, np.zeros(ACTION_DIM)))
+        return canonical_posture(self, motion, placement_centre, size)
 
     def plan(self, geometry: ObjectGeometry, p_object: np.ndarray, yaw: float, table_top: float,
              action: np.ndarray) -> StrokePlan:
@@ -374,10 +389,9 @@ class StrokeBehavior:
         return outcome.contact_time if outcome.contact else now  # from the first touch
 
     def failure(self, outcome: StrokeOutcome) -> str | None:
-        if outcome.object_moved > MAX_OBJECT_MOVED_BEFORE:
-            return f"reach: the arm moved the object by {outcome.object_moved * 1e3:.1f} mm before the stroke"
-        if outcome.start_error > MAX_START_ERROR:
-            return f"reach: the stroke started {outcome.start_error * 1e3:.1f} mm from the planned pose"
+        reach = reach_failure(outcome, "stroke")
+        if reach is not None:
+            return reach
         if not outcome.contact:
             return "tap: the hand never touched the object"
         return None
