@@ -32,7 +32,7 @@ def main() -> None:
     counts: Counter = Counter()
     for i in range(args.draws):
         env.reset(seed=args.seed * 100_000 + i, options={"position": tuple(rng.uniform(REACH_LOW, REACH_HIGH))})
-        behavior, params = int(rng.integers(4)), rng.uniform(-1, 1, 3).astype(np.float32)
+        behavior, params = int(rng.integers(len(env.behaviors))), rng.uniform(-1, 1, 3).astype(np.float32)
         feasible = env.feasible(behavior, params)
         _, _, _, _, info = env.step({"behavior": behavior, "params": params})
         reached = bool(info["ik"]["success"]) and not str(info["failure"] or "").startswith("reach")
