@@ -73,8 +73,12 @@ def test_bad_actions_missing_and_foreign_models_are_refused_with_the_rebuild_com
         predict_effect(np.zeros(N), "push", action=[2.0, 0.0, 0.0])
     with pytest.raises(ValueError, match="2 actions for 3 objects"):
         predict_effect(np.zeros((3, N)), "push", action=np.zeros((2, 3)))
-    with pytest.raises(DefaultModelMissingError, match="affordance train-default --action-conditioned"):
-        predict_effect(np.zeros(N), "grasp", action=np.zeros(3))
+    import affordance_learning.default_model as default_model
+
+    with monkeypatch.context() as without_shipped:  # neither the user's nor the package's model of the grasp
+        without_shipped.setattr(default_model, "MODEL_DIR", tmp_path / "no-package-models")
+        with pytest.raises(DefaultModelMissingError, match="affordance train-default --action-conditioned"):
+            predict_effect(np.zeros(N), "grasp", action=np.zeros(3))
     wrong = tmp_path / "push_action_model.joblib"
     bundle = joblib.load(user_dir / "tap_action_model.joblib")
     joblib.dump(bundle, wrong)
@@ -83,3 +87,20 @@ def test_bad_actions_missing_and_foreign_models_are_refused_with_the_rebuild_com
     joblib.dump({**bundle, "versions": {**bundle["versions"], "scikit-learn": "0.1"}}, wrong)
     with pytest.raises(DefaultModelError, match="other library versions"):
         predict_effect(np.zeros(N), "tap", action=np.zeros(3), path=wrong)
+
+
+def test_the_shipped_models_predict_each_behaviours_way(monkeypatch, tmp_path):
+    # After install, with no model of the user's: the package's, one per behaviour, each moving the object its way.
+    import gymnasium as gym
+
+    import affordance_env  # noqa: F401 (registers the envs)
+
+    monkeypatch.setenv("TAP_AFFORDANCE_DATA", str(tmp_path / "nothing-here"))
+    env = gym.make("TapAffordanceGoal-v2", camera_width=160, camera_height=120)
+    obs, _ = env.reset(seed=0, options={"object_type": "box", "size": 0.05, "position": (-0.30, 0.03)})
+    features = obs["observation"]["features"]
+    moved = {b: predict_effect(features, b, action=np.zeros(3)).displacement for b in ("tap", "tap_back", "draw")}
+    assert moved["tap"][1] < -0.005 and moved["tap_back"][1] > 0.005 and moved["draw"][0] > 0.03
+    placed = predict_effect(features, "grasp", action=[0.5, -0.5, 0.0])  # pick and place: 10 cm +x, 10 cm -y
+    assert placed.lifted > 0.5 and placed.displacement[0] > 0.04 and placed.displacement[1] < -0.04
+    env.close()
