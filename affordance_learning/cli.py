@@ -23,7 +23,7 @@ from affordance_env.collect_cli import (
     positive_int,
 )
 from affordance_env.exceptions import AffordanceEnvError
-from affordance_env.registry import ENV_ID
+from affordance_env.registry import BEHAVIOR_NAMES, ENV_ID
 from affordance_learning.exceptions import AffordanceLearningError, InvalidValueError
 from affordance_learning.plan_results import PLAN_RESULTS_FORMAT
 
@@ -32,7 +32,7 @@ if TYPE_CHECKING:
 
 #: The sizes of ``affordance plan`` (:class:`~affordance_learning.plan_experiment.PlanSettings`' defaults), for its
 #: help; an option not given keeps PlanSettings' own default.
-PLAN_DEFAULTS = {"episodes": 2000, "objects": 32, "multi_episodes": 80}
+PLAN_DEFAULTS = {"episodes": 1500, "objects": 24, "multi_episodes": 64}
 #: What ``affordance plan`` writes into its ``--out``: its goal episodes in this directory, and its results
 #: (of the format :data:`~affordance_learning.plan_results.PLAN_RESULTS_FORMAT`), report and figures beside it.
 PLAN_DATASET = "dataset"
@@ -303,7 +303,7 @@ def build_parser() -> argparse.ArgumentParser:
     demo = sub.add_parser("demo", help="tap a few objects with the canonical tap and print what happened")
     demo.add_argument("--episodes", type=positive_int, default=8, help="number of interactions (default 8)")
     demo.add_argument("--seed", type=non_negative_int, default=0, help="seed of the first interaction (default 0)")
-    demo.add_argument("--behavior", default="tap", help="tap | tap_back | push | grasp (default tap)")
+    demo.add_argument("--behavior", default="tap", help=" | ".join(BEHAVIOR_NAMES) + " (default tap)")
     demo.add_argument("--object", default=None, help="only this object type (default: all four)")
     demo.set_defaults(func=_demo)
 
