@@ -28,7 +28,7 @@ Two departures from Saponaro's module, both set by this scene:
 Over 200 canonical draws (``python benchmarks/draw.py``) 4 fail (2 %, all "reach": boxes of 9.6-10 cm that the arm
 nudges 3.2-3.9 mm on its way behind them, over the 3 mm a stroke allows); the others move the object a median 9.2 cm
 toward the robot (5.0 cm for the smallest third of sizes, 10.3 for the largest), 99.5 % of them at least 2 cm,
-and 0.6 cm across; one ball rolled on over the table's edge. Balls of 4-5 cm move only 1.7-3.0 cm: the palm, tilted
+and 0.6 cm across; one ball rolled on over the table's edge. Balls of 4-5.5 cm move only 1.7-3.0 cm: the palm, tilted
 toward the table and 4 cm above it at least, rides over them once they are under its lower edge.
 
 The action is three numbers in [-1, 1]; 0 is the canonical draw:
