@@ -55,7 +55,7 @@ def main() -> None:
 
     mujoco.mj_step = timed("mj_step", counted_step)
     mujoco.mj_multiRay = timed("ray casting", original["mj_multiRay"])
-    world_module.compute_features = timed("features", world_module.compute_features)
+    world_module.object_features = timed("features", world_module.object_features)
     # Every range image: the snapshots' and the attention's (ray casting included, and the arrays around it).
     original_capture = RangeCamera.capture
     RangeCamera.capture = timed("range images", original_capture)

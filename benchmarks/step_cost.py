@@ -90,8 +90,8 @@ def _env_id(gym: ModuleType) -> str:
 
 
 def _time_perception(spent: dict[str, float]) -> None:
-    """Count the range images (``RangeCamera.capture``) and the features (``compute_features``, wherever a module
-    of this tree calls it by name) into ``spent["perception"]`` [s]."""
+    """Count the range images (``RangeCamera.capture``) and the features (``compute_features`` and
+    ``object_features``, wherever a module of this tree calls them by name) into ``spent["perception"]`` [s]."""
     from affordance_env import features
     from affordance_env.camera import RangeCamera
 
@@ -105,11 +105,15 @@ def _time_perception(spent: dict[str, float]) -> None:
         return wrapper
 
     RangeCamera.capture = timed(RangeCamera.capture)  # type: ignore[method-assign]
-    original = features.compute_features
-    for module in list(sys.modules.values()):  # the env is built: every module that calls it is loaded
-        if getattr(module, "__name__", "").startswith("affordance_env.") and module is not features \
-                and getattr(module, "compute_features", None) is original:
-            setattr(module, "compute_features", timed(original))  # noqa: B010 (any module of the tree)
+    # compute_features, and object_features where the tree has it (the features of the object's pixels alone)
+    for name in ("compute_features", "object_features"):
+        original = getattr(features, name, None)
+        if original is None:
+            continue
+        for module in list(sys.modules.values()):  # the env is built: every module that calls it is loaded
+            if getattr(module, "__name__", "").startswith("affordance_env.") and module is not features \
+                    and getattr(module, name, None) is original:
+                setattr(module, name, timed(original))  # any module of the tree
 
 
 # --- the driver ---------------------------------------------------------------------------------------------------
