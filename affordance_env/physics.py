@@ -300,23 +300,20 @@ class TapPhysics:
 
     def links_touching_object(self) -> set[str]:
         """Names of the robot links (of the variant's contact links) in contact with the object."""
-        links = set()
-        obj, hand = self.active_geom, self._is_hand_geom
-        for g1, g2 in self.data.contact.geom[: self.data.ncon].tolist():
-            if g1 == obj and hand[g2]:
-                links.add(self.body_names[self.model.geom_bodyid[g2]])
-            elif g2 == obj and hand[g1]:
-                links.add(self.body_names[self.model.geom_bodyid[g1]])
-        return links
+        return self._links_touching(self.active_geom)
 
     def links_touching_table(self) -> set[str]:
         """Names of the robot links (of the variant's contact links) in contact with the table top."""
+        return self._links_touching(self.table_geom)
+
+    def _links_touching(self, geom: int) -> set[str]:
+        """Names of the robot links (of the variant's contact links) in contact with ``geom``."""
         links = set()
-        table, hand = self.table_geom, self._is_hand_geom
+        hand = self._is_hand_geom
         for g1, g2 in self.data.contact.geom[: self.data.ncon].tolist():
-            if g1 == table and hand[g2]:
+            if g1 == geom and hand[g2]:
                 links.add(self.body_names[self.model.geom_bodyid[g2]])
-            elif g2 == table and hand[g1]:
+            elif g2 == geom and hand[g1]:
                 links.add(self.body_names[self.model.geom_bodyid[g1]])
         return links
 
@@ -417,32 +414,25 @@ class TapPhysics:
                 near.append(g)
         return near
 
-    def sweep_clearance(self, path: np.ndarray, max_distance: float) -> float:
-        """Smallest distance [m] between the robot's geoms that touch the world and the object over the joint
-        configurations ``path`` ((k, active joints) [rad]), the object and everything else as they are now:
-        kinematics only, on the scratch data. ``max_distance`` if never nearer."""
-        scratch = self.scratch
-        scratch.qpos[:] = self.data.qpos
-        nearest = max_distance
-        for q in np.atleast_2d(path):
-            scratch.qpos[self.robot_qpos] = q
-            mujoco.mj_kinematics(self.model, scratch)
-            nearest = min(nearest, self.arm_object_distance(nearest, scratch))
-        return nearest
-
-    def sweep_table_clearance(self, path: np.ndarray, max_distance: float) -> float:
-        """Smallest distance [m] between the robot's geoms that touch the world and the table top over the joint
-        configurations ``path`` ((k, active joints) [rad]): kinematics only, on the scratch data. ``max_distance``
-        if never nearer."""
+    def sweep_clearance(self, path: np.ndarray, max_object: float | None, max_table: float | None = None
+                        ) -> tuple[float | None, float | None]:
+        """Smallest distances [m] between the robot's geoms that touch the world and the object, and the table top,
+        over the joint configurations ``path`` ((k, active joints) [rad]), everything else as it is now: kinematics
+        only, on the scratch data, one pass over ``path``. Each is its ``max_`` if never nearer, and None (not
+        measured) where its ``max_`` is None."""
         scratch, model, table = self.scratch, self.model, self.table_geom
         scratch.qpos[:] = self.data.qpos
-        nearest = max_distance
+        nearest, nearest_table = max_object, max_table
         for q in np.atleast_2d(path):
             scratch.qpos[self.robot_qpos] = q
             mujoco.mj_kinematics(model, scratch)
-            for g in self.hand_geoms:
-                nearest = min(nearest, mujoco.mj_geomDistance(model, scratch, g, table, nearest, None))
-        return nearest
+            if nearest is not None:
+                nearest = min(nearest, self.arm_object_distance(nearest, scratch))
+            if nearest_table is not None:
+                for g in self.hand_geoms:
+                    nearest_table = min(nearest_table, mujoco.mj_geomDistance(model, scratch, g, table, nearest_table,
+                                                                              None))
+        return nearest, nearest_table
 
     def hand_touches_object(self) -> bool:
         """Whether any contact joins the hand (or wrist, forearm) and the object."""

@@ -282,9 +282,12 @@ def stroke_reachable(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarr
     if not ik_verdict(stroke_line(motion, plan, start).results)[0]:
         return False
     samples = reach_trajectory(motion, above, start).q[::REACH_SWEEP_STRIDE]
-    if motion.physics.sweep_clearance(samples, REACH_CLEARANCE) < REACH_CLEARANCE:
+    # one kinematic pass over the reach for the object and the table, then the pre-stroke pose for the table
+    physics = motion.physics
+    clearance, table = physics.sweep_clearance(samples, REACH_CLEARANCE, 0.0)
+    if clearance < REACH_CLEARANCE:
         return False
-    return motion.physics.sweep_table_clearance(np.vstack([samples, start.q]), 0.0) >= -REACH_TABLE_PENETRATION
+    return physics.sweep_clearance(start.q, None, table)[1] >= -REACH_TABLE_PENETRATION
 
 
 def run_stroke(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> StrokeOutcome:
