@@ -58,6 +58,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from affordance_env.behaviors.action import check_action
+from affordance_env.behaviors.base import palm_rotation
 from affordance_env.behaviors.stroke import (
     CROSSING_CLEARANCE,
     FOREARM_RAISED,
@@ -232,8 +233,7 @@ def draw_orientation() -> np.ndarray:
     upright (facing +x, fingers level), not beyond 30 cm, short of the far side of the placement region (the IK's
     error 15-100 mm beyond it).
     """
-    fingers, normal = np.array([0.0, -1.0, 0.0]), np.array([1.0, 0.0, 0.0])
-    upright = np.column_stack([fingers, np.cross(normal, fingers), normal])
+    upright = palm_rotation((0.0, -1.0, 0.0), (1.0, 0.0, 0.0))
     turn = matmul(matmul(_rotation_z(-DRAW_HAND_TURN), _rotation_y(DRAW_HAND_TILT)), _rotation_x(DRAW_HAND_ROLL))
     return matmul(turn, upright)
 
