@@ -46,7 +46,6 @@ this run; fractions are in [0, 1], distances in metres, times in seconds.
 
 from __future__ import annotations
 
-import inspect
 import itertools
 import math
 import os
@@ -246,15 +245,9 @@ def _env(camera: tuple[int, int]):
 
 
 def feasible_at(env, state) -> Callable[[str, np.ndarray], bool]:
-    """``feasible(behavior, params)`` of the world in snapshot ``state``, whatever the env ran since: the env's
-    ``feasible(behavior, params, state=state)`` where it takes a state, else the snapshot put back first."""
-    if "state" in inspect.signature(env.feasible).parameters:
-        return lambda behavior, params: bool(env.feasible(behavior, params, state=state))
-
-    def feasible(behavior: str, params: np.ndarray) -> bool:
-        env.set_state(state)
-        return bool(env.feasible(behavior, params))
-    return feasible
+    """``feasible(behavior, params)`` of the world in snapshot ``state``, whatever the env ran since (the env's
+    ``feasible(..., state=state)``, which leaves the env as it is)."""
+    return lambda behavior, params: bool(env.feasible(behavior, params, state=state))
 
 
 def _trimmed(info: Mapping[str, Any]) -> dict[str, Any]:
