@@ -340,8 +340,11 @@ class ActionEffectPrediction:
     predictive distribution (:class:`~affordance_learning.effect_model.ActionEffectModel`).
 
     Attributes:
-        effect: The perceptual effect, final minus initial features (n, 49), each in its feature's unit.
-        displacement: How far the object's centre moves on the table (n, 2) [m], root frame (+x toward the robot).
+        effect: The perceptual effect, final minus initial features (n, 49), each in its feature's unit: the
+            training neighbours' as they were.
+        displacement: How far the object's centre moves on the table (n, 2) [m], root frame (+x toward the robot):
+            the neighbours' moved to this action along the local slopes
+            (:meth:`~affordance_learning.effect_model.ActionEffectModel.predictive_outcomes`).
         rolled: P(the object rolls further than the roll threshold), (n,).
         off_table: P(it leaves the table), (n,).
         lifted: P(a grasp lifts and holds it), (n,) (0 for the other behaviours).

@@ -2,15 +2,19 @@
 dataset.
 
 Each learner gives, for a query [49 features, 3 parameters], a distribution over training outcomes; P(goal) is the
-weighted share of outcomes that reach the goal (roll, lift, move 5 cm in 4 directions, per behaviour). Compared on
-the last quarter of each behaviour's interactions (by episode), trained on the rest:
+weighted share of outcomes that reach the goal (roll, lift, move 5 cm in 4 directions, and, per held-out
+interaction, 2 places 5-15 cm from where the object was, 3 cm tolerance, as ``affordance plan`` draws them).
+Compared on the last quarter of each behaviour's interactions (by episode), trained on the rest:
 
 - ``forest``: :class:`affordance_learning.effect_model.ActionEffectModel` (a random forest as a quantile
-  regression forest);
-- ``extra_trees``: the same with extremely randomised trees;
+  regression forest; each neighbour's displacement moved to the query's action along the local slopes);
+- ``forest_as_were``: the same forest with the neighbours' displacements as they were and the flags weighing as
+  much as a displacement in the splits (``action_inputs=0, flag_weight=1``: the model before the local slopes);
+- ``extra_trees``: the forest with extremely randomised trees;
 - ``knn``: the 15 nearest training interactions in standardised inputs, equally weighted.
 
-Prints log-loss, Brier score, ECE and AUROC per learner (lower, lower, lower, higher are better) and fit time.
+Prints log-loss, Brier score, ECE and AUROC per learner (lower, lower, lower, higher are better) over every goal
+and over the place goals alone, and fit time.
 
     python benchmarks/effect_models.py DATASET   # e.g. OUT/dataset of `affordance plan`
 """
@@ -27,11 +31,13 @@ from sklearn.preprocessing import StandardScaler
 
 from affordance_env import load_dataset
 from affordance_learning.effect_model import ActionEffectModel
-from affordance_learning.goals import Lift, Move, Roll
+from affordance_learning.goals import Lift, Move, Place, Roll
 from affordance_learning.outcomes import model_inputs, outcome_table
 from affordance_learning.plan_experiment import BEHAVIORS, calibration
 
 GOALS = [Roll(), Lift(), *(Move(d, 0.05) for d in ((1, 0), (-1, 0), (0, 1), (0, -1)))]
+#: Place goals per held-out interaction, their distance from where the object was [m] and tolerance [m].
+PLACES, PLACE_DISTANCE, PLACE_TOLERANCE = 2, (0.05, 0.15), 0.03
 
 
 class KnnEffectModel:
@@ -46,8 +52,11 @@ class KnnEffectModel:
 
     def goal_probability(self, X, goal, start_xy=None):
         _, index = self.nn_.kneighbors(self.scaler_.transform(X))
-        reached = goal.reached(self.outcomes_).astype(float)
-        return reached[index].mean(axis=1)
+        if start_xy is None:
+            return goal.reached(self.outcomes_).astype(float)[index].mean(axis=1)
+        start = np.repeat(np.asarray(start_xy, dtype=float), index.shape[1], axis=0)  # one start per query
+        neighbours = self.outcomes_.iloc[index.ravel()].reset_index(drop=True)
+        return goal.reached(neighbours, start).astype(float).reshape(index.shape).mean(axis=1)
 
 
 def main() -> None:
@@ -55,14 +64,21 @@ def main() -> None:
     parser.add_argument("dataset", help="a goal-episode dataset directory")
     args = parser.parse_args()
     frame = load_dataset(args.dataset).sort_values(["episode", "step"])
-    learners = {"forest": lambda: ActionEffectModel(random_state=0), "extra_trees":
-                lambda: ActionEffectModel(trees="extra", random_state=0), "knn": lambda: KnnEffectModel()}
-    scores = {name: {"p": [], "y": [], "fit": 0.0} for name in learners}
+    learners = {"forest": lambda: ActionEffectModel(random_state=0),
+                "forest_as_were": lambda: ActionEffectModel(action_inputs=0, flag_weight=1.0, random_state=0),
+                "extra_trees": lambda: ActionEffectModel(trees="extra", random_state=0), "knn": lambda: KnnEffectModel()}
+    scores = {name: {"p": [], "y": [], "place_p": [], "place_y": [], "fit": 0.0} for name in learners}
+    rng = np.random.default_rng(0)
     for behavior in BEHAVIORS:
         rows = frame[frame["behavior"] == behavior]
         split = int(0.75 * len(rows))
         train, test = rows.iloc[:split], rows.iloc[split:]
         X, Y, Xt, Yt = model_inputs(train), outcome_table(train), model_inputs(test), outcome_table(test)
+        # Places relative to where each object was: Place((0, 0)) seen from minus the target's offset
+        angle = rng.uniform(-np.pi, np.pi, (PLACES, len(Yt)))
+        offsets = rng.uniform(*PLACE_DISTANCE, (PLACES, len(Yt)))[..., None] * np.stack([np.cos(angle),
+                                                                                          np.sin(angle)], -1)
+        place = Place((0.0, 0.0), PLACE_TOLERANCE)
         for name, make in learners.items():
             start = time.perf_counter()
             model = make().fit(X, Y)
@@ -72,13 +88,21 @@ def main() -> None:
                 if 0 < truth.mean() < 1:
                     scores[name]["p"].append(model.goal_probability(Xt, goal))
                     scores[name]["y"].append(truth)
-    print(f"{'learner':<12} {'log-loss':>9} {'Brier':>7} {'ECE':>7} {'AUROC':>7} {'fit [s]':>8}")
+            for offset in offsets:
+                for key in ("", "place_"):
+                    scores[name][f"{key}p"].append(model.goal_probability(Xt, place, -offset))
+                    scores[name][f"{key}y"].append(place.reached(Yt, -offset))
+    print(f"{'learner':<15} {'goals':<6} {'log-loss':>9} {'Brier':>7} {'ECE':>7} {'AUROC':>7} {'fit [s]':>8}")
     for name, s in scores.items():
-        p, y = np.concatenate(s["p"]), np.concatenate(s["y"])
-        clipped = np.clip(p, 1e-3, 1 - 1e-3)
-        print(f"{name:<12} {log_loss(y, clipped):9.3f} {brier_score_loss(y, p):7.3f} "
-              f"{calibration(p, y)['ece']:7.3f} {roc_auc_score(y, p):7.3f} {s['fit']:8.1f}")
-    print(f"({len(p)} held-out (interaction, goal) pairs over {len(BEHAVIORS)} behaviours and {len(GOALS)} goals)")
+        for key, goals in (("", "all"), ("place_", "place")):
+            p, y = np.concatenate(s[f"{key}p"]), np.concatenate(s[f"{key}y"])
+            clipped = np.clip(p, 1e-3, 1 - 1e-3)
+            print(f"{name:<15} {goals:<6} {log_loss(y, clipped):9.3f} {brier_score_loss(y, p):7.3f} "
+                  f"{calibration(p, y)['ece']:7.3f} {roc_auc_score(y, p):7.3f} {s['fit']:8.1f}")
+        if name == "forest":
+            n_all, n_place = len(np.concatenate(s["p"])), len(p)
+    print(f"({n_all} held-out (interaction, goal) pairs over {len(BEHAVIORS)} behaviours, {len(GOALS)} goals and "
+          f"{PLACES} places per interaction, {n_place} of them places)")
 
 
 if __name__ == "__main__":

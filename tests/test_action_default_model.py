@@ -60,7 +60,8 @@ def test_an_action_conditioned_prediction_follows_the_action(user_dir, monkeypat
     back = predict_effect(features, "push", action=[-0.9, 0.0, 0.0])
     assert isinstance(far, ActionEffectPrediction) and far.effect.shape == (N,) and far.displacement.shape == (2,)
     assert far.displacement[0] < -0.05 < 0.05 < back.displacement[0]  # pushed away, or toward the robot
-    assert abs(far.displacement[1]) < 0.01 and far.effect[0] == pytest.approx(far.displacement[0])
+    # the displacement is the neighbours' moved to this action, the perceptual effect theirs as they were
+    assert abs(far.displacement[1]) < 0.01 and far.effect[0] == pytest.approx(far.displacement[0], abs=0.02)
     assert 0.0 <= far.rolled <= 1.0 and far.lifted == 0.0
     tap = predict_effect(np.zeros((3, N)), "tap", action=np.array([[0.9, 0, 0], [0, 0, 0], [-0.9, 0, 0]]))
     assert tap.displacement.shape == (3, 2) and tap.displacement[0, 1] < tap.displacement[1, 1] < tap.displacement[2, 1]
