@@ -190,12 +190,13 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         self.displacement_columns_ = np.array([self.outcome_names_.index(n) for n in DISPLACEMENT_COLUMNS]
                                               if has_displacement else [], dtype=np.intp)
         self.action_params_ = X[:, X.shape[1] - k:].copy() if has_displacement and k > 0 else None
-        # The kind of every training outcome: a code of the flags of KIND_COLUMNS it has (0 where it has none).
-        kinds = np.zeros(len(y2), dtype=np.intp)
+        # The kind of every training outcome, numbered 0, 1, ... over the combinations of the flags of
+        # KIND_COLUMNS that occur (a behaviour that never lifts has half as many kinds to fit slopes for).
+        codes = np.zeros(len(y2), dtype=np.intp)
         for bit, name in enumerate(KIND_COLUMNS):
             if name in self.outcome_names_:
-                kinds |= (y2[:, self.outcome_names_.index(name)] > 0.5).astype(np.intp) << bit
-        self.kinds_ = kinds
+                codes |= (y2[:, self.outcome_names_.index(name)] > 0.5).astype(np.intp) << bit
+        self.kinds_ = np.unique(codes, return_inverse=True)[1].astype(np.intp).ravel()
         leaves = self.forest_.apply(X)  # (n, T): each training row's leaf in every tree
         trees = [self._leaf_onehot(leaves[:, t]) for t in range(leaves.shape[1])]
         # One table of every tree's leaves: leaf r of tree t is row leaf_offset[t] + r of a stacked CSR matrix.
