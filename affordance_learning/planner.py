@@ -10,9 +10,10 @@ then candidate by candidate across the behaviours. Below ``threshold`` it abstai
 the next interaction of a multi-step episode towards a place on the table: by default a search over two
 interactions, where the behaviours' workspaces say a second one can act (re-planned after every interaction).
 
-The planner remembers the actions that failed to reach (:meth:`Planner.note_failure`): an action that failed on
-an object where it is (within ``FAILURE_RADIUS``) is not chosen there again, unchanged; :meth:`forget_failures`
-clears what it remembers (a new episode or object).
+The planner remembers the actions that failed (:meth:`Planner.note_failure`: they failed to reach, or left the
+object where it was): on an object still where one failed (within ``FAILURE_RADIUS``), no action within
+``REFUSAL_RADIUS`` of it is chosen again, since a reach or a grasp fails for a region of the parameters, not for one
+point; :meth:`forget_failures` clears what it remembers (a new episode or object).
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ from scipy.stats import qmc
 
 from affordance_env.scene import table_extent
 from affordance_learning.behaviors import BEHAVIORS
-from affordance_learning.effect_model import ActionEffectModel
+from affordance_learning.effect_model import ActionEffectModel, PredictiveOutcomes
 from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.goals import Goal, Move, Place, check_goal, check_start
 
@@ -39,8 +40,24 @@ LOOKAHEAD_ROOTS, LOOKAHEAD_OUTCOMES, LOOKAHEAD_SECOND = 8, 4, 8
 #: A first action is chosen for its value over two interactions when that value is at least this.
 MIN_SEQUENCE_VALUE = 0.1
 #: Calls to ``feasible`` per decision at most: the candidates asked, from the best down. Each costs 2-70 ms (the
-#: grasp's the most); 8 keep a decision under a second where the most likely candidates are out of reach.
-MAX_CHECKS = 8
+#: grasp's the most); 12 keep a decision under a second where the most likely candidates are out of reach.
+MAX_CHECKS = 12
+#: :meth:`Planner.choose` ranks candidates by P(goal) in steps of this, then by their expected progress towards the
+#: goal: P is a weighted share of a few hundred training outcomes, and differences under a few per cent are its
+#: noise, whereas a place nearer the target is a real difference.
+P_RESOLUTION = 0.05
+#: In one decision, a candidate nearer than this (Euclidean, in the parameters' [-1, 1] units) to one that
+#: ``feasible`` refused is not asked: a reach fails for a region of the parameters (a place beyond the arm's
+#: reach, a stroke that starts beyond it), or for every action of a behaviour where the object lies out of its
+#: arm's reach, so that the checks go to other regions and other behaviours rather than to the refused one's
+#: neighbours.
+REFUSAL_RADIUS = 1.0
+#: :meth:`Planner.choose` refines a goal with a distance (a move, a place): around the action it found, it scores
+#: REFINE_POINTS more within REFINE_RADIUS of it (per parameter, a scrambled Sobol set) and takes the best of them
+#: that ranks above it, asking ``feasible`` about REFINE_CHECKS of them at most. The Sobol candidates lie about
+#: 0.25 apart in the two parameters that aim a stroke or a place: 5 cm of a pick and place's 20 cm range, coarser
+#: than a place's 3 cm tolerance.
+REFINE_POINTS, REFINE_RADIUS, REFINE_CHECKS = 16, 0.15, 2
 #: An action that failed to reach is not chosen again on an object that is still within this distance [m] of
 #: where it failed (:meth:`Planner.note_failure`); an object that moved further is a new situation.
 FAILURE_RADIUS = 0.01
@@ -56,7 +73,15 @@ def in_workspace(behavior: str, xy: np.ndarray) -> np.ndarray:
 
 def _reached_by_any(reachable: Callable[[str, np.ndarray], np.ndarray], names: list[str], xy: np.ndarray
                     ) -> np.ndarray:
-    return np.any([np.asarray(reachable(name, xy), dtype=bool) for name in names], axis=0)
+    """Whether some behaviour of ``names`` reaches each point ``xy`` (n, 2) [m]; each behaviour is asked only
+    about the points no behaviour before it reaches."""
+    out = np.zeros(len(xy), dtype=bool)
+    for name in names:
+        rest = np.flatnonzero(~out)
+        if not rest.size:
+            break
+        out[rest] = np.asarray(reachable(name, xy[rest]), dtype=bool)
+    return out
 
 
 def _check_on_table(name: str, value, xy: np.ndarray) -> None:
@@ -149,18 +174,21 @@ class Planner:
         self.threshold = float(threshold)
         self.max_checks = int(max_checks)
         self.params = candidate_params(n_candidates, random_state)
+        # The offsets of a refinement (REFINE_POINTS within REFINE_RADIUS), drawn once.
+        local = qmc.Sobol(self.params.shape[1], scramble=True, seed=random_state + 1).random_base2(
+            int(np.log2(REFINE_POINTS)))
+        self._offsets = REFINE_RADIUS * (2.0 * local - 1.0)
         #: How many feature values each method's ``features`` must have: the models' inputs but the parameters.
         self.n_features = next(iter(inputs.values())) - self.params.shape[1]
-        # Each model's training outcomes, read once: every decision judges its goal on them.
-        self._frames = {name: model.outcome_frame() for name, model in self.models.items()}
         #: The actions that failed to reach, each (behaviour, params, where the object was (x, y) or None, its
         #: features): :meth:`note_failure`.
         self.failures: list[tuple[str, np.ndarray, np.ndarray | None, np.ndarray]] = []
 
     # --- what failed ---------------------------------------------------------------------------------------------
     def note_failure(self, behavior: str, params, start_xy=None, features=None) -> None:
-        """Remember that ``behavior`` with ``params`` failed to reach the object at ``start_xy`` [m] (or, without
-        a position, seen with ``features``): no later decision on that object there chooses it again."""
+        """Remember that ``behavior`` with ``params`` failed on the object at ``start_xy`` [m] (or, without a
+        position, seen with ``features``): it failed to reach it, or left it where it was. No later decision on that
+        object there chooses it, or an action of ``behavior`` within :data:`REFUSAL_RADIUS` of it, again."""
         where = None if start_xy is None else _check_start(start_xy)
         seen = np.zeros(0) if features is None else np.asarray(features, dtype=np.float64).ravel()
         self.failures.append((str(behavior), np.asarray(params, dtype=np.float64).ravel().copy(), where, seen))
@@ -169,23 +197,27 @@ class Planner:
         """Forget every failure noted (:meth:`note_failure`): for a new object or episode."""
         self.failures.clear()
 
-    def _excluded(self, features: np.ndarray, start: np.ndarray | None) -> set[tuple[str, int]]:
-        """The candidates (behaviour, index) that failed on this object where it is now."""
+    def _excluded(self, features: np.ndarray, start: np.ndarray | None,
+                  candidates: Mapping[str, np.ndarray]) -> set[tuple[str, int]]:
+        """The candidates (behaviour, index in ``candidates[behaviour]``) that failed on this object where it is
+        now."""
         out = set()
         for name, params, where, seen in self.failures:
-            if name not in self.models:
+            if name not in candidates:
                 continue
             if where is not None and start is not None:
                 here = np.linalg.norm(where - start) <= FAILURE_RADIUS
             else:
                 here = seen.shape == features.shape and np.allclose(seen, features, rtol=1e-3, atol=1e-6)
             if here:
-                same = np.flatnonzero(np.all(np.abs(self.params - params) <= 1e-6, axis=1))
-                out.update((name, int(k)) for k in same)
+                near = np.flatnonzero(np.linalg.norm(candidates[name] - params, axis=1) < REFUSAL_RADIUS)
+                out.update((name, int(k)) for k in near)
         return out
 
     # --- scoring -------------------------------------------------------------------------------------------------
-    def _inputs(self, features: np.ndarray) -> np.ndarray:
+    def _inputs(self, features: np.ndarray, params: np.ndarray | None = None) -> np.ndarray:
+        """The models' inputs: ``features`` beside every row of ``params`` (default: the candidates)."""
+        params = self.params if params is None else params
         x = np.asarray(features, dtype=np.float64)
         if x.size != self.n_features or x.ndim > 2:
             named = " (affordance_env.FEATURE_NAMES)" if self.n_features == 49 else ""
@@ -195,44 +227,50 @@ class Planner:
         x = x.ravel()
         if not np.all(np.isfinite(x)):
             raise InvalidValueError("features must be finite (the object must have been seen).")
-        return np.hstack([np.repeat(x[None], len(self.params), axis=0), self.params])
+        return np.hstack([np.repeat(x[None], len(params), axis=0), params])
 
-    def _progress(self, name: str, goal: Goal, start: np.ndarray | None) -> np.ndarray | None:
-        """Per training outcome of ``name``, how far it goes towards ``goal`` (higher is better): along a
-        :class:`Move`'s direction, minus the distance to a :class:`Place`'s target [m]; None for other goals."""
-        frame = self._frames[name]
-        off = frame["off_table"].to_numpy(bool)
+    @staticmethod
+    def _progress(outcomes: PredictiveOutcomes, goal: Goal, start: np.ndarray | None) -> np.ndarray | None:
+        """Per entry of ``outcomes``, how far it goes towards ``goal`` (higher is better): along a :class:`Move`'s
+        direction, minus the distance to a :class:`Place`'s target [m]; None for other goals."""
+        off = outcomes["off_table"].astype(bool)
         if isinstance(goal, Move):
-            along = frame["dx"].to_numpy() * goal.direction[0] + frame["dy"].to_numpy() * goal.direction[1]
+            along = outcomes["dx"] * goal.direction[0] + outcomes["dy"] * goal.direction[1]
             return np.where(off, -OFF_TABLE_DISTANCE, along)
         if isinstance(goal, Place):
-            end = start + frame[["dx", "dy"]].to_numpy()
+            end = start + outcomes.displacement
             return -np.where(off, OFF_TABLE_DISTANCE, np.linalg.norm(end - np.asarray(goal.target_xy), axis=1))
         return None
 
-    def _score(self, features: np.ndarray, goal: Goal, start_xy) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    def _score(self, features: np.ndarray, goal: Goal, start_xy, candidates: Mapping[str, np.ndarray] | None = None
+               ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """Per behaviour, every candidate's P(goal) and expected progress towards it (:meth:`_progress`, 0 where
-        the goal has no distance)."""
+        the goal has no distance), from the models' predictive outcomes (each neighbour's displacement at the
+        candidate's action: :meth:`~affordance_learning.effect_model.ActionEffectModel.predictive_outcomes`).
+        ``candidates``: the actions per behaviour (default: :attr:`params` for every behaviour)."""
         check_goal(goal)
         start = _check_start(start_xy) if isinstance(goal, Place) else None
-        X = self._inputs(features)
+        if candidates is None:
+            candidates = dict.fromkeys(self.models, self.params)
         out = {}
-        for name, model in self.models.items():
-            W = model.predictive_weights(X, as_sparse=True)
-            frame = self._frames[name]
-            p = np.asarray(W @ goal.reached(frame, start).astype(np.float64)).ravel()
-            progress = self._progress(name, goal, start)
-            out[name] = (p, np.zeros(len(p)) if progress is None else np.asarray(W @ progress).ravel())
+        for name, params in candidates.items():
+            outcomes = self.models[name].predictive_outcomes(self._inputs(features, params))
+            p = outcomes.probability(goal, start)
+            progress = self._progress(outcomes, goal, start)
+            out[name] = (p, np.zeros(len(p)) if progress is None else outcomes.share(progress))
         return out
 
     def scores(self, features: np.ndarray, goal: Goal, start_xy=None) -> dict[str, np.ndarray]:
         """P(goal) of every candidate, per behaviour: {behaviour: (n_candidates,)}."""
         return {name: p for name, (p, _) in self._score(features, goal, start_xy).items()}
 
-    def _first_feasible(self, ranked, feasible, excluded: set[tuple[str, int]], asked: dict[tuple[str, int], bool]):
-        """The first entry of ``ranked`` (each ending with behaviour and candidate index) that is not ``excluded``
-        and that ``feasible`` accepts, asking at most ``max_checks`` times per decision over all rankings
-        (``asked`` holds the answers so far); None when none is found within that."""
+    def _first_feasible(self, ranked, feasible, excluded: set[tuple[str, int]], asked: dict[tuple[str, int], bool],
+                        candidates: Mapping[str, np.ndarray]):
+        """The first entry of ``ranked`` (each ending with behaviour and candidate index in ``candidates``) that is
+        not ``excluded`` and that ``feasible`` accepts, asking at most ``max_checks`` times per decision over all
+        rankings (``asked`` holds the answers so far) and not about a candidate within :data:`REFUSAL_RADIUS` of
+        one it refused; None when none is found within that."""
+        refused = [(name, candidates[name][k]) for (name, k), ok in asked.items() if not ok]
         for entry in ranked:
             key = (entry[-2], entry[-1])
             if key in excluded:
@@ -242,32 +280,60 @@ class Planner:
             if key not in asked:
                 if len(asked) >= self.max_checks:
                     return None
-                asked[key] = bool(feasible(key[0], self.params[key[1]]))
+                params = candidates[key[0]][key[1]]
+                if any(name == key[0] and np.linalg.norm(params - other) < REFUSAL_RADIUS for name, other in refused):
+                    continue
+                asked[key] = bool(feasible(key[0], params))
+                if not asked[key]:
+                    refused.append((key[0], params))
             if asked[key]:
                 return entry
         return None
 
+    def _ranked(self, scores: Mapping[str, tuple[np.ndarray, np.ndarray]], goal: Goal) -> list[tuple]:
+        """Every candidate (P, progress, behaviour, index), best first: by P(goal), for a place in steps of
+        P_RESOLUTION (the nearer expected end decides among them), then by progress, then the earlier candidate,
+        behaviour after behaviour."""
+        step = P_RESOLUTION if isinstance(goal, Place) else 0.0
+        ranked = sorted(((float(p), float(g), k, i, name) for i, name in enumerate(scores)
+                         for k, (p, g) in enumerate(zip(*scores[name], strict=True))),
+                        key=lambda e: (-np.floor(e[0] / step + 1e-9) if step else -e[0], -e[1], e[2], e[3]))
+        return [(p, g, name, k) for p, g, k, _, name in ranked]
+
     def choose(self, features: np.ndarray, goal: Goal, start_xy=None,
                feasible: Callable[[str, np.ndarray], bool] | None = None) -> Choice:
         """The most likely feasible action for ``goal`` on the object seen with ``features`` at ``start_xy``, not
-        one that failed there (:meth:`note_failure`). Ties in P(goal) go to the candidate whose outcomes go
-        furthest towards the goal on average, then to the earlier candidate (the canonical action first),
-        behaviour after behaviour; ``feasible`` is asked at most ``max_checks`` times, and where none of those is
-        feasible the choice is None."""
+        one that failed there (:meth:`note_failure`), ranked as :meth:`_ranked` says; ``feasible`` is asked at
+        most ``max_checks`` times, and where none of those is feasible the choice is None. For a goal with a
+        distance (:class:`Move`, :class:`Place`) the actions around the one found are scored too
+        (:data:`REFINE_POINTS` within :data:`REFINE_RADIUS`), and the best of them that ranks above it is taken
+        if feasible (at most :data:`REFINE_CHECKS` asked)."""
         scores = self._score(features, goal, start_xy)
-        names = list(scores)
-        ranked = sorted(((float(p), float(g), k, i, name) for i, name in enumerate(names)
-                         for k, (p, g) in enumerate(zip(*scores[name], strict=True))),
-                        key=lambda e: (-e[0], -e[1], e[2], e[3]))
-        ranked = [(p, g, name, k) for p, g, k, _, name in ranked]
+        candidates = dict.fromkeys(scores, self.params)
         start = None if start_xy is None else _check_start(start_xy)
+        seen = self._inputs(features)[0, : self.n_features]
         asked: dict[tuple[str, int], bool] = {}
-        best = self._first_feasible(ranked, feasible, self._excluded(self._inputs(features)[0, : self.n_features],
-                                                                      start), asked)
+        best = self._first_feasible(self._ranked(scores, goal), feasible, self._excluded(seen, start, candidates),
+                                    asked, candidates)
         if best is None:
             return Choice(None, np.zeros(3), 0.0, True, checked=len(asked))
         p, _, name, k = best
-        return Choice(name, self.params[k].copy(), p, p < self.threshold, checked=len(asked))
+        params, checked = candidates[name][k], len(asked)
+        if isinstance(goal, Move | Place):
+            local = {name: np.clip(params + self._offsets, -1.0, 1.0)}
+            p_local, g_local = self._score(features, goal, start_xy, local)[name]
+            around = {name: (np.append(p_local, p), np.append(g_local, best[1]))}  # the one found last
+            local[name] = np.vstack([local[name], params])
+            excluded, refined = self._excluded(seen, start, local), {}
+            for entry in self._ranked(around, goal):
+                if entry[-1] == len(p_local) or len(refined) >= REFINE_CHECKS:
+                    break  # none better than the one found, or enough asked
+                found = self._first_feasible([entry], feasible, excluded, refined, local)
+                if found is not None:
+                    p, params = found[0], local[name][found[-1]]
+                    break
+            checked += len(refined)
+        return Choice(name, params.copy(), p, p < self.threshold, checked=checked)
 
     def toward(self, features: np.ndarray, start_xy, target_xy, tolerance: float,
                feasible: Callable[[str, np.ndarray], bool] | None = None, steps_left: int | None = None,
@@ -303,30 +369,30 @@ class Planner:
         X = self._inputs(features)
         features = X[0, : self.n_features]
         names = list(self.models)
-        weights, p1, distance, ends = {}, {}, {}, {}
+        predicted, p1, distance, ends = {}, {}, {}, {}
         for name, model in self.models.items():
-            W = model.predictive_weights(X, as_sparse=True)
-            frame = self._frames[name]
-            end, off = start + frame[["dx", "dy"]].to_numpy(), frame["off_table"].to_numpy(bool)
-            within = goal.reached(frame, start).astype(np.float64)
+            outcomes = model.predictive_outcomes(X)  # per entry: a neighbour's outcome at the candidate's action
+            end, off = start + outcomes.displacement, outcomes["off_table"].astype(bool)
+            within = goal.reached(outcomes, start).astype(np.float64)
             dist = np.where(off, OFF_TABLE_DISTANCE, np.linalg.norm(end - target, axis=1))
-            if reachable is not None:
-                stuck = ~_reached_by_any(reachable, names, end) & (within == 0)
-                dist = np.where(stuck, OFF_TABLE_DISTANCE, dist)
-            weights[name], ends[name] = W, (end, off, within)
-            p1[name], distance[name] = np.asarray(W @ within).ravel(), np.asarray(W @ dist).ravel()
+            if reachable is not None:  # an end no behaviour reaches counts as off the table, unless within
+                open_ = np.flatnonzero((within == 0) & ~off)
+                dist[open_[~_reached_by_any(reachable, names, end[open_])]] = OFF_TABLE_DISTANCE
+            predicted[name], ends[name] = outcomes, (end, off, within)
+            p1[name], distance[name] = outcomes.share(within), outcomes.share(dist)
         value = {name: p1[name].copy() for name in names}
         if steps_left is None or steps_left >= 2:
-            self._look_ahead(features, goal, weights, ends, p1, distance, value, reachable)
+            self._look_ahead(features, goal, predicted, ends, p1, distance, value, reachable)
         entries = [(float(value[n][k]), float(p1[n][k]), float(distance[n][k]), n, k)
                    for k in range(len(self.params)) for n in names]
         finish = sorted((e for e in entries if e[1] >= self.threshold), key=lambda e: (-e[1], e[2]))
         sequence = sorted((e for e in entries if e[0] >= MIN_SEQUENCE_VALUE), key=lambda e: (-e[0], e[2]))
         nearest = sorted(entries, key=lambda e: (e[2], -e[0]))
-        excluded = self._excluded(features, start)
+        candidates = dict.fromkeys(names, self.params)
+        excluded = self._excluded(features, start, candidates)
         asked: dict[tuple[str, int], bool] = {}
         for ranked in (finish, sequence, nearest):
-            found = self._first_feasible(ranked, feasible, excluded, asked)
+            found = self._first_feasible(ranked, feasible, excluded, asked, candidates)
             if found is not None:
                 v, p, d, name, k = found
                 return Choice(name, self.params[k].copy(), p, p < self.threshold, d, len(asked), v)
@@ -334,38 +400,45 @@ class Planner:
                 break
         return Choice(None, np.zeros(3), 0.0, True, float("nan"), len(asked), 0.0)
 
-    def _look_ahead(self, features, goal, weights, ends, p1, distance, value, reachable) -> None:
+    def _look_ahead(self, features, goal, predicted, ends, p1, distance, value, reachable) -> None:
         """Add to ``value`` (P(within) of each first action) the chance of a second interaction (see
         :meth:`toward`), over the ``LOOKAHEAD_ROOTS`` first actions nearest on average and most likely, their
         ``LOOKAHEAD_OUTCOMES`` most likely outcomes each, and ``LOOKAHEAD_SECOND`` parameter vectors per
-        behaviour for the second."""
+        behaviour for the second. ``predicted`` and ``ends``: per behaviour, the first actions' predictive outcomes
+        and, per entry, where it ends, whether it left the table and whether it ends within the tolerance."""
         names = list(self.models)
         flat = [(n, k) for n in names for k in range(len(self.params))]
         p_all = np.concatenate([p1[n] for n in names])
         d_all = np.concatenate([distance[n] for n in names])
         roots = list(dict.fromkeys([flat[i] for i in np.argsort(d_all, kind="stable")[:LOOKAHEAD_ROOTS]]
                                    + [flat[i] for i in np.argsort(-p_all, kind="stable")[:LOOKAHEAD_ROOTS // 2]]))
-        # The distinct outcomes (behaviour, training row) the roots lead to, and each root's share of them.
-        states: dict[tuple[str, int], int] = {}
+        # The outcomes (root, training row) the roots lead to: where each ends and the training row of its effect.
+        states: dict[tuple[str, int, int], int] = {}
+        where: list[np.ndarray] = []
         # Per root: the mass of its outcomes that leave something to do (neither within nor off the table), and
         # the most likely of them with their weights: a sample of where the second interaction starts.
         links: list[tuple[str, int, float, list[tuple[int, float]]]] = []
         for name, k in roots:
-            row = weights[name].getrow(k)
-            row.sum_duplicates()  # a training outcome once, with its whole weight
+            weights = predicted[name].weights
+            entries = np.arange(weights.indptr[k], weights.indptr[k + 1])  # each training outcome once
             end, off, within = ends[name]
-            open_ = ~within[row.indices].astype(bool) & ~off[row.indices]
-            if not open_.any():
+            open_ = entries[~within[entries].astype(bool) & ~off[entries]]
+            if not open_.size:
                 continue
-            indices, data = row.indices[open_], row.data[open_]
-            top = np.argsort(-data, kind="stable")[:LOOKAHEAD_OUTCOMES]
-            followed = [(states.setdefault((name, int(j)), len(states)), float(w))
-                        for j, w in zip(indices[top], data[top], strict=True)]
+            data = weights.data[open_]
+            top = open_[np.argsort(-data, kind="stable")[:LOOKAHEAD_OUTCOMES]]
+            followed = []
+            for e in top:
+                key = (name, k, int(weights.indices[e]))
+                if key not in states:
+                    states[key] = len(states)
+                    where.append(end[e])
+                followed.append((states[key], float(weights.data[e])))
             links.append((name, k, float(data.sum()), followed))
         if not states:
             return
         keys = list(states)
-        for name in {n for n, _ in keys}:
+        for name in {n for n, _, _ in keys}:
             if len(self.models[name].effect_columns_) not in (0, len(features)):
                 raise InvalidValueError(
                     f"the model of {name!r} has {len(self.models[name].effect_columns_)} effect columns "
@@ -376,23 +449,19 @@ class Planner:
             columns = self.models[name].effect_columns_
             return self.models[name].outcomes_[j, columns] if len(columns) else 0.0
 
-        xy = np.array([ends[n][0][j] for n, j in keys])
-        seen = np.array([features + effect(n, j) for n, j in keys])
+        xy = np.array(where)
+        seen = np.array([features + effect(n, j) for n, _, j in keys])
         second = self.params[: LOOKAHEAD_SECOND]
         best = np.zeros(len(keys))
+        target = np.asarray(goal.target_xy)
         for name, model in self.models.items():
             X2 = np.hstack([np.repeat(seen, len(second), axis=0), np.tile(second, (len(keys), 1))])
-            W2 = model.predictive_weights(X2, as_sparse=True)
-            frame = self._frames[name]  # displacements; each state adds its own start below
-            end2, off2 = frame[["dx", "dy"]].to_numpy(), frame["off_table"].to_numpy(bool)
-            hits = (np.linalg.norm(xy[:, None, :] + end2[None] - np.asarray(goal.target_xy), axis=2)
-                    <= goal.tolerance) & ~off2[None]
-            query = np.repeat(np.arange(W2.shape[0]), np.diff(W2.indptr))
-            p2 = np.bincount(query, weights=W2.data * hits[query // len(second), W2.indices], minlength=W2.shape[0])
-            p2 = p2.reshape(len(keys), len(second)).max(axis=1)
+            outcomes = model.predictive_outcomes(X2)  # each state adds its own start below
+            ends2 = xy[outcomes.query // len(second)] + outcomes.displacement
+            hits = (np.linalg.norm(ends2 - target, axis=1) <= goal.tolerance) & ~outcomes["off_table"].astype(bool)
+            p2 = outcomes.share(hits).reshape(len(keys), len(second)).max(axis=1)
             if reachable is not None:
                 p2 = p2 * np.asarray(reachable(name, xy), dtype=bool)
             best = np.maximum(best, p2)
         for name, k, mass, followed in links:  # the followed outcomes stand for all that leave something to do
             value[name][k] += mass * sum(w * best[state] for state, w in followed) / sum(w for _, w in followed)
-
