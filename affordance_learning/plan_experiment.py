@@ -63,7 +63,7 @@ from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
 from affordance_learning.effect_model import ActionEffectModel
 from affordance_learning.goals import Goal, Lift, Move, Place, Roll
 from affordance_learning.outcomes import model_inputs, outcome_table
-from affordance_learning.planner import Planner
+from affordance_learning.planner import FAILURE_RADIUS, Planner
 
 BEHAVIORS = BEHAVIOR_NAMES
 GOAL_KINDS = ("roll", "lift", "move", "place")
@@ -310,10 +310,9 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
     outcomes = Outcomes(env, state)
     oracle_set = oracle_params()
     tried = [(b, k, outcomes.run(b, params)) for b in BEHAVIORS for k, params in enumerate(oracle_set)]
-    # Every oracle action's P(goal) is read from its predictive weights, computed once for the object.
+    # Every oracle action's P(goal) is read from its predictive outcomes, computed once for the object.
     X = np.hstack([np.repeat(features[None], len(oracle_set), axis=0), oracle_set])
-    weights = {b: planner.models[b].predictive_weights(X, as_sparse=True) for b in BEHAVIORS}
-    frames = {b: planner.models[b].outcome_frame() for b in BEHAVIORS}
+    predicted = {b: planner.models[b].predictive_outcomes(X) for b in BEHAVIORS}
     canonical_pick = Planner(planner.models, n_candidates=1, threshold=planner.threshold)
     left_out = shape_planners.get(item["shape"])
     for p in (planner, left_out):
@@ -330,6 +329,7 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
         if done is not None and isinstance(goal, Place):
             end = np.asarray(done["object"]["final_pose"][:2])
             record["placement_error"] = float(np.linalg.norm(end - np.asarray(goal.target_xy)))
+            record["placement_committed"] = not choice.abstained
         if left_out is not None:
             record["planner_left_out"] = _decide(left_out, features, goal, start, feasible, outcomes)[1]
         hits = {(b, k): reached(goal, info) for b, k, info in tried}
@@ -341,8 +341,7 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
         if som is not None:
             record["som_categories"] = record["canonical"][som.choose(features, goal, start)[0]]
         record["oracle"] = any(hits.values())
-        p = np.concatenate([np.asarray(weights[b] @ goal.reached(frames[b], start).astype(np.float64)).ravel()
-                            for b in BEHAVIORS])
+        p = np.concatenate([predicted[b].probability(goal, start) for b in BEHAVIORS])
         record["pooled"] = (p, np.array([hits[(b, k)] for b in BEHAVIORS for k in range(len(oracle_set))]))
         records.append(record)
     return records
@@ -428,8 +427,10 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
         steps += 1
         if reach_failure(info):
             failures.append(info["failure"])
-            if policy == "planner":
-                planner.note_failure(behavior, params, start)
+        # An action that failed to reach, or left the object where it was, would do so again from there: noted
+        moved = float(np.linalg.norm(np.asarray(obs["achieved_goal"]) - np.asarray(start)))
+        if policy == "planner" and (reach_failure(info) or (not terminated and moved < FAILURE_RADIUS)):
+            planner.note_failure(behavior, params, start)
         distance = float(info["distance"])
         if frames is not None:
             frames.append((f"{behavior}: {100 * distance:.1f} cm to go", env.render()))
@@ -761,6 +762,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
                                                                       if inside else None)}
     acted = [r for r in records if r["planner_behavior"]]
     placement = [r["placement_error"] for r in records if "placement_error" in r]
+    committed = [r["placement_error"] for r in records if r.get("placement_committed")]
     oracle = single["oracle"]["success"] or 0.0
     choose_s = [r["decision_s"] for r in records]
     toward_s = [s for e in planner_episodes for s in e["decision_s"]]
@@ -785,6 +787,9 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         "multi_step": multi,
         "placement_error_median_m": float(np.median(placement)) if placement else None,
         "placement_error_n": len(placement),  # the place goals the planner acted on: the median's n
+        # the same over the place goals it acted on without abstaining (P(goal) >= its threshold)
+        "placement_error_committed_median_m": float(np.median(committed)) if committed else None,
+        "placement_error_committed_n": len(committed),
         "calibration": calibrations(records),
         "decision_seconds": {**seconds_summary(choose_s + toward_s), "choose": seconds_summary(choose_s),
                              "toward": seconds_summary(toward_s)},

@@ -261,8 +261,13 @@ def _why(name: str, results: PlanResults) -> str:
         return f"the gap to the oracle is largest for {worst}"
     if name.startswith("median placement"):
         place = _reached(single.get("place", {}), "oracle")
-        return (f"place goals are reached in {_share(place)} of cases even by the oracle: most "
-                "targets 5-15 cm away are beyond what one interaction does to the object")
+        median, n = results.placement_error_committed
+        committed = ("" if median is None else
+                     f"; on the {n} place goals it did not abstain from (P >= its threshold) the median error is "
+                     f"{100 * median:.1f} cm")
+        return (f"place goals are reached in {_share(place)} of cases even by the oracle: most targets 5-15 cm "
+                "away are beyond what one interaction does to the object (a grasp holds only objects under about "
+                "7 cm), and the planner acts on every place goal, also where it predicts it will miss" + committed)
     if name.startswith("decision time"):
         return ("a decision scores every candidate of every behaviour and asks the kinematics (``feasible``, "
                 "2-70 ms a call) about the best ones; the slowest are those whose best candidates are out of reach")

@@ -199,6 +199,9 @@ class PlanResults:
             without any.
         placement_error_n: How many place goals the planner acted on (counted from the goals in results written
             before it was recorded).
+        placement_error_committed: The median placement error [m] and n of the place goals the planner acted on
+            without abstaining (P(goal) at least its threshold); (None, 0) without any, or in results written
+            before it was recorded.
         calibration: The calibration of the planner's predicted probabilities.
         decision_seconds: The planner's decision times, single-step and multi-step together (n 0 in results
             written before they were recorded).
@@ -223,6 +226,7 @@ class PlanResults:
     decision_seconds: DecisionTimes = DecisionTimes(None, None, 0)
     workers: int | None = None
     oracle: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
+    placement_error_committed: tuple[float | None, int] = (None, 0)
 
     @classmethod
     def from_dict(cls, results: PlanResults | Mapping[str, Any]) -> PlanResults:
@@ -260,6 +264,9 @@ class PlanResults:
             calibration=_calibration(top["calibration"], ("calibration",)),
             decision_seconds=_decisions(top.get("decision_seconds"), ("decision_seconds",)),
             workers=None if top.get("workers") is None else _count(top["workers"], ("workers",)),
+            placement_error_committed=(
+                _number(top.get("placement_error_committed_median_m"), ("placement_error_committed_median_m",), True),
+                _count(top.get("placement_error_committed_n", 0), ("placement_error_committed_n",))),
             oracle=MappingProxyType(dict(_mapping(top.get("oracle", {}), ("oracle",)))),
         )
 
