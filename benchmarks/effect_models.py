@@ -66,7 +66,8 @@ def main() -> None:
     frame = load_dataset(args.dataset).sort_values(["episode", "step"])
     learners = {"forest": lambda: ActionEffectModel(random_state=0),
                 "forest_as_were": lambda: ActionEffectModel(action_inputs=0, flag_weight=1.0, random_state=0),
-                "extra_trees": lambda: ActionEffectModel(trees="extra", random_state=0), "knn": lambda: KnnEffectModel()}
+                "extra_trees": lambda: ActionEffectModel(trees="extra", random_state=0),
+                "knn": lambda: KnnEffectModel()}
     scores = {name: {"p": [], "y": [], "place_p": [], "place_y": [], "fit": 0.0} for name in learners}
     rng = np.random.default_rng(0)
     for behavior in BEHAVIORS:

@@ -235,8 +235,8 @@ def test_predictive_outcomes_move_each_neighbour_to_the_query_action():
         else:  # as they were, the neighbours' actions blur the place by centimetres
             assert np.median(error[lifted]) > 0.01
     place = [Place(tuple(0.2 * x[2:4]), 0.01) for x in Xq[small]]
-    p_moved = [moved.goal_probability(x[None], goal, (0.0, 0.0))[0] for x, goal in zip(Xq[small], place)]
-    p_as_were = [as_were.goal_probability(x[None], goal, (0.0, 0.0))[0] for x, goal in zip(Xq[small], place)]
+    p_moved, p_as_were = ([model.goal_probability(x[None], goal, (0.0, 0.0))[0]
+                           for x, goal in zip(Xq[small], place, strict=True)] for model in (moved, as_were))
     assert np.mean(p_moved) > 0.8 > 0.5 > np.mean(p_as_were)
     np.testing.assert_allclose(moved.predict(Xq)[:, 0], moved.predictive_outcomes(Xq).share(
         moved.predictive_outcomes(Xq)["dx"]))
