@@ -386,3 +386,37 @@ def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     report = write_plan_report(results, tmp_path).read_text()
     assert all(name in report for name in TARGETS)
     assert (tmp_path / "success.png").stat().st_size > 1000 and (tmp_path / "reliability.png").exists()
+
+
+@pytest.mark.slow
+def test_a_multi_step_action_that_left_the_object_where_it_was_is_noted_as_failed():
+    """A 10 cm box, which the hand cannot hold, grasped again and again: every grasp leaves it where it was, and
+    the episode notes each as failed, so that a planner does not choose it again from there."""
+    from affordance_learning import plan_experiment
+    from affordance_learning.planner import Choice
+
+    class Grasping:  # a planner that grasps whatever the situation, recording what it is told
+        def __init__(self) -> None:
+            self.noted: list[tuple[str, np.ndarray, np.ndarray]] = []
+
+        def forget_failures(self) -> None:
+            self.noted.clear()
+
+        def toward(self, features, start_xy, target_xy, tolerance, **kwargs) -> Choice:
+            return Choice("grasp", np.zeros(3), 0.5, False)
+
+        def note_failure(self, behavior, params, start_xy=None, features=None) -> None:
+            self.noted.append((behavior, np.asarray(params), np.asarray(start_xy)))
+
+    env = plan_experiment._env((40, 30))
+    reset = env.reset
+    env.reset = lambda seed=None, options=None: reset(seed=seed, options={
+        **(options or {}), "object_type": "box", "size": 0.1, "position": (-0.3, 0.1)})
+    planner = Grasping()
+    try:
+        episode = plan_experiment.evaluate_episode({"seed": 5, "rng": 5, "index": 1}, planner, "planner", (40, 30))
+    finally:
+        env.reset = reset
+    assert not episode["success"] and episode["steps"] >= 2
+    assert len(planner.noted) == episode["steps"]  # every grasp left the box where it was
+    assert all(behavior == "grasp" for behavior, _, _ in planner.noted)
