@@ -58,8 +58,9 @@ REFUSAL_RADIUS = 1.0
 #: 0.25 apart in the two parameters that aim a stroke or a place: 5 cm of a pick and place's 20 cm range, coarser
 #: than a place's 3 cm tolerance.
 REFINE_POINTS, REFINE_RADIUS, REFINE_CHECKS = 16, 0.15, 2
-#: An action that failed to reach is not chosen again on an object that is still within this distance [m] of
-#: where it failed (:meth:`Planner.note_failure`); an object that moved further is a new situation.
+#: An action that failed (to reach, or to move the object) is not chosen again, nor one within REFUSAL_RADIUS of
+#: it, on an object that is still within this distance [m] of where it failed (:meth:`Planner.note_failure`); an
+#: object that moved further is a new situation.
 FAILURE_RADIUS = 0.01
 
 
