@@ -450,6 +450,9 @@ def _load_action(path: str, size: int, mtime_ns: int, behavior: str):
     if changed:
         raise DefaultModelError(_action_problem(path, "was stored under other library versions: "
                                                 + "; ".join(changed)))
+    if not hasattr(model, "kinds_"):  # fitted before the model moved its neighbours to the query's action
+        raise DefaultModelError(_action_problem(path, "was fitted by an earlier ActionEffectModel, without the "
+                                                      "local slopes of its displacements"))
     return model
 
 

@@ -102,6 +102,12 @@ class PredictiveOutcomes:
             raise KeyError(name) from None
         return self._model.outcomes_[self.weights.indices, column]
 
+    def values(self) -> np.ndarray:
+        """(nnz, n_outcomes) every entry's whole outcome row, its displacement at the query's action."""
+        rows = self._model.outcomes_[self.weights.indices]
+        rows[:, self._model.displacement_columns_] = self.displacement
+        return rows
+
     def share(self, values: np.ndarray) -> np.ndarray:
         """(m,) each query's weighted mean of ``values`` given for every entry (a weighted share for booleans)."""
         return ActionEffectModel.weighted_share(self.weights, np.asarray(values, dtype=np.float64))
@@ -261,18 +267,17 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         :data:`MIN_SLOPE_NEIGHBOURS` effective neighbours keeps its displacements. Without ``action_params_``
         (``action_inputs`` 0, or outcomes without ``dx`` and ``dy``) the displacements stay as they were."""
         weights = _summed(self.predictive_weights(X, as_sparse=True))  # the slopes' sums see each outcome once
-        columns = getattr(self, "displacement_columns_", np.zeros(0, dtype=np.intp))
         rows = weights.indices
-        displacement = self.outcomes_[rows[:, None], columns[None, :]]
-        if getattr(self, "action_params_", None) is None:
-            return PredictiveOutcomes(self, weights, displacement)
+        outcomes = PredictiveOutcomes(self, weights, self.outcomes_[rows[:, None], self.displacement_columns_])
+        if self.action_params_ is None:
+            return outcomes
         X = validate_data(self, X, reset=False, dtype=np.float64)
         actions = X[:, X.shape[1] - self.action_params_.shape[1]:]
         slopes = self._slopes(weights, actions)  # (m, kinds, k, 2)
-        query = np.repeat(np.arange(weights.shape[0]), np.diff(weights.indptr))
+        query = outcomes.query
         offset = actions[query] - self.action_params_[rows]  # (nnz, k): the query's action minus the neighbour's
-        displacement += np.einsum("ek,ekj->ej", offset, slopes[query, self.kinds_[rows]])
-        return PredictiveOutcomes(self, weights, displacement)
+        outcomes.displacement += np.einsum("ek,ekj->ej", offset, slopes[query, self.kinds_[rows]])
+        return outcomes
 
     def _slopes(self, weights: sparse.csr_matrix, actions: np.ndarray) -> np.ndarray:
         """(m, kinds, k, 2) the slope of ``dx`` and ``dy`` on the k action parameters among each query's neighbours
@@ -289,8 +294,7 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         sums = np.asarray(weights @ blocks.reshape(n, -1)).reshape(len(actions), kinds, width)
         squares = weights.copy()
         squares.data = squares.data ** 2
-        onehot = np.zeros((n, kinds))
-        onehot[np.arange(n), self.kinds_] = 1.0
+        onehot = blocks[:, :, 0]  # the term 1 in its kind's block
         kish = sums[:, :, 0] ** 2 / np.maximum(np.asarray(squares @ onehot), 1e-300)  # effective neighbours
         fitted = (sums[:, :, 0] > 0) & (kish >= MIN_SLOPE_NEIGHBOURS)
         total = np.where(fitted, sums[:, :, 0], 1.0)[:, :, None]
@@ -307,8 +311,7 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         """The mean outcome under the predictive distribution (:meth:`predictive_outcomes`), (m, n_outcomes) (or
         (m,) for a 1-d ``y``)."""
         outcomes = self.predictive_outcomes(X)
-        values = self.outcomes_[outcomes.weights.indices]
-        values[:, self.displacement_columns_] = outcomes.displacement
+        values = outcomes.values()
         mean = np.column_stack([outcomes.share(values[:, j]) for j in range(values.shape[1])])
         return mean[:, 0] if self._single_output else mean
 
@@ -335,9 +338,7 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         (:meth:`predictive_outcomes`: training outcomes, their displacement at the query's action)."""
         rng = np.random.default_rng(random_state)
         outcomes = self.predictive_outcomes(X)
-        weights = outcomes.weights
-        values = self.outcomes_[weights.indices]
-        values[:, self.displacement_columns_] = outcomes.displacement
+        weights, values = outcomes.weights, outcomes.values()
         picks = []
         for i in range(weights.shape[0]):
             entries = slice(weights.indptr[i], weights.indptr[i + 1])

@@ -454,13 +454,10 @@ class Planner:
         seen = np.array([features + effect(n, j) for n, _, j in keys])
         second = self.params[: LOOKAHEAD_SECOND]
         best = np.zeros(len(keys))
-        target = np.asarray(goal.target_xy)
+        starts = np.repeat(xy, len(second), axis=0)  # each query's start: its state's
         for name, model in self.models.items():
             X2 = np.hstack([np.repeat(seen, len(second), axis=0), np.tile(second, (len(keys), 1))])
-            outcomes = model.predictive_outcomes(X2)  # each state adds its own start below
-            ends2 = xy[outcomes.query // len(second)] + outcomes.displacement
-            hits = (np.linalg.norm(ends2 - target, axis=1) <= goal.tolerance) & ~outcomes["off_table"].astype(bool)
-            p2 = outcomes.share(hits).reshape(len(keys), len(second)).max(axis=1)
+            p2 = model.predictive_outcomes(X2).probability(goal, starts).reshape(len(keys), len(second)).max(axis=1)
             if reachable is not None:
                 p2 = p2 * np.asarray(reachable(name, xy), dtype=bool)
             best = np.maximum(best, p2)

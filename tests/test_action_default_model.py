@@ -88,6 +88,11 @@ def test_bad_actions_missing_and_foreign_models_are_refused_with_the_rebuild_com
     joblib.dump({**bundle, "versions": {**bundle["versions"], "scikit-learn": "0.1"}}, wrong)
     with pytest.raises(DefaultModelError, match="other library versions"):
         predict_effect(np.zeros(N), "tap", action=np.zeros(3), path=wrong)
+    earlier = bundle["model"]
+    del earlier.kinds_  # as a model fitted before the local slopes has none
+    joblib.dump(bundle, wrong)
+    with pytest.raises(DefaultModelError, match="earlier ActionEffectModel"):
+        predict_effect(np.zeros(N), "tap", action=np.zeros(3), path=wrong)
 
 
 def test_the_shipped_models_predict_each_behaviours_way(monkeypatch, tmp_path):
