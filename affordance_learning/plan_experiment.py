@@ -49,6 +49,8 @@ from __future__ import annotations
 import itertools
 import math
 import os
+import pickle
+import tempfile
 import threading
 import time
 from collections.abc import Callable, Mapping, Sequence
@@ -347,6 +349,16 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
     return records
 
 
+def _evaluate(task: tuple[str | None, Mapping[str, Any]], planner: Planner, shape_planners: Mapping[str, Planner],
+              som: SomBaseline | None, camera: tuple[int, int]):
+    """One task of the evaluation: ``(None, item)`` an object of the single step (:func:`evaluate_object`),
+    ``(policy, item)`` a multi-step episode of that policy (:func:`evaluate_episode`)."""
+    policy, item = task
+    if policy is None:
+        return evaluate_object(item, planner, shape_planners, som, camera)
+    return evaluate_episode(item, planner, policy, camera)
+
+
 def _direction_heuristic(start: np.ndarray, target: np.ndarray) -> str:
     """The behaviour that moves an object the way the target lies: push away (-x), draw toward the robot (+x)
     where the env has it, tap to -y, tap back to +y."""
@@ -573,22 +585,28 @@ def _items(seed: int, part: int, n: int) -> list[dict]:
 
 
 def _parallel(function, items: list, workers: int, **kwargs) -> list:
+    """``[function(item, **kwargs) for item in items]`` on ``workers`` processes. The items go one at a time to
+    the first process free, so that none is left idle while another works through its costlier objects (a grasp's
+    oracle costs 4-20 times a stroke's); ``kwargs`` (the planners: tens of MB) are written once to a temporary
+    file and read once per process, and the processes (with the env each has built) serve every call. Each call
+    depends on its item and ``kwargs`` alone, so the results are the same for any number of processes."""
+    if workers == 1 or len(items) <= 1:
+        return [function(item, **kwargs) for item in items]
     from joblib import Parallel, delayed
 
-    chunks = [items[i::workers] for i in range(workers)]
-    if workers == 1:
-        results = [[function(item, **kwargs) for item in chunks[0]]]
-    else:
-        results = Parallel(n_jobs=workers)(delayed(_chunk)(function, chunk, kwargs) for chunk in chunks)
-    merged = [None] * len(items)
-    for w, chunk_results in enumerate(results):
-        for j, r in enumerate(chunk_results):
-            merged[w + j * workers] = r
-    return merged
+    with tempfile.TemporaryDirectory(prefix="affordance-plan-") as tmp:
+        task = Path(tmp) / "task.pickle"
+        task.write_bytes(pickle.dumps((function, kwargs), protocol=pickle.HIGHEST_PROTOCOL))
+        return Parallel(n_jobs=workers, batch_size=1)(delayed(_call)(str(task), item) for item in items)
 
 
-def _chunk(function, chunk: list, kwargs: dict) -> list:
-    return [function(item, **kwargs) for item in chunk]
+def _call(task: str, item):
+    """One item of :func:`_parallel` in a worker process: ``task``'s function and keyword arguments, read from its
+    file the first time this process meets it."""
+    if getattr(_worker, "task_file", None) != task:
+        _worker.task, _worker.task_file = pickle.loads(Path(task).read_bytes()), task
+    function, kwargs = _worker.task
+    return function(item, **kwargs)
 
 
 #: Top-up interactions are collected this many times what is missing (some fail, and are not rows) ...
@@ -698,14 +716,20 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
 
     t = time.perf_counter()
     items = _items(seed, 0, settings.objects)
-    objects = _parallel(evaluate_object, items, workers, planner=planner, shape_planners=shape_planners, som=som,
-                        camera=camera)
+    multi_items = _items(seed, 9, settings.multi_episodes)
+    # Steps 3 and 5 in one queue: the objects first (20-60 s each, most of it the grasp's oracle), then the
+    # multi-step episodes (about a second each), so that no process waits while the other finishes its last object.
+    done = _parallel(_evaluate, [(None, item) for item in items]
+                     + [(policy, item) for policy in MULTI_POLICIES for item in multi_items],
+                     workers, planner=planner, shape_planners=shape_planners, som=som, camera=camera)
+    objects, multi_done = done[: len(items)], done[len(items):]
+    timings["evaluate"] = time.perf_counter() - t
     records = [r for rs in objects if rs is not None for r in rs]
     fixed_choice = best_fixed(records)
-    timings["single_step"] = time.perf_counter() - t
     single = summarize(records, POLICIES)
     n_objects = sum(rs is not None for rs in objects)
-    say(f"[3/5] single step: {len(records)} goals on {n_objects} held-out objects ({timings['single_step']:.0f} s): "
+    say(f"[3/5] single step: {len(records)} goals on {n_objects} held-out objects (with step 5: "
+        f"{timings['evaluate']:.0f} s): "
         + ", ".join(f"{p} {share_text(single[p]['success'], single[p]['n'], single[p]['success_ci'])}"
                     for p in POLICIES)
         + f"; {single['oracle']['n_feasible']} goals feasible")
@@ -718,12 +742,9 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         + ", ".join(f"{s} " + share_text(loso[s]["planner"]["success_feasible"], loso[s]["planner"]["n_feasible"],
                                          loso[s]["planner"]["success_feasible_ci"], "feasible") for s in SHAPES))
 
-    t = time.perf_counter()
-    multi_items = _items(seed, 9, settings.multi_episodes)
     multi: dict[str, Any] = {}
-    for policy in MULTI_POLICIES:
-        episodes = _parallel(evaluate_episode, multi_items, workers, planner=planner, policy=policy,
-                             camera=camera)
+    for i, policy in enumerate(MULTI_POLICIES):
+        episodes = multi_done[i * len(multi_items): (i + 1) * len(multi_items)]
         if policy == "planner":
             planner_episodes = episodes
         n = len(episodes)
@@ -737,8 +758,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
                          "median_final_distance_m": float(np.median([e["final_distance"] for e in episodes])),
                          "success_toward_robot": kt / len(toward) if toward else None,
                          "success_toward_robot_ci": wilson(kt, len(toward)), "n_toward_robot": len(toward)}
-    timings["multi_step"] = time.perf_counter() - t
-    say(f"[5/5] multi-step on {settings.multi_episodes} episodes ({timings['multi_step']:.0f} s): "
+    say(f"[5/5] multi-step on {settings.multi_episodes} episodes (with step 3): "
         + ", ".join(f"{p} {share_text(multi[p]['success'], multi[p]['n'], multi[p]['success_ci'])}"
                     for p in MULTI_POLICIES)
         + "; toward the robot: planner " + share_text(multi["planner"]["success_toward_robot"],

@@ -357,6 +357,26 @@ def test_goals_are_judged_on_what_the_simulator_measured():
     assert draw_goal("move", np.zeros(2), rng).min_distance == 0.05
 
 
+def _sleep_then_pid(seconds: float, scale: float = 1.0) -> tuple[float, int]:
+    import os
+    import time
+
+    time.sleep(seconds * scale)
+    return seconds, os.getpid()
+
+
+@pytest.mark.slow
+def test_the_evaluation_hands_each_item_to_the_first_free_process_and_keeps_the_order():
+    from affordance_learning.plan_experiment import _parallel
+
+    items = [1.5] + [0.01] * 9  # the first item is slow: the other process does the rest meanwhile
+    results = _parallel(_sleep_then_pid, items, 2, scale=1.0)
+    assert [r[0] for r in results] == items  # in the items' order
+    slow = results[0][1]
+    assert [pid for _, pid in results[1:]].count(slow) <= 1  # not every other item, as fixed halves would give
+    assert _parallel(_sleep_then_pid, items[1:3], 1, scale=0.0)[0][0] == 0.01
+
+
 @pytest.mark.slow
 def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     from affordance_learning.plan_experiment import PlanSettings, run_plan
