@@ -29,6 +29,15 @@ from affordance_env.robot_model import (
 
 #: At most this many distinct joint ranges (and dampings) are kept by a :class:`Kinematics` between IK calls.
 MAX_CACHED_RANGES = 32
+#: :meth:`Kinematics.solve_ik` with ``give_up_beyond`` gives up on a target once its error has stood still beyond
+#: what the caller accepts: over the last STALL_WINDOW + 1 iterations the error (the larger of the position and the
+#: orientation error, each over the solver's tolerance) varied by less than STALL_SPREAD of itself, and the position
+#: or the orientation error is more than STALL_MARGIN times the caller's. A target beyond the arm's reach ends so
+#: (the arm stretched towards it, or a joint at its limit) and used the whole budget of 150 iterations: in a
+#: goal-episode collection, 36 % of the time, in the checks of candidate actions. Of the 6894 calls of 50 goal
+#: episodes, none whose whole budget ends within the caller's tolerances (5 mm, 0.35 rad) gives up so; at a window
+#: of 10 one did (its error stood still at 7 mm, then fell); those that give up save 29 % of all iterations.
+STALL_WINDOW, STALL_SPREAD, STALL_MARGIN = 20, 3e-3, 1.05
 
 
 @dataclass(frozen=True)
@@ -202,6 +211,7 @@ class Kinematics:
         max_iterations: int = 150,
         damping: float = 1e-4,
         joint_ranges: Mapping[str, tuple[float, float]] | None = None,
+        give_up_beyond: tuple[float, float] | None = None,
     ) -> IKResult:
         """Damped least-squares IK of the palm over the variant's reach joints (torso and arm).
 
@@ -220,6 +230,9 @@ class Kinematics:
             damping: Levenberg-Marquardt damping of the least-squares step.
             joint_ranges: Narrower ranges for some joints, ``{name: (low, high)}`` [rad] (see :meth:`joint_limits`):
                 a posture the solution must keep, e.g. a wrist angle that holds the forearm off the table.
+            give_up_beyond: The position [m] and orientation [rad] errors the caller accepts, if it needs only to
+                know whether they are met (a feasibility check), not the closest configuration: the solver gives up
+                once its error stands still beyond them (:data:`STALL_WINDOW`) rather than spend the whole budget.
         """
         p_target = np.asarray(p_world_target, dtype=float)
         if p_target.shape != (3,) or not np.logical_and.reduce(np.isfinite(p_target)):
@@ -244,6 +257,12 @@ class Kinematics:
         error_position, error_rotation = error[:3], error[3:]  # views, made once
         pos_err = rot_err = np.inf
         iteration = 0
+        errors = []  # each iteration's error over its tolerance (the stall test; none with a zero tolerance)
+        stall_test = give_up_beyond is not None and position_tolerance > 0 and orientation_tolerance > 0
+        pos_scale = 1.0 / position_tolerance if stall_test else 0.0
+        rot_scale = 1.0 / (0.5 * orientation_tolerance) if stall_test else 0.0
+        pos_beyond, rot_beyond = ((STALL_MARGIN * give_up_beyond[0], STALL_MARGIN * give_up_beyond[1])
+                                  if stall_test else (np.inf, np.inf))
         # Pinocchio's functions and the frames' placements bound once: the loop below runs a few times per call.
         jacobian, log3, placements = pin.computeFrameJacobian, pin.log3, data.oMf
         world_aligned = pin.LOCAL_WORLD_ALIGNED
@@ -264,6 +283,11 @@ class Kinematics:
                 jac[3:] *= orientation_weight
             if pos_err <= position_tolerance and rot_err <= orientation_tolerance * 0.5:
                 break
+            errors.append(max(pos_err * pos_scale, rot_err * rot_scale))
+            if stall_test and iteration > STALL_WINDOW and (pos_err > pos_beyond or rot_err > rot_beyond):
+                last = errors[-STALL_WINDOW - 1:]
+                if max(last) - min(last) < STALL_SPREAD * errors[-1]:
+                    break  # stood still: q is where the errors were measured
             step = matmul_f64(solve_spd(matmul_f64(jac, jac.T) + regulariser, error), jac)
             q[dofs] = np.minimum(np.maximum(q[dofs] + step, lower), upper)
         else:

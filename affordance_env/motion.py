@@ -161,12 +161,13 @@ class LinePath:
         ramp: Time to reach the speed from rest [s].
         to_rest: The line ends at rest (else at speed).
         check_waypoints: Spans whose joint speeds cap the cruise speed; None: all of them (solved now).
+        check: Only whether every waypoint is reached matters (a feasibility check): see :meth:`MotionExecutor.ik`.
     """
 
     def __init__(self, executor: MotionExecutor, p_start: np.ndarray, direction: np.ndarray, length: float,
                  hand: HandTarget, speed: float, q_start: np.ndarray, *, ramp: float = LINE_RAMP,
-                 to_rest: bool = True, check_waypoints: int | None = None) -> None:
-        self._executor, self._hand = executor, hand
+                 to_rest: bool = True, check_waypoints: int | None = None, check: bool = False) -> None:
+        self._executor, self._hand, self._check = executor, hand, check
         self.p_start, self.direction = np.asarray(p_start, dtype=float), np.asarray(direction, dtype=float)
         self._s_ik = np.linspace(0.0, length, max(2, int(np.ceil(length / IK_SPACING - 1e-9)) + 1))
         self._q_ik: list[np.ndarray] = [np.asarray(q_start, dtype=float)]
@@ -195,7 +196,8 @@ class LinePath:
         while len(self._q_ik) <= k:
             n = len(self._q_ik)
             q_init = self._q_ik[-1] if n < 2 else 2.0 * self._q_ik[-1] - self._q_ik[-2]  # extrapolated one spacing
-            result = self._executor.ik(self.p_start + self._s_ik[n] * self.direction, q_init, self._hand)
+            result = self._executor.ik(self.p_start + self._s_ik[n] * self.direction, q_init, self._hand,
+                                       check=self._check)
             self.results.append(result)
             self._q_ik.append(result.q)
         return self._q_ik[k]
@@ -364,11 +366,15 @@ class MotionExecutor:
                     break
         return norm(self.palm - p_world_target)
 
-    def ik(self, p: np.ndarray, q_init: np.ndarray, hand: HandTarget) -> IKResult:
-        """IK of a palm position [m] with the hand's orientation and joint ranges, from ``q_init``."""
+    def ik(self, p: np.ndarray, q_init: np.ndarray, hand: HandTarget, *, check: bool = False) -> IKResult:
+        """IK of a palm position [m] with the hand's orientation and joint ranges, from ``q_init``. ``check``: only
+        whether the pose is within IK_POSITION_TOLERANCE and IK_ORIENTATION_TOLERANCE matters (a feasibility
+        check): the solver gives up once its error stands still beyond them
+        (:data:`~affordance_env.kinematics.STALL_WINDOW`)."""
         return self.kinematics.solve_ik(
             p, q_init, hand.R_world_hand, position_tolerance=1e-3, orientation_tolerance=IK_ORIENTATION_TOLERANCE,
             joint_ranges=hand.joint_ranges,
+            give_up_beyond=(IK_POSITION_TOLERANCE, IK_ORIENTATION_TOLERANCE) if check else None,
         )
 
     # --- lines of the palm -------------------------------------------------------------------------------------

@@ -320,30 +320,33 @@ def hand_target(plan: GraspPlan) -> HandTarget:
     return HandTarget(plan.R_world_hand)
 
 
-def grasp_poses(motion: MotionExecutor, plan: GraspPlan) -> list[IKResult]:
-    """IK of the grasp's poses above the object, at the grasp and lifted, the hand open."""
+def grasp_poses(motion: MotionExecutor, plan: GraspPlan, *, check: bool = False) -> list[IKResult]:
+    """IK of the grasp's poses above the object, at the grasp and lifted, the hand open; ``check``: see
+    :meth:`~affordance_env.motion.MotionExecutor.ik`."""
     hand = hand_target(plan)
     q_open = with_hand(motion, motion.physics.joint_targets(), plan.hand_open)
-    results = [motion.ik(plan.p_above, q_open, hand)]
+    results = [motion.ik(plan.p_above, q_open, hand, check=check)]
     for p in (plan.p_grasp, plan.p_lift):
-        results.append(motion.ik(p, results[-1].q, hand))
+        results.append(motion.ik(p, results[-1].q, hand, check=check))
     return results
 
 
 def grasp_reachable(motion: MotionExecutor, plan: GraspPlan) -> bool:
     """Whether :func:`run_grasp` will find its poses within the IK's tolerances (above, at and down to the grasp,
     the lift and the put-down beside); kinematics only. The descent stops at the first touch, anywhere between
-    the pose above and the grasp pose, and the lift rises from there: the lifts from both ends are checked."""
-    above, at, lifted = grasp_poses(motion, plan)
+    the pose above and the grasp pose, and the lift rises from there: the lifts from both ends are checked.
+    Every pose and line decides the answer by whether it is reached: each IK gives up once it stands still
+    (``check``)."""
+    above, at, lifted = grasp_poses(motion, plan, check=True)
     hand = hand_target(plan)
     place = motion.ik(np.array([plan.p_place[0], plan.p_place[1], plan.p_grasp[2] + PLACE_APPROACH]), lifted.q,
-                      hand)
+                      hand, check=True)
     if not ik_verdict([above, at, lifted, place])[0]:  # a pose out of reach: the lines are not solved
         return False
-    descent = motion.line(plan.p_above, plan.p_grasp, hand, GUARDED_SPEED, q_start=above.q)
-    lift = motion.line(plan.p_grasp, plan.p_lift, hand, LIFT_SPEED, q_start=at.q)
+    descent = motion.line(plan.p_above, plan.p_grasp, hand, GUARDED_SPEED, q_start=above.q, check=True)
+    lift = motion.line(plan.p_grasp, plan.p_lift, hand, LIFT_SPEED, q_start=at.q, check=True)
     high_lift = motion.line(plan.p_above, plan.p_above + (plan.p_lift - plan.p_grasp), hand, LIFT_SPEED,
-                            q_start=above.q)
+                            q_start=above.q, check=True)
     return ik_verdict([*descent.results, *lift.results, *high_lift.results])[0]
 
 

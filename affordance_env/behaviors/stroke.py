@@ -233,28 +233,39 @@ def approach_posture(motion: MotionExecutor, plan: StrokePlan) -> np.ndarray:
     return motion.ik(plan.p_start, motion.physics.joint_targets(), hand_target(plan)).q
 
 
-def plan_approach(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None
-                  ) -> tuple[IKResult | None, IKResult]:
-    """IK of the pose above the pre-stroke pose (None if the plan has none) and of the pre-stroke pose, from the
-    arm's ``posture`` (:func:`approach_posture`; None: the current servo targets)."""
-    # The pre-stroke pose first, the pose above it from there: the two differ by a short vertical move, so
-    # the descent (and the way up after the stroke) is a small joint motion, not a change of arm posture.
+def approach_start(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None, *, check: bool = False
+                   ) -> IKResult:
+    """IK of the pre-stroke pose from the arm's ``posture`` (:func:`approach_posture`; None: the current servo
+    targets); ``check``: see :meth:`~affordance_env.motion.MotionExecutor.ik`."""
     q_init = motion.physics.joint_targets()  # the neck and the fingers keep their targets
     if posture is not None:
         reach = motion.kinematics.reach_dofs
         q_init[reach] = posture[reach]
-    hand = hand_target(plan)
-    start = motion.ik(plan.p_start, q_init, hand)
-    above = None if plan.p_above is None else motion.ik(plan.p_above, start.q, hand)
-    return above, start
+    return motion.ik(plan.p_start, q_init, hand_target(plan), check=check)
 
 
-def stroke_line(motion: MotionExecutor, plan: StrokePlan, start: IKResult) -> LinePath:
+def approach_above(motion: MotionExecutor, plan: StrokePlan, start: IKResult) -> IKResult | None:
+    """IK of the pose above the pre-stroke pose ``start`` (None if the plan has none), from ``start``: the two
+    differ by a short vertical move, so the descent (and the way up after the stroke) is a small joint motion,
+    not a change of arm posture. A via point that only has to clear the object: its configuration is used even
+    where it misses the pose."""
+    return None if plan.p_above is None else motion.ik(plan.p_above, start.q, hand_target(plan))
+
+
+def plan_approach(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None
+                  ) -> tuple[IKResult | None, IKResult]:
+    """IK of the pose above the pre-stroke pose (None if the plan has none) and of the pre-stroke pose, from the
+    arm's ``posture`` (:func:`approach_start`, :func:`approach_above`)."""
+    start = approach_start(motion, plan, posture)
+    return approach_above(motion, plan, start), start
+
+
+def stroke_line(motion: MotionExecutor, plan: StrokePlan, start: IKResult, *, check: bool = False) -> LinePath:
     """The stroke's line from the pre-stroke pose ``start``, every waypoint's IK solved (the joint speeds along
-    the whole line cap the stroke's speed)."""
+    the whole line cap the stroke's speed); ``check``: see :class:`~affordance_env.motion.LinePath`."""
     length = dot(plan.p_end - plan.p_start, plan.direction)
     return LinePath(motion, plan.p_start, plan.direction, length, hand_target(plan), plan.speed, start.q,
-                    ramp=plan.ramp, to_rest=plan.to_rest)
+                    ramp=plan.ramp, to_rest=plan.to_rest, check=check)
 
 
 def plan_stroke_path(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None
@@ -275,12 +286,14 @@ def reach_trajectory(motion: MotionExecutor, above: IKResult | None, start: IKRe
 def stroke_reachable(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> bool:
     """Whether :func:`run_stroke` will find every pose of ``plan`` within the IK's tolerances, and its reach keeps
     the arm ``REACH_CLEARANCE`` from the object and out of the table beyond ``REACH_TABLE_PENETRATION``;
-    kinematics only."""
-    above, start = plan_approach(motion, plan, posture)
+    kinematics only. The IK of a pose whose miss decides the answer gives up once it stands still (``check``):
+    the same answers, a pose out of reach found sooner."""
+    start = approach_start(motion, plan, posture, check=True)
     if not ik_verdict([start])[0]:  # out of reach already at the pre-stroke pose: the line is not solved
         return False
-    if not ik_verdict(stroke_line(motion, plan, start).results)[0]:
+    if not ik_verdict(stroke_line(motion, plan, start, check=True).results)[0]:
         return False
+    above = approach_above(motion, plan, start)  # a via point, used as it is: solved in full
     samples = reach_trajectory(motion, above, start).q[::REACH_SWEEP_STRIDE]
     # one kinematic pass over the reach for the object and the table, then the pre-stroke pose for the table
     physics = motion.physics
