@@ -108,9 +108,10 @@ class PlanSettings:
         threshold: The planner abstains below this P(goal).
         som_clusters: Effect categories of the ``som_categories`` baseline.
 
-    Sizing (TapAffordanceGoal-v2, five behaviours, one core each): an object's oracle costs about 20-30 s (65
-    actions x 5 behaviours; a grasp 0.2-0.3 s, a stroke or a draw 0.02-0.06 s), its 20 goals a few seconds more; a
-    collected goal-episode interaction about 0.17 s (``feasible`` draws included), a top-up one about 0.1 s. The
+    Sizing (TapAffordanceGoal-v2, five behaviours, one core each): an object's single step costs 18-57 s (seed 0),
+    most of it the oracle (65 actions x 5 behaviours; a grasp 0.2-0.5 s, a stroke or a draw 0.02-0.06 s); a
+    multi-step episode about a second; a collected goal-episode interaction about 0.14 s (``feasible`` draws
+    included), a top-up one about 0.1 s. The
     grasp gets about a fifth of the goal episodes' interactions: 1000 of them take about 1500 episodes, the
     collection's largest part. Half of the goals were feasible in a reduced run (a third of a box's): 24 objects
     give about 240 feasible goals, 6 objects of each shape.
