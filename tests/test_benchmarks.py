@@ -15,6 +15,7 @@ ROOT = Path(__file__).resolve().parents[1]
     ["benchmarks/env.py", "--episodes", "2", "--repeats", "1", "--width", "40", "--height", "30"],
     ["benchmarks/step_cost.py", "--episodes", "2", "--rounds", "1"],
     ["benchmarks/draw.py", "--episodes", "2"],
+    ["benchmarks/feasible.py", "--draws", "3"],  # patches MotionExecutor.ik to time the IK's whole budget
 ])
 def test_benchmark_runs(argv):
     done = subprocess.run([sys.executable, *argv], cwd=ROOT, capture_output=True, text=True, timeout=600)
