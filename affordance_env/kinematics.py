@@ -259,12 +259,12 @@ class Kinematics:
         error_position, error_rotation = error[:3], error[3:]  # views, made once
         pos_err = rot_err = np.inf
         iteration = 0
-        errors = []  # each iteration's error over its tolerance (the stall test; none with a zero tolerance)
+        # The stall test (give_up_beyond; none with a zero tolerance): each iteration's error over its tolerance.
         stall_test = give_up_beyond is not None and position_tolerance > 0 and orientation_tolerance > 0
-        pos_scale = 1.0 / position_tolerance if stall_test else 0.0
-        rot_scale = 1.0 / (0.5 * orientation_tolerance) if stall_test else 0.0
-        pos_beyond, rot_beyond = ((STALL_MARGIN * give_up_beyond[0], STALL_MARGIN * give_up_beyond[1])
-                                  if stall_test else (np.inf, np.inf))
+        if stall_test:
+            errors: list[float] = []
+            rot_scale = position_tolerance / (0.5 * orientation_tolerance)  # in units of the position tolerance
+            pos_beyond, rot_beyond = STALL_MARGIN * give_up_beyond[0], STALL_MARGIN * give_up_beyond[1]
         # Pinocchio's functions and the frames' placements bound once: the loop below runs a few times per call.
         jacobian, log3, placements = pin.computeFrameJacobian, pin.log3, data.oMf
         world_aligned = pin.LOCAL_WORLD_ALIGNED
@@ -285,11 +285,12 @@ class Kinematics:
                 jac[3:] *= orientation_weight
             if pos_err <= position_tolerance and rot_err <= orientation_tolerance * 0.5:
                 break
-            errors.append(max(pos_err * pos_scale, rot_err * rot_scale))
-            if stall_test and iteration > STALL_WINDOW and (pos_err > pos_beyond or rot_err > rot_beyond):
-                last = errors[-STALL_WINDOW - 1:]
-                if max(last) - min(last) < STALL_SPREAD * errors[-1]:
-                    break  # stood still: q is where the errors were measured
+            if stall_test:
+                errors.append(max(pos_err, rot_err * rot_scale))
+                if iteration > STALL_WINDOW and (pos_err > pos_beyond or rot_err > rot_beyond):
+                    last = errors[-STALL_WINDOW - 1:]
+                    if max(last) - min(last) < STALL_SPREAD * errors[-1]:
+                        break  # stood still: q is where the errors were measured
             step = matmul_f64(solve_spd(matmul_f64(jac, jac.T) + regulariser, error), jac)
             q[dofs] = np.minimum(np.maximum(q[dofs] + step, lower), upper)
         else:
