@@ -21,6 +21,8 @@ to every neighbour's outcome rather than to the mean alone, so that the distribu
 
 from __future__ import annotations
 
+import copy
+
 import numpy as np
 import pandas as pd
 from scipy import sparse
@@ -89,11 +91,32 @@ class PredictiveOutcomes:
     def __init__(self, model: ActionEffectModel, weights: sparse.csr_matrix, displacement: np.ndarray) -> None:
         self._model, self.weights, self.displacement = model, weights, displacement
         self.query = np.repeat(np.arange(weights.shape[0]), np.diff(weights.indptr))
+        self._off_table: np.ndarray | None = None  # ``off_table`` as off_beyond left it; None: the outcomes'
+
+    def _starts(self, start_xy) -> np.ndarray:
+        """Where each entry's object started: ``start_xy`` ((2,), or (m, 2) one per query) per entry."""
+        start = np.asarray(start_xy, dtype=np.float64)
+        return start[self.query] if start.ndim == 2 else start
+
+    def off_beyond(self, start_xy, low, high) -> PredictiveOutcomes:
+        """These outcomes, with every entry whose object's centre ends (``start_xy`` plus its displacement, [m])
+        outside the rectangle ``low`` .. ``high`` (x, y) [m] counted off the table.
+
+        An object whose centre of mass is beyond the table top's edge does not rest on it, yet a displacement moved
+        to the query's action can carry a neighbour's outcome there while it still says "on the table" (an action
+        never executed, such as a place beyond the edge, leaves no outcome that says otherwise)."""
+        end = self._starts(start_xy) + self.displacement
+        outside = np.any((end < np.asarray(low)) | (end > np.asarray(high)), axis=1)
+        out = copy.copy(self)
+        out._off_table = self["off_table"].astype(bool) | outside
+        return out
 
     def __len__(self) -> int:
         return self.weights.shape[0]
 
     def __getitem__(self, name: str) -> np.ndarray:
+        if name == "off_table" and self._off_table is not None:
+            return self._off_table
         if name in DISPLACEMENT_COLUMNS and self.displacement.shape[1]:
             return self.displacement[:, DISPLACEMENT_COLUMNS.index(name)]
         try:
@@ -106,6 +129,8 @@ class PredictiveOutcomes:
         """(nnz, n_outcomes) every entry's whole outcome row, its displacement at the query's action."""
         rows = self._model.outcomes_[self.weights.indices]
         rows[:, self._model.displacement_columns_] = self.displacement
+        if self._off_table is not None:
+            rows[:, self._model.outcome_names_.index("off_table")] = self._off_table
         return rows
 
     def share(self, values: np.ndarray) -> np.ndarray:
@@ -115,8 +140,7 @@ class PredictiveOutcomes:
     def probability(self, goal: Goal, start_xy=None) -> np.ndarray:
         """(m,) P(goal) of each query; ``start_xy``: where the object is ((2,), or (m, 2) one per query) [m]."""
         if start_xy is not None:
-            start = np.asarray(start_xy, dtype=np.float64)
-            start_xy = start[self.query] if start.ndim == 2 else start
+            start_xy = self._starts(start_xy)
         return self.share(goal.reached(self, start_xy))
 
 

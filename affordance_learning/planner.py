@@ -30,6 +30,9 @@ from affordance_learning.effect_model import ActionEffectModel, PredictiveOutcom
 from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.goals import Goal, Move, Place, check_goal, check_start
 
+#: The scene's table top, ((x_low, y_low), (x_high, y_high)) [m] in the robot's root frame: the planner's default
+#: ``table``.
+SCENE_TABLE = table_extent()
 #: An outcome that leaves the table counts as this far from any place [m] when actions are ranked by distance.
 OFF_TABLE_DISTANCE = 1.0
 #: The search over two interactions (:meth:`Planner.toward`): first actions looked at (the nearest on average,
@@ -146,6 +149,10 @@ class Planner:
         random_state: Seed of the candidates.
         max_checks: Calls to ``feasible`` per decision at most (:data:`MAX_CHECKS`); when none of the candidates
             asked is feasible the choice is None (``behavior`` None, abstained).
+        table: The table top's extent, ((x_low, y_low), (x_high, y_high)) [m] in the frame of the positions the
+            methods are given (default :data:`SCENE_TABLE`, the scene's): a predicted outcome that leaves the
+            object's centre beyond it leaves the object off the table, whatever the neighbour it comes from says
+            (a place beyond the edge was never executed, so no training outcome says what it does). None: no table.
 
     Every method checks its inputs before any work: ``features`` must have as many values as the models take
     (ValueError), the goal must be a goal of :mod:`affordance_learning.goals` (TypeError), a
@@ -154,7 +161,8 @@ class Planner:
     """
 
     def __init__(self, models: Mapping[str, ActionEffectModel], n_candidates: int = 64, threshold: float = 0.5,
-                 random_state: int = 0, max_checks: int = MAX_CHECKS) -> None:
+                 random_state: int = 0, max_checks: int = MAX_CHECKS,
+                 table: tuple[tuple[float, float], tuple[float, float]] | None = SCENE_TABLE) -> None:
         if not models:
             raise InvalidValueError("models must map at least one behaviour name to its fitted ActionEffectModel.")
         if not (isinstance(threshold, int | float) and 0.0 <= threshold <= 1.0):
@@ -175,6 +183,15 @@ class Planner:
         self.threshold = float(threshold)
         self.max_checks = int(max_checks)
         self.params = candidate_params(n_candidates, random_state)
+        if table is not None:
+            corners = np.asarray(table, dtype=np.float64)
+            if corners.shape != (2, 2) or not np.all(np.isfinite(corners)) or np.any(corners[0] >= corners[1]):
+                raise InvalidValueError(f"table must be the table top's ((x_low, y_low), (x_high, y_high)) [m], "
+                                        f"got {table!r}.")
+            table = (corners[0], corners[1])
+        #: The table top's extent, (x, y) low and high [m], or None: an outcome that leaves the object's centre
+        #: beyond it leaves the object off the table (:meth:`_on_table`).
+        self.table = table
         # The offsets of a refinement (REFINE_POINTS within REFINE_RADIUS), drawn once.
         local = qmc.Sobol(self.params.shape[1], scramble=True, seed=random_state + 1).random_base2(
             int(np.log2(REFINE_POINTS)))
@@ -230,6 +247,12 @@ class Planner:
             raise InvalidValueError("features must be finite (the object must have been seen).")
         return np.hstack([np.repeat(x[None], len(params), axis=0), params])
 
+    def _on_table(self, outcomes: PredictiveOutcomes, start) -> PredictiveOutcomes:
+        """``outcomes`` with every entry that leaves the object's centre beyond the table top's edge counted off the
+        table (:meth:`~affordance_learning.effect_model.PredictiveOutcomes.off_beyond`); as they are without
+        ``start`` (where the object is: (2,), or (m, 2) one per query)."""
+        return outcomes if start is None or self.table is None else outcomes.off_beyond(start, *self.table)
+
     @staticmethod
     def _progress(outcomes: PredictiveOutcomes, goal: Goal, start: np.ndarray | None) -> np.ndarray | None:
         """Per entry of ``outcomes``, how far it goes towards ``goal`` (higher is better): along a :class:`Move`'s
@@ -250,12 +273,12 @@ class Planner:
         candidate's action: :meth:`~affordance_learning.effect_model.ActionEffectModel.predictive_outcomes`).
         ``candidates``: the actions per behaviour (default: :attr:`params` for every behaviour)."""
         check_goal(goal)
-        start = _check_start(start_xy) if isinstance(goal, Place) else None
+        start = _check_start(start_xy) if isinstance(goal, Place) or start_xy is not None else None
         if candidates is None:
             candidates = dict.fromkeys(self.models, self.params)
         out = {}
         for name, params in candidates.items():
-            outcomes = self.models[name].predictive_outcomes(self._inputs(features, params))
+            outcomes = self._on_table(self.models[name].predictive_outcomes(self._inputs(features, params)), start)
             p = outcomes.probability(goal, start)
             progress = self._progress(outcomes, goal, start)
             out[name] = (p, np.zeros(len(p)) if progress is None else outcomes.share(progress))
@@ -372,8 +395,8 @@ class Planner:
         names = list(self.models)
         predicted, p1, distance, ends = {}, {}, {}, {}
         for name, model in self.models.items():
-            outcomes = model.predictive_outcomes(X)  # per entry: a neighbour's outcome at the candidate's action
-            end, off = start + outcomes.displacement, outcomes["off_table"].astype(bool)
+            outcomes = self._on_table(model.predictive_outcomes(X), start)  # per entry: a neighbour's outcome at
+            end, off = start + outcomes.displacement, outcomes["off_table"].astype(bool)  # the candidate's action
             within = goal.reached(outcomes, start).astype(np.float64)
             dist = np.where(off, OFF_TABLE_DISTANCE, np.linalg.norm(end - target, axis=1))
             if reachable is not None:  # an end no behaviour reaches counts as off the table, unless within
@@ -457,7 +480,8 @@ class Planner:
         starts = np.repeat(xy, len(second), axis=0)  # each query's start: its state's
         for name, model in self.models.items():
             X2 = np.hstack([np.repeat(seen, len(second), axis=0), np.tile(second, (len(keys), 1))])
-            p2 = model.predictive_outcomes(X2).probability(goal, starts).reshape(len(keys), len(second)).max(axis=1)
+            p2 = self._on_table(model.predictive_outcomes(X2), starts).probability(goal, starts)
+            p2 = p2.reshape(len(keys), len(second)).max(axis=1)
             if reachable is not None:
                 p2 = p2 * np.asarray(reachable(name, xy), dtype=bool)
             best = np.maximum(best, p2)
