@@ -11,9 +11,9 @@
    shapes in turn). On each object every behaviour's :func:`oracle_params` (the canonical action and a 4 x 4 x 4
    grid, 65 per behaviour, the same for every object) is run from the same snapshot (``get_state`` /
    ``set_state``), once; then :data:`GOALS_PER_OBJECT` goals (:mod:`affordance_learning.goals`: roll, lift, move
-   5 cm in each of 8 directions, and places within 3 cm of points 5-15 cm away) are each judged against those
-   outcomes. Policies, all from that snapshot (an action run once is not run again: the env repeats an
-   interaction bit for bit from a snapshot):
+   5 cm in each of 8 directions, and places within 3 cm of points 5-15 cm away, on the table as the goal env's
+   targets are: :func:`place_target`) are each judged against those outcomes. Policies, all from that snapshot
+   (an action run once is not run again: the env repeats an interaction bit for bit from a snapshot):
 
    - ``planner``: :meth:`~affordance_learning.planner.Planner.choose`, with ``feasible`` ruling out reach
      failures, remembering the actions that failed on this object (:meth:`~affordance_learning.planner.Planner.
@@ -61,7 +61,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from affordance_env.goal_env import GOAL_TABLE_MARGIN
 from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
+from affordance_env.scene import table_extent
+from affordance_env.workspace import in_any_workspace
 from affordance_learning.effect_model import ActionEffectModel
 from affordance_learning.goals import Goal, Lift, Move, Place, Roll
 from affordance_learning.outcomes import model_inputs, outcome_table
@@ -75,7 +78,7 @@ MULTI_POLICIES = ("planner", "direction", "random")
 #: Goals: Move's distance [m], Place's distance from the object [m] and tolerance [m].
 MOVE_DISTANCE, PLACE_DISTANCE, PLACE_TOLERANCE = 0.05, (0.05, 0.15), 0.03
 #: The goals drawn for every object of the single-step evaluation, in this order: one roll, one lift, a move in
-#: each of the 8 directions (every 45 degrees), and places 5-15 cm away in uniform directions.
+#: each of the 8 directions (every 45 degrees), and places 5-15 cm away in uniform directions (:func:`place_target`).
 GOALS_PER_OBJECT: dict[str, int] = {"roll": 1, "lift": 1, "move": 8, "place": 10}
 #: Seeds of the evaluation's objects: SeedSequence([seed, EVAL_STREAM, part, i]), apart from the training's.
 EVAL_STREAM = 7919
@@ -155,21 +158,33 @@ def reach_failure(info: Mapping[str, Any]) -> bool:
     return bool(info["failure"]) and info["failure"].split(":")[0] in ("ik", "reach")
 
 
+def place_target(start_xy: np.ndarray, rng: np.random.Generator, draws: int = 1000) -> np.ndarray:
+    """A place ``PLACE_DISTANCE`` from ``start_xy`` [m] in a uniform direction, where the goal env puts its goals:
+    at least ``GOAL_TABLE_MARGIN`` inside the table top's edges and in some behaviour's workspace (a place beyond
+    the edge is no place an object can be put). Raises RuntimeError if ``draws`` draws find none."""
+    (x0, y0), (x1, y1) = table_extent()
+    low = np.array([x0, y0]) + GOAL_TABLE_MARGIN
+    high = np.array([x1, y1]) - GOAL_TABLE_MARGIN
+    for _ in range(draws):
+        angle = rng.uniform(-np.pi, np.pi)
+        target = start_xy + rng.uniform(*PLACE_DISTANCE) * np.array([np.cos(angle), np.sin(angle)])
+        if np.all(target >= low) and np.all(target <= high) and in_any_workspace(target):
+            return target
+    raise RuntimeError(f"No place {PLACE_DISTANCE} m from the object at {np.asarray(start_xy).tolist()} lies "
+                       f"{GOAL_TABLE_MARGIN} m inside the table and in a workspace after {draws} draws.")
+
+
 def draw_goal(kind: str, start_xy: np.ndarray, rng: np.random.Generator, direction: int | None = None) -> Goal:
     """A goal of ``kind`` for an object seen at ``start_xy``; a move goes along ``direction`` (0-7, every 45
-    degrees from +x), else one drawn."""
+    degrees from +x), else one drawn; a place is drawn by :func:`place_target`."""
     if kind == "roll":
         return Roll()
     if kind == "lift":
         return Lift()
     if kind == "move":
         angle = (rng.integers(8) if direction is None else direction) * np.pi / 4
-    else:
-        angle = rng.uniform(-np.pi, np.pi)
-    unit = np.array([np.cos(angle), np.sin(angle)])
-    if kind == "move":
-        return Move(tuple(np.round(unit, 12)), MOVE_DISTANCE)
-    return Place(tuple(start_xy + rng.uniform(*PLACE_DISTANCE) * unit), PLACE_TOLERANCE)
+        return Move(tuple(np.round(np.array([np.cos(angle), np.sin(angle)]), 12)), MOVE_DISTANCE)
+    return Place(tuple(place_target(np.asarray(start_xy, dtype=np.float64), rng)), PLACE_TOLERANCE)
 
 
 def draw_goals(start_xy: np.ndarray, rng: np.random.Generator) -> list[Goal]:

@@ -11,7 +11,7 @@ import pytest
 from affordance_learning.effect_model import ActionEffectModel
 from affordance_learning.goals import Lift, Move, Percept, Place, Roll, goal_from_dict
 from affordance_learning.outcomes import MOTION_COLUMNS
-from affordance_learning.planner import REFUSAL_RADIUS, Planner, candidate_params
+from affordance_learning.planner import REFUSAL_RADIUS, SCENE_TABLE, Planner, candidate_params
 
 
 def synthetic(n: int = 600, seed: int = 0, push: float = 0.12) -> tuple[np.ndarray, pd.DataFrame]:
@@ -135,7 +135,7 @@ def test_toward_by_default_looks_ahead_within_the_workspaces():
 
 def test_the_planner_never_chooses_again_an_action_that_failed_where_the_object_still_is(model):
     planner = Planner({"push": model}, n_candidates=32)
-    features, start, goal = np.array([-0.3, 1.0, 0.0]), np.array([-0.3, 0.0]), Move((1.0, 0.0), 0.15)
+    features, start, goal = np.array([-0.3, 1.0, 0.0]), np.array([-0.45, 0.0]), Move((1.0, 0.0), 0.15)
     first = planner.choose(features, goal, start)
     planner.note_failure(first.behavior, first.params, start)
     second = planner.choose(features, goal, start + 0.004)  # moved 4 mm by the failed reach: the same situation
@@ -145,9 +145,9 @@ def test_the_planner_never_chooses_again_an_action_that_failed_where_the_object_
     assert not any(np.array_equal(third.params, c.params) for c in (first, second))
     # elsewhere, the action may work: it is a candidate again; and a new object forgets every failure
     assert np.array_equal(planner.choose(features, goal, start + 0.05).params, first.params)
-    toward = planner.toward(features, start, (-0.2, 0.0), 0.03, steps_left=1, reachable=None)
+    toward = planner.toward(features, start, (-0.35, 0.0), 0.03, steps_left=1, reachable=None)
     planner.note_failure(toward.behavior, toward.params, start)
-    again = planner.toward(features, start, (-0.2, 0.0), 0.03, steps_left=1, reachable=None)
+    again = planner.toward(features, start, (-0.35, 0.0), 0.03, steps_left=1, reachable=None)
     assert not np.array_equal(again.params, toward.params)
     planner.forget_failures()
     assert np.array_equal(planner.choose(features, goal, start).params, first.params)
@@ -250,14 +250,56 @@ def test_choose_refines_a_place_between_its_candidates():
     X, Y = _pick_and_place()
     planner = Planner({"grasp": ActionEffectModel(n_estimators=50, random_state=0).fit(X, Y)})
     rng = np.random.default_rng(3)
+    start = np.array([-0.45, 0.0])  # on the table, 29 cm from its nearest edge
     errors = []
     for _ in range(20):
-        target = rng.uniform(-0.15, 0.15, 2)
-        choice = planner.choose(np.array([-0.5, 0.0]), Place(tuple(target), 0.03), (0.0, 0.0))
-        errors.append(np.linalg.norm(0.2 * choice.params[:2] - target))  # where this action puts the object
+        shift = rng.uniform(-0.15, 0.15, 2)
+        choice = planner.choose(np.array([-0.5, 0.0]), Place(tuple(start + shift), 0.03), start)
+        errors.append(np.linalg.norm(0.2 * choice.params[:2] - shift))  # where this action puts the object
     # the 64 candidates lie about 0.25 apart, 5 cm of the place (a median 1.9 cm off and up to 3.1 cm without the
     # refinement): the actions scored around the best one bring it within a centimetre
     assert np.median(errors) < 0.012 and max(errors) < 0.025
+
+
+def test_an_outcome_that_ends_beyond_the_table_edge_counts_as_off_the_table():
+    X, Y = _pick_and_place()
+    model = ActionEffectModel(n_estimators=50, random_state=0).fit(X, Y)
+    (_, y_low), (x_edge, y_high) = SCENE_TABLE
+    start = np.array([x_edge - 0.09, 0.0])  # a held object put down more than 9 cm toward the robot falls off
+    goal, small = Move((1.0, 0.0), 0.05), np.array([-0.5, 0.0])
+    for table, on_table in ((None, False), (SCENE_TABLE, True)):
+        choice = Planner({"grasp": model}, table=table).choose(small, goal, start)
+        end = start[0] + 0.2 * choice.params[0]  # where the chosen action puts the object
+        # without the table the furthest move ranks first, over the edge; with it, one that stays on the table
+        assert choice.probability > 0.8 and (end <= x_edge - 0.005) == on_table, (table, end)
+    actions = np.array([[0.2, 0.0, 0.0], [0.5, 0.0, 0.0]])  # 4 cm and 10 cm toward the robot
+    outcomes = model.predictive_outcomes(np.column_stack([np.repeat(small[None], 2, axis=0), actions]))
+    bounded = outcomes.off_beyond(start, (-0.76, y_low), (x_edge, y_high))
+    beyond = start[0] + outcomes.displacement[:, 0] > x_edge
+    assert beyond.any() and not outcomes["off_table"].any()
+    np.testing.assert_array_equal(bounded["off_table"], beyond)
+    np.testing.assert_array_equal(bounded.values()[:, model.outcome_names_.index("off_table")], beyond)
+    there = Place((x_edge + 0.01, 0.0), 0.03)  # 1 cm beyond the edge: within 3 cm of it only on the table's rim
+    assert outcomes.probability(there, start)[1] > 0.5 and bounded.probability(there, start)[1] < 0.05
+    with pytest.raises(ValueError, match="table"):
+        Planner({"grasp": model}, table=((0.0, 0.0), (-1.0, 1.0)))
+
+
+def test_place_goals_lie_on_the_table_where_the_goal_env_puts_its_goals():
+    from affordance_env.goal_env import GOAL_TABLE_MARGIN
+    from affordance_env.workspace import in_any_workspace
+    from affordance_learning.plan_experiment import PLACE_DISTANCE, draw_goal
+
+    rng = np.random.default_rng(0)
+    low, high = np.array(SCENE_TABLE[0]) + GOAL_TABLE_MARGIN, np.array(SCENE_TABLE[1]) - GOAL_TABLE_MARGIN
+    # objects at the placement region's near corners and centre: a uniform place 5-15 cm away falls off the table
+    # (x above -0.16) from the near ones a fifth of the time
+    for start in ([-0.21, -0.2], [-0.21, 0.2], [-0.33, 0.0]):
+        targets = np.array([draw_goal("place", np.array(start), rng).target_xy for _ in range(200)])
+        distance = np.linalg.norm(targets - start, axis=1)
+        assert np.all(targets >= low) and np.all(targets <= high) and np.all(in_any_workspace(targets))
+        assert PLACE_DISTANCE[0] <= distance.min() and distance.max() <= PLACE_DISTANCE[1]
+        assert np.ptp(np.arctan2(*(targets - start).T[::-1])) > np.pi  # still spread over directions
 
 
 def test_step_reach_and_within_reach_bound_what_a_few_interactions_can_do():
