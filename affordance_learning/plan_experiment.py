@@ -35,7 +35,8 @@
    against random actions and a direction heuristic. Where no candidate is feasible the planner stops
    (``gave_up``) rather than run an interaction it knows would fail; an action that failed to reach is not chosen
    again from where it failed. Targets toward the robot (within 45 degrees of +x from the object) are counted
-   apart.
+   apart; every ``TOWARD_ROBOT_EVERY``-th episode has one, on an object that leaves room for it
+   (:func:`episode_start`).
 6. Calibration of P(goal) on the planner's chosen actions of step 3 (expected calibration error over 10 bins,
    AUROC), and, beside it, pooled over every action of the oracle's set for every goal.
 
@@ -390,6 +391,10 @@ def _direction_heuristic(start: np.ndarray, target: np.ndarray) -> str:
 #: the env draws its goals but within 45 degrees of +x: drawn uniformly in direction, a goal lies toward the robot
 #: in a tenth of the episodes only, the table's near edge being 14 cm in front of the objects.
 TOWARD_ROBOT_EVERY = 4
+#: Objects drawn at most for an episode toward the robot: one within 31 cm of the robot leaves no room for a target
+#: 10 cm or more toward it and 5 cm inside the table's near edge, so the episode takes the next object drawn that
+#: does (on the first alone, seeds 0-3 gave 13, 16, 13 and 11 such episodes of 16).
+TOWARD_ROBOT_OBJECTS = 20
 
 
 def goal_toward_robot(start_xy, env, rng: np.random.Generator) -> list[float] | None:
@@ -416,23 +421,40 @@ def toward_robot(start_xy, target_xy) -> bool:
     return bool(need[0] > abs(need[1]))
 
 
+def episode_start(env, item: Mapping[str, Any], rng: np.random.Generator) -> tuple[dict, dict]:
+    """``env.reset`` for the multi-step episode ``item``: the goal env's object and target from reset seed
+    ``item["seed"]``; every ``TOWARD_ROBOT_EVERY``-th episode a target toward the robot (:func:`goal_toward_robot`),
+    on the first of ``TOWARD_ROBOT_OBJECTS`` objects (the item's, then reset seeds from ``rng``) that the table leaves
+    room for one in front of. Returns reset's observation and info."""
+    seed = item["seed"]
+    obs, info = env.reset(seed=seed)
+    if item["index"] % TOWARD_ROBOT_EVERY:
+        return obs, info
+    for _ in range(TOWARD_ROBOT_OBJECTS):
+        goal = goal_toward_robot(obs["achieved_goal"], env, rng)
+        if goal is not None:
+            return env.reset(seed=seed, options={"goal": goal})  # the same object, this target
+        seed = int(rng.integers(2**31))
+        obs, info = env.reset(seed=seed)
+    return obs, info
+
+
 def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, camera: tuple[int, int],
                      frames: list | None = None) -> dict[str, Any]:
     """One multi-step episode of ``policy`` from reset seed ``item["seed"]``: reached, interactions, reach
-    failures, the final distance [m], the planner's decision times [s]."""
+    failures, the final distance [m], the planner's decision times [s]; ``frames``, if given, gets a labelled picture
+    of the start and after each interaction."""
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
 
     env = _env(camera)
     rng = np.random.default_rng(item["rng"])
-    obs, info = env.reset(seed=item["seed"])
-    if item["index"] % TOWARD_ROBOT_EVERY == 0:  # a target toward the robot, where the table leaves room for one
-        goal = goal_toward_robot(obs["achieved_goal"], env, rng)
-        if goal is not None:
-            obs, info = env.reset(seed=item["seed"], options={"goal": goal})  # the same object, this target
+    obs, info = episode_start(env, item, rng)
     tolerance = env.goal_tolerance
     steps, failures, success, gave_up, decisions = 0, [], False, False, []
     distance = initial = float(info["distance"])
     start_xy, target_xy = (np.asarray(obs[key], dtype=float).tolist() for key in ("achieved_goal", "desired_goal"))
+    if frames is not None:
+        frames.append((f"start: {100 * distance:.1f} cm to go", env.render()))
     planner.forget_failures()
     for step in range(GOAL_MAX_EPISODE_STEPS):
         start, target = obs["achieved_goal"], obs["desired_goal"]
@@ -857,10 +879,8 @@ def record_episode(out: str | os.PathLike, results: Mapping[str, Any], seed: int
     try:
         item = _items(seed, 9, 1)[0]
         pictures: list[tuple[str, np.ndarray]] = []
-        _, info = env.reset(seed=item["seed"])
-        start = [(f"start: {100 * info['distance']:.1f} cm to go", env.render())]
         evaluate_episode(item, planner, "planner", (160, 120), frames=pictures)
-        return start + pictures
+        return pictures
     finally:
         _worker.env = previous
         env.close()

@@ -482,3 +482,34 @@ def test_a_multi_step_action_that_left_the_object_where_it_was_is_noted_as_faile
     assert not episode["success"] and episode["steps"] >= 2
     assert len(planner.noted) == episode["steps"]  # every grasp left the box where it was
     assert all(behavior == "grasp" for behavior, _, _ in planner.noted)
+
+
+def test_an_episode_toward_the_robot_takes_an_object_the_table_leaves_room_for_such_a_target():
+    """An object 22 cm from the robot leaves no room for a target 10 cm or more toward it 5 cm inside the table's
+    near edge: the episode draws another object, and its target lies toward the robot."""
+    from affordance_env.goal_env import GOAL_DISTANCE, GOAL_TABLE_MARGIN
+    from affordance_learning import plan_experiment
+
+    env = plan_experiment._env((40, 30))
+    reset = env.reset
+    near_edge = 7
+
+    def reset_near_edge(seed=None, options=None):  # the item's own object lies near the table's near edge
+        extra = {"position": (-0.22, 0.0)} if seed == near_edge else {}
+        return reset(seed=seed, options={**(options or {}), **extra})
+
+    env.reset = reset_near_edge
+    try:
+        starts = {index: plan_experiment.episode_start(env, {"seed": near_edge, "rng": 3, "index": index},
+                                                       np.random.default_rng(3))
+                  for index in (0, 1)}
+    finally:
+        env.reset = reset
+    (obs, info), (obs_kept, _) = starts[0], starts[1]
+    start, target = np.asarray(obs["achieved_goal"]), np.asarray(obs["desired_goal"])
+    assert start[0] < -0.22 - 0.05  # another object, further out
+    assert plan_experiment.toward_robot(start, target)
+    assert GOAL_DISTANCE[0] - 1e-9 <= np.linalg.norm(target - start) <= GOAL_DISTANCE[1] + 1e-9
+    assert target[0] <= SCENE_TABLE[1][0] - GOAL_TABLE_MARGIN + 1e-9
+    # an episode that is not one toward the robot keeps the goal env's object and target
+    np.testing.assert_allclose(obs_kept["achieved_goal"][0], -0.22, atol=0.01)
