@@ -505,7 +505,7 @@ def test_an_episode_toward_the_robot_takes_an_object_the_table_leaves_room_for_s
                   for index in (0, 1)}
     finally:
         env.reset = reset
-    (obs, info), (obs_kept, _) = starts[0], starts[1]
+    (obs, _), (obs_kept, _) = starts[0], starts[1]
     start, target = np.asarray(obs["achieved_goal"]), np.asarray(obs["desired_goal"])
     assert start[0] < -0.22 - 0.05  # another object, further out
     assert plan_experiment.toward_robot(start, target)
