@@ -391,6 +391,10 @@ def _direction_heuristic(start: np.ndarray, target: np.ndarray) -> str:
 #: the env draws its goals but within 45 degrees of +x: drawn uniformly in direction, a goal lies toward the robot
 #: in a tenth of the episodes only, the table's near edge being 14 cm in front of the objects.
 TOWARD_ROBOT_EVERY = 4
+#: The behaviours that bring an object toward the robot: the draw, and the grasp that puts it down there. A missed
+#: episode toward the robot records whether each could act on the object where it started (``pulls_at_start``:
+#: ``feasible`` of its canonical action).
+PULLING = ("draw", "grasp")
 #: Objects drawn at most for an episode toward the robot: one within 31 cm of the robot leaves no room for a target
 #: 10 cm or more toward it and 5 cm inside the table's near edge, so the episode takes the next object drawn that
 #: does (on the first alone, seeds 0-3 gave 13, 16, 13 and 11 such episodes of 16).
@@ -449,6 +453,7 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
     env = _env(camera)
     rng = np.random.default_rng(item["rng"])
     obs, info = episode_start(env, item, rng)
+    initial_state = env.get_state()
     tolerance = env.goal_tolerance
     steps, failures, success, gave_up, decisions = 0, [], False, False, []
     distance = initial = float(info["distance"])
@@ -487,10 +492,14 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
         if terminated:
             success = bool(info["is_success"])
             break
+    toward = toward_robot(start_xy, target_xy)
+    # What could bring the object toward the robot from where it started, had the episode missed such a target
+    pulls = ({name: bool(feasible_at(env, initial_state)(name, np.zeros(3))) for name in PULLING}
+             if policy == "planner" and toward and not success else None)
     return {"policy": policy, "success": success, "steps": steps, "reach_failures": len(failures), "failures": failures,
             "final_distance": distance, "gave_up": gave_up, "type": info["object"]["type"],
             "initial_distance": initial, "start_xy": start_xy, "target_xy": target_xy, "tolerance": tolerance,
-            "toward_robot": toward_robot(start_xy, target_xy), "decision_s": decisions}
+            "toward_robot": toward, "pulls_at_start": pulls, "decision_s": decisions}
 
 
 #: The directions of :func:`step_reach`: world +x (towards the robot), -x (away), +y (to its right), -y (left).

@@ -279,7 +279,15 @@ def _why(name: str, results: PlanResults) -> str:
         multi = results.multi_step.policy("planner")
         towards = [e for e in multi.episodes if e.toward_robot]
         beyond = sum(not e.within_reach for e in towards)
-        return (f"{beyond} of the {len(towards)} targets toward the robot lay further than the episode's "
+        missed = [e for e in towards if not e.success and e.pulls_at_start is not None]
+        no_draw = [e for e in missed if not e.pulls_at_start.get("draw", True)]
+        neither = sum(not e.pulls_at_start.get("grasp", True) for e in no_draw)
+        where = (f" (the nearest {100 * min(-e.start_xy[0] for e in no_draw):.0f} cm in front of the robot)"
+                 if no_draw else "")
+        pulls = (f"of the {len(missed)} missed, {len(no_draw)} started where the draw, the one behaviour that pulls, "
+                 f"cannot reach behind the object{where}, {neither} of them out of the grasp's reach too (their "
+                 "canonical actions not feasible); " if missed else "")
+        return (f"{pulls}{beyond} of the {len(towards)} targets toward the robot lay further than the episode's "
                 "interactions took any object of their type toward it in training")
     if name.startswith("each left-out"):
         loso = results.leave_one_shape_out

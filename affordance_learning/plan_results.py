@@ -74,6 +74,9 @@ class Episode:
         gave_up: Whether the planner stopped where no candidate action was reachable.
         failures: The messages of its interactions that failed to reach.
         toward_robot: Whether its target lay toward the robot (within 45 degrees of +x from the object).
+        pulls_at_start: For a missed episode toward the robot: whether each behaviour that brings objects toward
+            it (the draw, the grasp) could act on the object where it started (``feasible`` of its canonical
+            action); None otherwise.
     """
 
     type: str
@@ -84,6 +87,7 @@ class Episode:
     gave_up: bool
     failures: tuple[str, ...] = ()
     toward_robot: bool = False
+    pulls_at_start: Mapping[str, bool] | None = None
 
 
 @dataclass(frozen=True)
@@ -337,7 +341,17 @@ def _episode(value: Any, path: _Path) -> Episode:
                    target_xy=_xy(entry["target_xy"], (*path, "target_xy")), success=bool(entry["success"]),
                    within_reach=bool(entry["within_reach"]), gave_up=bool(entry["gave_up"]),
                    failures=tuple(str(f) for f in _list(entry.get("failures", []), (*path, "failures"))),
-                   toward_robot=bool(entry.get("toward_robot", False)))
+                   toward_robot=bool(entry.get("toward_robot", False)),
+                   pulls_at_start=_pulls(entry.get("pulls_at_start"), (*path, "pulls_at_start")))
+
+
+def _pulls(value: Any, path: _Path) -> Mapping[str, bool] | None:
+    if value is None:
+        return None
+    if not isinstance(value, Mapping) or not all(isinstance(v, bool) for v in value.values()):
+        raise InvalidValueError(f"{_where(path)} must map behaviour names to true or false, got {value!r}; "
+                                f"{_EXPECTED}.")
+    return {str(k): v for k, v in value.items()}
 
 
 #: The entries of ``multi_step`` that describe the evaluation, not a policy.

@@ -37,6 +37,7 @@ from affordance_learning.plan_report import (
     write_plan_report,
 )
 from affordance_learning.plan_report import TOO_FEW as TARGET_TOO_FEW
+from affordance_learning.plan_results import PlanResults
 from affordance_learning.report import render_report
 
 STRADDLE = "1 x 3 map: a category straddles the critical size"
@@ -264,3 +265,24 @@ def test_every_claim_carries_its_n_in_the_report() -> None:
     assert "had too few data for a verdict" in text and f"at least {MIN_TRIALS} trials of {MIN_INTERACTIONS}" in text
     few = render_report({**results, "config": {**results["config"], "n_trials": 3}})
     assert "**too few** (n=3 trials of 1000 interactions; at least" in few
+
+
+def test_a_missed_target_toward_the_robot_says_where_the_draw_could_not_reach(tmp_path: Path) -> None:
+    results = _plan_results()
+    planner = results["multi_step"]["planner"]
+    planner.update(success_toward_robot=0.4, success_toward_robot_ci=list(wilson_interval(8, 20)),
+                   n_toward_robot=20)
+
+    def episode(x: float, pulls: dict | None, success: bool = False) -> dict:
+        return {"type": "box", "start_xy": [x, 0.0], "target_xy": [x + 0.15, 0.0], "success": success,
+                "within_reach": True, "gave_up": False, "toward_robot": True, "pulls_at_start": pulls}
+
+    planner["episodes"] = [episode(-0.47, {"draw": False, "grasp": False}),
+                           episode(-0.45, {"draw": False, "grasp": True}),
+                           episode(-0.30, {"draw": True, "grasp": True}), episode(-0.30, None, success=True)]
+    row = next(line for line in write_plan_report(results, tmp_path).read_text().splitlines()
+               if line.startswith("| multi-step targets toward the robot"))
+    assert ("of the 3 missed, 2 started where the draw, the one behaviour that pulls, cannot reach behind the "
+            "object (the nearest 45 cm in front of the robot), 1 of them out of the grasp's reach too") in row
+    assert PlanResults.from_dict(results).multi_step.policy("planner").episodes[1].pulls_at_start == {
+        "draw": False, "grasp": True}
