@@ -820,7 +820,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
                                                                                   GOAL_MAX_EPISODE_STEPS)
     multi["planner"]["episodes"] = [
         {**{k: e[k] for k in ("type", "start_xy", "target_xy", "initial_distance", "final_distance", "steps",
-                              "success", "gave_up", "reach_failures", "failures", "toward_robot")},
+                              "success", "gave_up", "reach_failures", "failures", "toward_robot", "pulls_at_start")},
          "within_reach": e["type"] in reach and within_reach(e["start_xy"], e["target_xy"], reach[e["type"]],
                                                              tolerance, GOAL_MAX_EPISODE_STEPS)}
         for e in planner_episodes]
