@@ -96,6 +96,9 @@ class PredictiveOutcomes:
     def _starts(self, start_xy) -> np.ndarray:
         """Where each entry's object started: ``start_xy`` ((2,), or (m, 2) one per query) per entry."""
         start = np.asarray(start_xy, dtype=np.float64)
+        if start.shape not in ((2,), (len(self), 2)):
+            raise InvalidValueError(f"start_xy must be where the object is, (2,) or one (x, y) per query "
+                                    f"({len(self)}, 2) [m], got shape {start.shape}.")
         return start[self.query] if start.ndim == 2 else start
 
     def off_beyond(self, start_xy, low, high) -> PredictiveOutcomes:
@@ -116,7 +119,7 @@ class PredictiveOutcomes:
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name == "off_table" and self._off_table is not None:
-            return self._off_table
+            return self._off_table.copy()
         if name in DISPLACEMENT_COLUMNS and self.displacement.shape[1]:
             return self.displacement[:, DISPLACEMENT_COLUMNS.index(name)]
         try:

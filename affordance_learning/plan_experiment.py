@@ -331,7 +331,7 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
     tried = [(b, k, outcomes.run(b, params)) for b in BEHAVIORS for k, params in enumerate(oracle_set)]
     # Every oracle action's P(goal) is read from its predictive outcomes, computed once for the object.
     X = np.hstack([np.repeat(features[None], len(oracle_set), axis=0), oracle_set])
-    predicted = {b: planner.models[b].predictive_outcomes(X) for b in BEHAVIORS}
+    predicted = {b: planner.on_table(planner.models[b].predictive_outcomes(X), start) for b in BEHAVIORS}
     canonical_pick = Planner(planner.models, n_candidates=1, threshold=planner.threshold)
     left_out = shape_planners.get(item["shape"])
     for p in (planner, left_out):
@@ -395,9 +395,10 @@ TOWARD_ROBOT_EVERY = 4
 #: episode toward the robot records whether each could act on the object where it started (``pulls_at_start``:
 #: ``feasible`` of its canonical action).
 PULLING = ("draw", "grasp")
-#: Objects drawn at most for an episode toward the robot: one within 31 cm of the robot leaves no room for a target
-#: 10 cm or more toward it and 5 cm inside the table's near edge, so the episode takes the next object drawn that
-#: does (on the first alone, seeds 0-3 gave 13, 16, 13 and 11 such episodes of 16).
+#: Objects drawn at most for an episode toward the robot: one within about 28-30 cm of the robot leaves no room (or
+#: little) for a target 10 cm or more toward it, within 45 degrees of straight ahead and 5 cm inside the table's
+#: near edge, so the episode takes the next object drawn that does (on the first alone, seeds 0-3 gave 13, 16, 13
+#: and 11 such episodes of 16).
 TOWARD_ROBOT_OBJECTS = 20
 
 

@@ -87,7 +87,7 @@ class Episode:
     gave_up: bool
     failures: tuple[str, ...] = ()
     toward_robot: bool = False
-    pulls_at_start: Mapping[str, bool] | None = None
+    pulls_at_start: Mapping[str, bool] | None = field(default=None, hash=False)  # read-only
 
 
 @dataclass(frozen=True)
@@ -351,7 +351,7 @@ def _pulls(value: Any, path: _Path) -> Mapping[str, bool] | None:
     if not isinstance(value, Mapping) or not all(isinstance(v, bool) for v in value.values()):
         raise InvalidValueError(f"{_where(path)} must map behaviour names to true or false, got {value!r}; "
                                 f"{_EXPECTED}.")
-    return {str(k): v for k, v in value.items()}
+    return MappingProxyType({str(k): v for k, v in value.items()})
 
 
 #: The entries of ``multi_step`` that describe the evaluation, not a policy.

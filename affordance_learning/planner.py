@@ -88,8 +88,8 @@ def _reached_by_any(reachable: Callable[[str, np.ndarray], np.ndarray], names: l
     return out
 
 
-def _check_on_table(name: str, value, xy: np.ndarray) -> None:
-    (x0, y0), (x1, y1) = table_extent()
+def _check_on_table(name: str, value, xy: np.ndarray, table=None) -> None:
+    (x0, y0), (x1, y1) = SCENE_TABLE if table is None else table
     if xy.shape != (2,) or not np.all(np.isfinite(xy)) or not (x0 <= xy[0] <= x1 and y0 <= xy[1] <= y1):
         raise InvalidValueError(f"{name} must be (x, y) [m] on the table top, x in [{x0:.2f}, {x1:.2f}] and y in "
                          f"[{y0:.2f}, {y1:.2f}], got {value!r}.")
@@ -190,7 +190,7 @@ class Planner:
                                         f"got {table!r}.")
             table = (corners[0], corners[1])
         #: The table top's extent, (x, y) low and high [m], or None: an outcome that leaves the object's centre
-        #: beyond it leaves the object off the table (:meth:`_on_table`).
+        #: beyond it leaves the object off the table (:meth:`on_table`).
         self.table = table
         # The offsets of a refinement (REFINE_POINTS within REFINE_RADIUS), drawn once.
         local = qmc.Sobol(self.params.shape[1], scramble=True, seed=random_state + 1).random_base2(
@@ -247,10 +247,11 @@ class Planner:
             raise InvalidValueError("features must be finite (the object must have been seen).")
         return np.hstack([np.repeat(x[None], len(params), axis=0), params])
 
-    def _on_table(self, outcomes: PredictiveOutcomes, start) -> PredictiveOutcomes:
-        """``outcomes`` with every entry that leaves the object's centre beyond the table top's edge counted off the
-        table (:meth:`~affordance_learning.effect_model.PredictiveOutcomes.off_beyond`); as they are without
-        ``start`` (where the object is: (2,), or (m, 2) one per query)."""
+    def on_table(self, outcomes: PredictiveOutcomes, start) -> PredictiveOutcomes:
+        """``outcomes`` as the planner reads them: every entry that leaves the object's centre beyond the table top's
+        edge (:attr:`table`) counted off the table
+        (:meth:`~affordance_learning.effect_model.PredictiveOutcomes.off_beyond`); as they are without ``start``
+        (where the object is: (2,), or (m, 2) one per query) or without a table."""
         return outcomes if start is None or self.table is None else outcomes.off_beyond(start, *self.table)
 
     @staticmethod
@@ -270,22 +271,25 @@ class Planner:
                ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """Per behaviour, every candidate's P(goal) and expected progress towards it (:meth:`_progress`, 0 where
         the goal has no distance), from the models' predictive outcomes (each neighbour's displacement at the
-        candidate's action: :meth:`~affordance_learning.effect_model.ActionEffectModel.predictive_outcomes`).
-        ``candidates``: the actions per behaviour (default: :attr:`params` for every behaviour)."""
+        candidate's action: :meth:`~affordance_learning.effect_model.ActionEffectModel.predictive_outcomes`, read
+        with the table: :meth:`on_table`). ``candidates``: the actions per behaviour (default: :attr:`params` for
+        every behaviour). ``start_xy`` (where the object is) is needed for a :class:`Place`, and for any goal, when
+        given, says which outcomes leave the object beyond the table's edge."""
         check_goal(goal)
         start = _check_start(start_xy) if isinstance(goal, Place) or start_xy is not None else None
         if candidates is None:
             candidates = dict.fromkeys(self.models, self.params)
         out = {}
         for name, params in candidates.items():
-            outcomes = self._on_table(self.models[name].predictive_outcomes(self._inputs(features, params)), start)
+            outcomes = self.on_table(self.models[name].predictive_outcomes(self._inputs(features, params)), start)
             p = outcomes.probability(goal, start)
             progress = self._progress(outcomes, goal, start)
             out[name] = (p, np.zeros(len(p)) if progress is None else outcomes.share(progress))
         return out
 
     def scores(self, features: np.ndarray, goal: Goal, start_xy=None) -> dict[str, np.ndarray]:
-        """P(goal) of every candidate, per behaviour: {behaviour: (n_candidates,)}."""
+        """P(goal) of every candidate, per behaviour: {behaviour: (n_candidates,)}; ``start_xy`` as for
+        :meth:`choose` (outcomes that leave the object beyond the table's edge are off the table)."""
         return {name: p for name, (p, _) in self._score(features, goal, start_xy).items()}
 
     def _first_feasible(self, ranked, feasible, excluded: set[tuple[str, int]], asked: dict[tuple[str, int], bool],
@@ -362,8 +366,8 @@ class Planner:
     def toward(self, features: np.ndarray, start_xy, target_xy, tolerance: float,
                feasible: Callable[[str, np.ndarray], bool] | None = None, steps_left: int | None = None,
                reachable: Callable[[str, np.ndarray], np.ndarray] | None = in_workspace) -> Choice:
-        """The next interaction towards ``target_xy`` [m], a place on the table top (:func:`table_extent`; another
-        is a ValueError), re-planned after every interaction.
+        """The next interaction towards ``target_xy`` [m], a place on the table top (:attr:`table`, the scene's
+        :func:`table_extent` without one; another is a ValueError), re-planned after every interaction.
 
         By default (``steps_left`` None: more interactions may follow) a search over sequences of two
         interactions: an action's value is its P(within ``tolerance``) plus the share of its predicted outcomes
@@ -388,14 +392,14 @@ class Planner:
             raise InvalidValueError(f"steps_left must be None or an integer >= 1, got {steps_left!r}.")
         goal = Place(target_xy, tolerance)
         target = np.asarray(goal.target_xy)
-        _check_on_table("target_xy", target_xy, target)
+        _check_on_table("target_xy", target_xy, target, self.table)
         start = _check_start(start_xy)
         X = self._inputs(features)
         features = X[0, : self.n_features]
         names = list(self.models)
         predicted, p1, distance, ends = {}, {}, {}, {}
         for name, model in self.models.items():
-            outcomes = self._on_table(model.predictive_outcomes(X), start)  # per entry: a neighbour's outcome at
+            outcomes = self.on_table(model.predictive_outcomes(X), start)  # per entry: a neighbour's outcome at
             end, off = start + outcomes.displacement, outcomes["off_table"].astype(bool)  # the candidate's action
             within = goal.reached(outcomes, start).astype(np.float64)
             dist = np.where(off, OFF_TABLE_DISTANCE, np.linalg.norm(end - target, axis=1))
@@ -480,7 +484,7 @@ class Planner:
         starts = np.repeat(xy, len(second), axis=0)  # each query's start: its state's
         for name, model in self.models.items():
             X2 = np.hstack([np.repeat(seen, len(second), axis=0), np.tile(second, (len(keys), 1))])
-            p2 = self._on_table(model.predictive_outcomes(X2), starts).probability(goal, starts)
+            p2 = self.on_table(model.predictive_outcomes(X2), starts).probability(goal, starts)
             p2 = p2.reshape(len(keys), len(second)).max(axis=1)
             if reachable is not None:
                 p2 = p2 * np.asarray(reachable(name, xy), dtype=bool)

@@ -281,8 +281,17 @@ def test_an_outcome_that_ends_beyond_the_table_edge_counts_as_off_the_table():
     np.testing.assert_array_equal(bounded.values()[:, model.outcome_names_.index("off_table")], beyond)
     there = Place((x_edge + 0.01, 0.0), 0.03)  # 1 cm beyond the edge: within 3 cm of it only on the table's rim
     assert outcomes.probability(there, start)[1] > 0.5 and bounded.probability(there, start)[1] < 0.05
+    bounded["off_table"][:] = False  # a copy: what a caller does with it leaves the outcomes as they are
+    np.testing.assert_array_equal(bounded["off_table"], beyond)
+    with pytest.raises(ValueError, match="start_xy"):  # one start per query, or one for all
+        outcomes.off_beyond(np.zeros((3, 2)), (-0.76, y_low), (x_edge, y_high))
     with pytest.raises(ValueError, match="table"):
         Planner({"grasp": model}, table=((0.0, 0.0), (-1.0, 1.0)))
+    # toward's target is checked against the planner's table: another frame, another table
+    with pytest.raises(ValueError, match="on the table top"):
+        Planner({"grasp": model}).toward(small, (0.0, 0.0), (0.1, 0.0), 0.03, steps_left=1, reachable=None)
+    assert Planner({"grasp": model}, table=((-1.0, -1.0), (1.0, 1.0))).toward(
+        small, (0.0, 0.0), (0.1, 0.0), 0.03, steps_left=1, reachable=None).behavior == "grasp"
 
 
 def test_place_goals_lie_on_the_table_where_the_goal_env_puts_its_goals():
@@ -497,8 +506,10 @@ def test_an_episode_toward_the_robot_takes_an_object_the_table_leaves_room_for_s
     reset = env.reset
     near_edge = 7
 
+    room = 8
+
     def reset_near_edge(seed=None, options=None):  # the item's own object lies near the table's near edge
-        extra = {"position": (-0.22, 0.0)} if seed == near_edge else {}
+        extra = {"position": (-0.22, 0.0)} if seed == near_edge else {"position": (-0.42, 0.0)} if seed == room else {}
         return reset(seed=seed, options={**(options or {}), **extra})
 
     env.reset = reset_near_edge
@@ -506,8 +517,12 @@ def test_an_episode_toward_the_robot_takes_an_object_the_table_leaves_room_for_s
         starts = {index: plan_experiment.episode_start(env, {"seed": near_edge, "rng": 3, "index": index},
                                                        np.random.default_rng(3))
                   for index in (0, 1)}
+        roomy, _ = plan_experiment.episode_start(env, {"seed": room, "rng": 3, "index": 4}, np.random.default_rng(3))
     finally:
         env.reset = reset
+    # an object with room in front of it keeps its place and gets a target toward the robot
+    np.testing.assert_allclose(roomy["achieved_goal"][0], -0.42, atol=0.01)
+    assert plan_experiment.toward_robot(roomy["achieved_goal"], roomy["desired_goal"])
     (obs, _), (obs_kept, _) = starts[0], starts[1]
     start, target = np.asarray(obs["achieved_goal"]), np.asarray(obs["desired_goal"])
     assert start[0] < -0.22 - 0.05  # another object, further out

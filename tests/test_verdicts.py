@@ -284,5 +284,7 @@ def test_a_missed_target_toward_the_robot_says_where_the_draw_could_not_reach(tm
                if line.startswith("| multi-step targets toward the robot"))
     assert ("of the 3 missed, 2 started where the draw, the one behaviour that pulls, cannot reach behind the "
             "object (the nearest 45 cm in front of the robot), 1 of them out of the grasp's reach too") in row
-    assert PlanResults.from_dict(results).multi_step.policy("planner").episodes[1].pulls_at_start == {
-        "draw": False, "grasp": True}
+    read = PlanResults.from_dict(results).multi_step.policy("planner").episodes[1]
+    assert read.pulls_at_start == {"draw": False, "grasp": True} and hash(read)
+    with pytest.raises(TypeError):
+        read.pulls_at_start["draw"] = True  # type: ignore[index]  # a read-only view, as the rest of the results
