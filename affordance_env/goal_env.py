@@ -33,6 +33,21 @@ GOAL_DISTANCE = (0.10, 0.25)
 GOAL_TABLE_MARGIN = 0.05
 
 
+def draw_target(xy: np.ndarray, rng: np.random.Generator, low, high, distance: tuple[float, float] = GOAL_DISTANCE,
+                angles: tuple[float, float] = (-np.pi, np.pi), draws: int = 1000) -> np.ndarray | None:
+    """A point ``distance`` [m] from ``xy`` in a direction uniform over ``angles`` [rad] (from +x), where the goal env
+    puts its goals: at least GOAL_TABLE_MARGIN inside the table top ``low`` .. ``high`` (x, y) [m] and in some
+    behaviour's workspace; None if ``draws`` draws find none. A pure function of ``rng``'s draws."""
+    inner_low, inner_high = np.asarray(low) + GOAL_TABLE_MARGIN, np.asarray(high) - GOAL_TABLE_MARGIN
+    for _ in range(draws):
+        angle = rng.uniform(*angles)
+        target = xy + rng.uniform(*distance) * np.array([np.cos(angle), np.sin(angle)])
+        if np.all(target >= inner_low) and np.all(target <= inner_high) and in_any_workspace(target):
+            return target
+    return None
+
+
+
 def goal_distance(achieved_goal: np.ndarray, desired_goal: np.ndarray) -> np.ndarray:
     """Distance on the table [m] between achieved and desired goals, (..., 2) -> (...)."""
     return np.linalg.norm(np.asarray(achieved_goal, dtype=float) - np.asarray(desired_goal, dtype=float), axis=-1)
@@ -238,15 +253,10 @@ class TapAffordanceGoalEnv(gym.Env):
         return self.world.table.check_position(goal, "goal")
 
     def _draw_goal(self, xy: np.ndarray) -> np.ndarray:
-        """A goal GOAL_DISTANCE from ``xy``, on the table and in some behaviour's workspace."""
-        low, high = self.world.table.low, self.world.table.high
-        rng = self.np_random
-        for _ in range(1000):
-            angle = rng.uniform(-np.pi, np.pi)
-            goal = xy + rng.uniform(*GOAL_DISTANCE) * np.array([np.cos(angle), np.sin(angle)])
-            if np.all(goal >= low + GOAL_TABLE_MARGIN) and np.all(goal <= high - GOAL_TABLE_MARGIN) \
-                    and in_any_workspace(goal):
-                return goal
+        """A goal GOAL_DISTANCE from ``xy``, on the table and in some behaviour's workspace (:func:`draw_target`)."""
+        goal = draw_target(xy, self.np_random, self.world.table.low, self.world.table.high)
+        if goal is not None:
+            return goal
         raise RuntimeError(f"No goal {GOAL_DISTANCE} m from the object at {xy} lies on the table and in a workspace; "
                            "place the object inside the workspaces (affordance_env.workspace).")
 

@@ -62,10 +62,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from affordance_env.goal_env import GOAL_TABLE_MARGIN
+from affordance_env.goal_env import GOAL_TABLE_MARGIN, draw_target
 from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
 from affordance_env.scene import table_extent
-from affordance_env.workspace import in_any_workspace
 from affordance_learning.effect_model import ActionEffectModel
 from affordance_learning.goals import Goal, Lift, Move, Place, Roll
 from affordance_learning.outcomes import model_inputs, outcome_table
@@ -164,13 +163,9 @@ def place_target(start_xy: np.ndarray, rng: np.random.Generator, draws: int = 10
     at least ``GOAL_TABLE_MARGIN`` inside the table top's edges and in some behaviour's workspace (a place beyond
     the edge is no place an object can be put). Raises RuntimeError if ``draws`` draws find none."""
     (x0, y0), (x1, y1) = table_extent()
-    low = np.array([x0, y0]) + GOAL_TABLE_MARGIN
-    high = np.array([x1, y1]) - GOAL_TABLE_MARGIN
-    for _ in range(draws):
-        angle = rng.uniform(-np.pi, np.pi)
-        target = start_xy + rng.uniform(*PLACE_DISTANCE) * np.array([np.cos(angle), np.sin(angle)])
-        if np.all(target >= low) and np.all(target <= high) and in_any_workspace(target):
-            return target
+    target = draw_target(start_xy, rng, np.array([x0, y0]), np.array([x1, y1]), PLACE_DISTANCE, draws=draws)
+    if target is not None:
+        return target
     raise RuntimeError(f"No place {PLACE_DISTANCE} m from the object at {np.asarray(start_xy).tolist()} lies "
                        f"{GOAL_TABLE_MARGIN} m inside the table and in a workspace after {draws} draws.")
 
@@ -406,18 +401,10 @@ def goal_toward_robot(start_xy, env, rng: np.random.Generator) -> list[float] | 
     """A target as the goal env draws its goals (``GOAL_DISTANCE`` from the object, ``GOAL_TABLE_MARGIN`` inside
     the table, in some behaviour's workspace) but toward the robot (within 45 degrees of +x), from ``rng``; None
     if 200 draws find none."""
-    from affordance_env.goal_env import GOAL_DISTANCE, GOAL_TABLE_MARGIN
-    from affordance_env.workspace import in_any_workspace
-
     table = env.world.table
-    start = np.asarray(start_xy, dtype=float)
-    for _ in range(200):
-        angle = rng.uniform(-np.pi / 4, np.pi / 4)
-        goal = start + rng.uniform(*GOAL_DISTANCE) * np.array([np.cos(angle), np.sin(angle)])
-        if (np.all(goal >= table.low + GOAL_TABLE_MARGIN) and np.all(goal <= table.high - GOAL_TABLE_MARGIN)
-                and in_any_workspace(goal)):
-            return goal.tolist()
-    return None
+    goal = draw_target(np.asarray(start_xy, dtype=float), rng, table.low, table.high, angles=(-np.pi / 4, np.pi / 4),
+                       draws=200)
+    return None if goal is None else goal.tolist()
 
 
 def toward_robot(start_xy, target_xy) -> bool:

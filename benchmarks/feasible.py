@@ -61,13 +61,15 @@ def _time_checks(env: TapAffordanceGoalEnv, draws: list, rounds: int = 3) -> Non
 
     seconds: dict[str, list[float]] = {"feasible": [], "whole budget": []}
     answers: dict[str, list[bool]] = {}
-    for _ in range(rounds):
-        for name in seconds:
-            MotionExecutor.ik = ik if name == "feasible" else in_full
-            start = time.perf_counter()
-            answers[name] = [bool(env.feasible(b, p, state=state)) for state, b, p in draws]
-            seconds[name].append(time.perf_counter() - start)
-    MotionExecutor.ik = ik
+    try:
+        for _ in range(rounds):
+            for name in seconds:
+                MotionExecutor.ik = ik if name == "feasible" else in_full
+                start = time.perf_counter()
+                answers[name] = [bool(env.feasible(b, p, state=state)) for state, b, p in draws]
+                seconds[name].append(time.perf_counter() - start)
+    finally:
+        MotionExecutor.ik = ik
     same = sum(a == b for a, b in zip(*answers.values(), strict=True))
     fast, full = (float(np.median(seconds[name])) / len(draws) * 1e3 for name in seconds)
     print(f"feasible(): {fast:.1f} ms per call against {full:.1f} ms with the whole IK budget ({full / fast:.2f} x, "
