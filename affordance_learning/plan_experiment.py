@@ -386,7 +386,7 @@ def _direction_heuristic(start: np.ndarray, target: np.ndarray) -> str:
 #: the env draws its goals but within 45 degrees of +x: drawn uniformly in direction, a goal lies toward the robot
 #: in a tenth of the episodes only, the table's near edge being 14 cm in front of the objects.
 TOWARD_ROBOT_EVERY = 4
-#: The behaviours that bring an object toward the robot: the draw, and the grasp that puts it down there. A missed
+#: The behaviours that bring an object toward the robot: the draw, and the grasp that puts it down there. An
 #: episode toward the robot records whether each could act on the object where it started (``pulls_at_start``:
 #: ``feasible`` of its canonical action).
 PULLING = ("draw", "grasp")
@@ -481,9 +481,9 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
             success = bool(info["is_success"])
             break
     toward = toward_robot(start_xy, target_xy)
-    # What could bring the object toward the robot from where it started, had the episode missed such a target
+    # What could bring the object toward the robot from where it started, for such a target
     pulls = ({name: bool(feasible_at(env, initial_state)(name, np.zeros(3))) for name in PULLING}
-             if policy == "planner" and toward and not success else None)
+             if policy == "planner" and toward else None)
     return {"policy": policy, "success": success, "steps": steps, "reach_failures": len(failures), "failures": failures,
             "final_distance": distance, "gave_up": gave_up, "type": info["object"]["type"],
             "initial_distance": initial, "start_xy": start_xy, "target_xy": target_xy, "tolerance": tolerance,

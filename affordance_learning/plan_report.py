@@ -287,8 +287,13 @@ def _why(name: str, results: PlanResults) -> str:
         pulls = (f"of the {len(missed)} missed, {len(no_draw)} started where the draw, the one behaviour that pulls, "
                  f"cannot reach behind the object{where}, {neither} of them out of the grasp's reach too (their "
                  "canonical actions not feasible); " if missed else "")
+        pullable = _pullable(towards)
+        reached = ("" if pullable is None else
+                   "; where the draw or the grasp could act on the object at the start, the planner reached "
+                   + share_text(pullable[0] / pullable[1] if pullable[1] else None, pullable[1],
+                                wilson(*pullable), "episodes", digits=1))
         return (f"{pulls}{beyond} of the {len(towards)} targets toward the robot lay further than the episode's "
-                "interactions took any object of their type toward it in training")
+                "interactions took any object of their type toward it in training" + reached)
     if name.startswith("each left-out"):
         loso = results.leave_one_shape_out
         parts = [f"{s}: {_share(loso[s]['planner'].feasible, 'feasible')} (best fixed "
@@ -319,6 +324,15 @@ _FAILURE_KINDS = {
     "ik: the grasp was not reachable": "where a grasp's pose was out of reach once the hand had touched",
     "ik: the stroke was not reachable": "where a stroke's pose was out of reach",
 }
+
+
+def _pullable(towards) -> tuple[int, int] | None:
+    """(reached, n) over the episodes toward the robot that started where the draw or the grasp could act on the
+    object (``pulls_at_start``); None where that was not recorded for every one of them."""
+    if not towards or any(e.pulls_at_start is None for e in towards):
+        return None
+    able = [e for e in towards if any(e.pulls_at_start.values())]
+    return sum(e.success for e in able), len(able)
 
 
 def multi_step_why(results: PlanResults | Mapping[str, Any]) -> str:

@@ -74,9 +74,10 @@ class Episode:
         gave_up: Whether the planner stopped where no candidate action was reachable.
         failures: The messages of its interactions that failed to reach.
         toward_robot: Whether its target lay toward the robot (within 45 degrees of +x from the object).
-        pulls_at_start: For a missed episode toward the robot: whether each behaviour that brings objects toward
-            it (the draw, the grasp) could act on the object where it started (``feasible`` of its canonical
-            action); None otherwise.
+        pulls_at_start: For an episode toward the robot: whether each behaviour that brings objects toward it
+            (the draw, the grasp) could act on the object where it started (``feasible`` of its canonical action);
+            None otherwise (and for the episodes that reached their target, in results of version 2 written before
+            it was recorded for them).
     """
 
     type: str

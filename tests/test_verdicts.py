@@ -284,6 +284,13 @@ def test_a_missed_target_toward_the_robot_says_where_the_draw_could_not_reach(tm
                if line.startswith("| multi-step targets toward the robot"))
     assert ("of the 3 missed, 2 started where the draw, the one behaviour that pulls, cannot reach behind the "
             "object (the nearest 45 cm in front of the robot), 1 of them out of the grasp's reach too") in row
+    assert "could act on the object at the start" not in row  # not recorded for the episode that reached it
+    # Recorded for every episode toward the robot: the share reached where the draw or the grasp could act at first
+    planner["episodes"][3] = episode(-0.30, {"draw": True, "grasp": False}, success=True)
+    row = next(line for line in write_plan_report(results, tmp_path).read_text().splitlines()
+               if line.startswith("| multi-step targets toward the robot"))
+    assert ("where the draw or the grasp could act on the object at the start, the planner reached 33.3 % "
+            "[6, 79] (n=3 episodes)") in row
     read = PlanResults.from_dict(results).multi_step.policy("planner").episodes[1]
     assert read.pulls_at_start == {"draw": False, "grasp": True} and hash(read)
     with pytest.raises(TypeError):
