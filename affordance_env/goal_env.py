@@ -162,6 +162,9 @@ class TapAffordanceGoalEnv(gym.Env):
       and place (its first two parameters name where the object is put down). Goals may lie toward the robot (the
       draw's workspace joins the union goals are drawn in); ``position_range="workspace"`` places objects in the
       workspace of a behaviour drawn uniformly (not uniformly over the union). Data of v1 are not comparable.
+      Fixed since its first release: an object the hand holds over the table's edge has not left the table
+      (``outcome`` ``"off_table"`` only once it is let go, or falls, there); a grasp of an object within a centimetre
+      of the near edge was labelled off the table, wherever it was put down.
     * v1: the motors of TapAffordance-v2 (each with its torque-speed curve) and its hand's controller (a finger's
       target kept within its servo's reach of the finger); the put-down lowers a held object at 2 cm/s, carries it
       along a straight line to above where it goes, and stops where fingertips under it meet the table first. Data

@@ -3,7 +3,8 @@
 :class:`ObjectMonitor` follows the object's state at every simulation step of an interaction, whatever the
 arm is doing, and records:
 
-- when and where the object's centre left the table top (it then falls to the floor);
+- when and where the object's centre left the table top (it then falls to the floor): beyond the top's edges or
+  below it, except while the hand holds it up (:attr:`ObjectMonitor.held`) over the edge, where it has not fallen;
 - the distance its centre covered while *rolling* on the table: moving with its lowest point nearly at rest
   (``|v_contact| <= ROLL_SLIP_RATIO |v|``, where ``v_contact = v + w x (-h z)`` is the velocity of the point
   ``h`` below the centre, ``h`` the centre's height above the table) and at constant height
@@ -85,6 +86,13 @@ class ObjectMonitor:
         self.max_rise = 0.0
         #: Simulation time since which the object has been still [s]; None while it moves.
         self.still_since: float | None = time
+        #: The hand holds the object up (set by the behaviour that lifts it, for as long as its hand may hold it):
+        #: its centre carried beyond the table top's edges, above the top's height, has not left the table. A
+        #: grasp near the near edge draws the object a few millimetres toward the robot as the fingers close on it
+        #: and lift it (a 4.6 cm ball 8 mm inside the edge: its centre 1 mm beyond it, 5 mm up, in the closing
+        #: hand, then carried and put down 7 cm away), and a held object may pass over the edge on its way to where
+        #: it is put down.
+        self.held = False
         self._time = float(time)
 
     @property
@@ -121,6 +129,8 @@ class ObjectMonitor:
             return
         x, y, z = p
         if not (self._x0 <= x <= self._x1 and self._y0 <= y <= self._y1 and z > self.table_top):
+            if self.held and z > self.table_top:
+                return  # in the hand, over the edge: not fallen, and not on the table either
             self.exit_time = time
             self.exit_position = np.array([x, y, z], dtype=np.float64)
             return

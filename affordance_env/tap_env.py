@@ -241,7 +241,8 @@ class TapAffordanceEnv(gym.Env):
       speed, ``affordance_env.motor_limits.JOINT_TORQUE_SPEED``; the wrist's pitch and yaw motors give 0.94 N m,
       not 2), and the hand's controller keeps each finger's target within its servo's reach of the finger, so a
       finger that loses the object never outruns its limit; the put-down is slower (2 cm/s). Data of v1 are not
-      comparable.
+      comparable. Fixed since its first release: an object the hand holds over the table's edge has not left the
+      table (a grasp's ``outcome`` was ``"off_table"`` for an object within a centimetre of the near edge).
     * v1: the iCub's motor limits (joint speeds planned within 100 deg/s for the arm, torso and neck and 180 deg/s
       for the fingers, motor torques limited, gravity compensation included), stiff contacts (10 ms, impedance
       0.995), the palm's restitution 0.3, every move one minimum-jerk or line trajectory with feedforward, the

@@ -82,6 +82,16 @@ def test_pick_and_place_puts_a_held_object_down_at_rest_where_asked(env, object_
     assert not env.feasible("grasp", (1.0, 0.0, 0.0), state=start)
 
 
+def test_a_ball_grasped_at_the_near_edge_and_put_down_on_the_table_stays_on_it(env):
+    # 8 mm inside the table's near edge, the closing fingers draw the ball's centre 1 mm beyond it, 5 mm up, and
+    # the hand carries it 8 cm away and puts it down: held over the edge, it never left the table
+    x_edge = float(env.unwrapped.world.table.high[0])
+    env.reset(seed=0, options={"object_type": "sphere", "size": 0.0456, "position": (x_edge - 0.008, 0.109)})
+    _, _, _, _, info = env.step({"behavior": "grasp", "params": np.array([-0.37, -0.23, -0.52], np.float32)})
+    assert info["failure"] is None and info["success"]
+    assert info["outcome"] == "rest" and info["object"]["pose"][0] < x_edge - 0.05
+
+
 def test_feasible_from_a_snapshot_answers_for_it_and_leaves_the_env_as_it_was(env):
     env.reset(seed=0, options={"object_type": "box", "size": 0.06, "position": (-0.30, 0.05)})
     start = env.get_state()

@@ -112,6 +112,31 @@ def test_leaving_the_table_is_recorded_where_and_when_it_happens():
     assert distance_at_exit == pytest.approx(0.3, abs=1e-9)  # nothing is counted after the object left
 
 
+def test_an_object_held_over_the_edge_has_not_left_the_table_until_it_falls():
+    start = np.array([0.0, -0.49, TABLE_TOP + 0.02])
+    still = (np.zeros(3), np.zeros(3))
+    over_the_edge = np.array([0.0, -0.51, TABLE_TOP + 0.03])  # beyond y = -0.5, above the top
+    for held in (True, False):
+        monitor = ObjectMonitor(TABLE_TOP, LOW, HIGH, start, 0.0)
+        monitor.held = held
+        monitor.sample(0.01, over_the_edge, *still)
+        assert monitor.left_table is not held
+    # held, back over the table: still on it; let go beyond the edge, or fallen below the top in the hand: off it
+    monitor = ObjectMonitor(TABLE_TOP, LOW, HIGH, start, 0.0)
+    monitor.held = True
+    monitor.sample(0.01, over_the_edge, *still)
+    monitor.sample(0.02, start, *still)
+    assert not monitor.left_table
+    monitor.sample(0.03, np.array([0.0, -0.52, TABLE_TOP - 0.01]), *still)
+    assert monitor.left_table and monitor.exit_time == 0.03
+    monitor = ObjectMonitor(TABLE_TOP, LOW, HIGH, start, 0.0)
+    monitor.held = True
+    monitor.sample(0.01, over_the_edge, *still)
+    monitor.held = False
+    monitor.sample(0.02, over_the_edge, *still)
+    assert monitor.left_table and monitor.exit_time == 0.02
+
+
 def test_rest_counts_from_a_given_time():
     monitor = ObjectMonitor(TABLE_TOP, LOW, HIGH, np.array([0.0, 0.0, 0.02]), 0.0)
     still = (np.array([0.0, 0.0, 0.02]), np.zeros(3), np.zeros(3))

@@ -408,6 +408,9 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan, at_end: Callable[[], None
     touch = motion.follow_line(descent, physics.hand_touches_object)
     # Close: the fingers at the plan's share of their speed limit, until their motors' torque holds the object.
     motion.phase = "close"
+    monitor = physics.monitor  # in the hand from its closing until it has opened and the object rests
+    if monitor is not None:
+        monitor.held = True
     move_fingers(motion, plan.hand_closed, plan.close_speed, until_held=True)
     motion.phase = "lift"
     p_from = motion.palm.copy()
@@ -443,6 +446,8 @@ def run_grasp(motion: MotionExecutor, plan: GraspPlan, at_end: Callable[[], None
     # slowly: the fingers open at RELEASE_SPEED_SHARE of their speed, and it slides down them onto the table.
     move_fingers(motion, plan.hand_release, 1.0 if placed or not held else RELEASE_SPEED_SHARE)
     motion.hold_still(also=object_at_rest)
+    if monitor is not None:
+        monitor.held = False
     release_time = float(physics.data.time)
     # The way home rises first: straight up from where the hand let go.
     p_up = motion.palm.copy() + np.array([0.0, 0.0, plan.p_retreat[2] - plan.p_place[2]])
