@@ -389,7 +389,7 @@ def train_action_models(frame: pd.DataFrame, out: str | Path | None = None, *,
     Raises:
         ValueError: A behaviour without interactions in the frame, or a frame without the goal dataset's columns.
     """
-    from affordance_learning.effect_model import ActionEffectModel
+    from affordance_learning.effect_model import behavior_model
     from affordance_learning.outcomes import model_inputs, outcome_table
 
     out = user_model_dir() if out is None else Path(out)
@@ -404,7 +404,7 @@ def train_action_models(frame: pd.DataFrame, out: str | Path | None = None, *,
         if rows.empty:
             raise InvalidValueError(f"the frame holds no {behavior!r} interactions to fit its action-conditioned "
                                     f"model on (it holds {', '.join(held) or 'none'}).")
-        model = ActionEffectModel(n_estimators=n_estimators, random_state=random_state).fit(
+        model = behavior_model(behavior, n_estimators=n_estimators, random_state=random_state).fit(
             model_inputs(rows), outcome_table(rows))
         bundle = {"format": ACTION_FORMAT, "behavior": behavior, "model": model, "versions": library_versions(),
                   "feature_names": _feature_names(), "n_interactions": int(len(rows))}

@@ -65,7 +65,7 @@ import pandas as pd
 from affordance_env.goal_env import GOAL_TABLE_MARGIN, draw_target
 from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
 from affordance_env.scene import table_extent
-from affordance_learning.effect_model import ActionEffectModel
+from affordance_learning.effect_model import ActionEffectModel, behavior_model
 from affordance_learning.goals import Goal, Lift, Move, Place, Roll
 from affordance_learning.outcomes import model_inputs, outcome_table
 from affordance_learning.planner import FAILURE_RADIUS, Planner
@@ -204,8 +204,8 @@ def training_frames(frame: pd.DataFrame, max_per_behavior: int, exclude_type: st
 
 def fit_models(frames: Mapping[str, pd.DataFrame], random_state: int, n_jobs: int | None = None
                ) -> dict[str, ActionEffectModel]:
-    """An effect model per behaviour."""
-    return {b: ActionEffectModel(random_state=random_state, n_jobs=n_jobs).fit(model_inputs(f), outcome_table(f))
+    """An effect model per behaviour (:func:`~affordance_learning.effect_model.behavior_model`)."""
+    return {b: behavior_model(b, random_state=random_state, n_jobs=n_jobs).fit(model_inputs(f), outcome_table(f))
             for b, f in frames.items()}
 
 

@@ -110,3 +110,18 @@ def test_the_shipped_models_predict_each_behaviours_way(monkeypatch, tmp_path):
     placed = predict_effect(features, "grasp", action=[0.5, -0.5, 0.0])  # pick and place: 10 cm +x, 10 cm -y
     assert placed.lifted > 0.5 and placed.displacement[0] > 0.04 and placed.displacement[1] < -0.04
     env.close()
+
+
+def test_the_plan_and_the_shipped_models_fit_each_behaviour_with_its_flag_weight(tmp_path):
+    from affordance_learning.effect_model import BEHAVIOR_FLAG_WEIGHTS, FLAG_WEIGHT
+    from affordance_learning.plan_experiment import fit_models
+
+    frame = goal_frame(120)
+    frame["behavior"] = np.where(frame["behavior"] == "push", "grasp", "tap")  # the grasp's flags weigh more
+    written = train_action_models(frame, tmp_path, n_estimators=5)
+    shipped = {b: joblib.load(path)["model"] for b, path in written.items()}
+    planned = fit_models({b: frame[frame["behavior"] == b] for b in ("tap", "grasp")}, random_state=0)
+    assert BEHAVIOR_FLAG_WEIGHTS["grasp"] != FLAG_WEIGHT
+    for models in (shipped, planned):
+        assert models["grasp"].flag_weight == BEHAVIOR_FLAG_WEIGHTS["grasp"]
+        assert models["tap"].flag_weight == FLAG_WEIGHT
