@@ -287,11 +287,15 @@ def _why(name: str, results: PlanResults) -> str:
         pulls = (f"of the {len(missed)} missed, {len(no_draw)} started where the draw, the one behaviour that pulls, "
                  f"cannot reach behind the object{where}, {neither} of them out of the grasp's reach too (their "
                  "canonical actions not feasible); " if missed else "")
-        pullable = _pullable(towards)
-        reached = ("" if pullable is None else
-                   "; where the draw or the grasp could act on the object at the start, the planner reached "
-                   + share_text(pullable[0] / pullable[1] if pullable[1] else None, pullable[1],
-                                wilson(*pullable), "episodes", digits=1))
+        reached = ""
+        if (draw := _pullable(towards, ("draw",))) is not None:
+            either = _pullable(towards, ("draw", "grasp"))
+            reached = ("; where the draw could act on the object at the start, the planner reached "
+                       + share_text(draw[0] / draw[1] if draw[1] else None, draw[1], wilson(*draw), "episodes",
+                                    digits=1)
+                       + ", where the draw or the grasp could, "
+                       + share_text(either[0] / either[1] if either[1] else None, either[1], wilson(*either),
+                                    "episodes", digits=1))
         return (f"{pulls}{beyond} of the {len(towards)} targets toward the robot lay further than the episode's "
                 "interactions took any object of their type toward it in training" + reached)
     if name.startswith("each left-out"):
@@ -326,12 +330,12 @@ _FAILURE_KINDS = {
 }
 
 
-def _pullable(towards) -> tuple[int, int] | None:
-    """(reached, n) over the episodes toward the robot that started where the draw or the grasp could act on the
+def _pullable(towards, behaviors: tuple[str, ...]) -> tuple[int, int] | None:
+    """(reached, n) over the episodes toward the robot that started where one of ``behaviors`` could act on the
     object (``pulls_at_start``); None where that was not recorded for every one of them."""
     if not towards or any(e.pulls_at_start is None for e in towards):
         return None
-    able = [e for e in towards if any(e.pulls_at_start.values())]
+    able = [e for e in towards if any(e.pulls_at_start.get(b, False) for b in behaviors)]
     return sum(e.success for e in able), len(able)
 
 

@@ -6,8 +6,11 @@ weighted share of outcomes that reach the goal (roll, lift, move 5 cm in 4 direc
 interaction, 2 places 5-15 cm from where the object was, 3 cm tolerance, as ``affordance plan`` draws them).
 Compared on the last quarter of each behaviour's interactions (by episode), trained on the rest:
 
-- ``forest``: :class:`affordance_learning.effect_model.ActionEffectModel` (a random forest as a quantile
-  regression forest; each neighbour's displacement moved to the query's action along the local slopes);
+- ``forest``: :class:`affordance_learning.effect_model.ActionEffectModel` as ``affordance plan`` fits it
+  (:func:`~affordance_learning.effect_model.behavior_model`: a random forest as a quantile regression forest; each
+  neighbour's displacement moved to the query's action along the local slopes; the grasp's flags weighing 5 times
+  a displacement in the splits, the others' twice);
+- ``forest_flags_2``: the same with every behaviour's flags weighing twice a displacement;
 - ``forest_as_were``: the same forest with the neighbours' displacements as they were and the flags weighing as
   much as a displacement in the splits (``action_inputs=0, flag_weight=1``: the model before the local slopes);
 - ``extra_trees``: the forest with extremely randomised trees;
@@ -30,7 +33,7 @@ from sklearn.neighbors import NearestNeighbors
 from sklearn.preprocessing import StandardScaler
 
 from affordance_env import load_dataset
-from affordance_learning.effect_model import ActionEffectModel
+from affordance_learning.effect_model import FLAG_WEIGHT, ActionEffectModel, behavior_model
 from affordance_learning.goals import Lift, Move, Place, Roll
 from affordance_learning.outcomes import model_inputs, outcome_table
 from affordance_learning.plan_experiment import BEHAVIORS, calibration
@@ -64,10 +67,11 @@ def main() -> None:
     parser.add_argument("dataset", help="a goal-episode dataset directory")
     args = parser.parse_args()
     frame = load_dataset(args.dataset).sort_values(["episode", "step"])
-    learners = {"forest": lambda: ActionEffectModel(random_state=0),
-                "forest_as_were": lambda: ActionEffectModel(action_inputs=0, flag_weight=1.0, random_state=0),
-                "extra_trees": lambda: ActionEffectModel(trees="extra", random_state=0),
-                "knn": lambda: KnnEffectModel()}
+    learners = {"forest": lambda b: behavior_model(b, random_state=0),
+                "forest_flags_2": lambda b: ActionEffectModel(flag_weight=FLAG_WEIGHT, random_state=0),
+                "forest_as_were": lambda b: ActionEffectModel(action_inputs=0, flag_weight=1.0, random_state=0),
+                "extra_trees": lambda b: behavior_model(b, trees="extra", random_state=0),
+                "knn": lambda b: KnnEffectModel()}
     scores = {name: {"p": [], "y": [], "place_p": [], "place_y": [], "fit": 0.0} for name in learners}
     rng = np.random.default_rng(0)
     for behavior in BEHAVIORS:
@@ -82,7 +86,7 @@ def main() -> None:
         place = Place((0.0, 0.0), PLACE_TOLERANCE)
         for name, make in learners.items():
             start = time.perf_counter()
-            model = make().fit(X, Y)
+            model = make(behavior).fit(X, Y)
             scores[name]["fit"] += time.perf_counter() - start
             for goal in GOALS:
                 truth = goal.reached(Yt)
