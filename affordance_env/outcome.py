@@ -90,7 +90,7 @@ class ObjectMonitor:
         #: its centre carried beyond the table top's edges, above the top's height, has not left the table. A
         #: grasp near the near edge draws the object a few millimetres toward the robot as the fingers close on it
         #: and lift it (a 4.6 cm ball 8 mm inside the edge: its centre 1 mm beyond it, 5 mm up, in the closing
-        #: hand, then carried and put down 7 cm away), and a held object may pass over the edge on its way to where
+        #: hand, then carried and put down 8.6 cm away), and a held object may pass over the edge on its way to where
         #: it is put down.
         self.held = False
         self._time = float(time)

@@ -169,7 +169,8 @@ class TapAffordanceEnv(gym.Env):
     tick from the start of the step, whatever the arm is doing (:mod:`affordance_env.outcome`). Once the arm is
     back home and still, the simulation goes on until the object is at rest (still for 50 ms after the first
     touch; for the grasp, after the hand opened), has left the table (detected the moment its centre crosses the
-    table's edge), or ``settle_timeout`` seconds have passed since then; then the final snapshot is taken.
+    table's edge; in the grasp's closed hand, once it is let go beyond the edge or its centre drops below the
+    top), or ``settle_timeout`` seconds have passed since then; then the final snapshot is taken.
 
     ## Info
     The step's ``info`` is made from the typed result of its interaction

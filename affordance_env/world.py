@@ -366,7 +366,8 @@ class World:
         final = None if fault else end.snapshot  # after a fault the state is not to be trusted
         final_pose = np.full(7, np.nan) if fault else end.pose
         failure = failure_reason(fault, initial, done, end.still, touched, b)
-        # Travel on the table: to where the object rests, or to where it left the table (not where it fell).
+        # Travel on the table: to where the object rests, or to where it left the table (not where it fell; for an
+        # object in the grasp's hand beyond the edge, where its centre dropped below the top or the hand let go).
         p_end = monitor.exit_position if end.left_table else final_pose
         displacement = 0.0 if fault else norm(p_end[:2] - initial.pose[:2])
         labels = None if fault else outcome_labels(monitor, initial.pose[3:], final_pose[3:], self.roll_threshold)

@@ -50,7 +50,8 @@ MIN_SLOPE_NEIGHBOURS = 4.0
 #: 0, a quarter of the objects held out), weights 1 / 2 / 4 gave Brier scores of "the grasp lifts it" of
 #: 0.112 / 0.099 / 0.089, of a grasp's move goals 0.046 / 0.042 / 0.038 and of its place goals 0.102 / 0.095 / 0.090;
 #: the strokes' and the draw's stayed within 0.002 but rose with 4 (the draw's place goals 0.049 / 0.050 / 0.052),
-#: and the single-step planner of that run did worst with 4: 2 is the middle.
+#: and the single-step planner of that run did worst with 4: 2 is the middle, for all but the grasp, whose flags
+#: weigh more (:data:`BEHAVIOR_FLAG_WEIGHTS`).
 FLAG_WEIGHT = 2.0
 #: Behaviours whose flags weigh otherwise (:func:`behavior_model`). The grasp's: whether it lifts the object turns
 #: on its size against the hand's span (in training, boxes over 7 cm are never held, under 7 cm four in five times),
@@ -386,6 +387,7 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
 
 def behavior_model(behavior: str, **kwargs) -> ActionEffectModel:
     """The unfitted effect model of ``behavior``: its flags weighing :data:`BEHAVIOR_FLAG_WEIGHTS` (else
-    :data:`FLAG_WEIGHT`), ``kwargs`` the other arguments of :class:`ActionEffectModel`. What ``affordance plan`` and
-    the shipped action-conditioned default models fit."""
-    return ActionEffectModel(flag_weight=BEHAVIOR_FLAG_WEIGHTS.get(behavior, FLAG_WEIGHT), **kwargs)
+    :data:`FLAG_WEIGHT`) unless ``kwargs`` say otherwise, ``kwargs`` the arguments of :class:`ActionEffectModel`.
+    What ``affordance plan`` and the shipped action-conditioned default models fit."""
+    kwargs.setdefault("flag_weight", BEHAVIOR_FLAG_WEIGHTS.get(behavior, FLAG_WEIGHT))
+    return ActionEffectModel(**kwargs)

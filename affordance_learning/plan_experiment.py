@@ -386,8 +386,8 @@ def _direction_heuristic(start: np.ndarray, target: np.ndarray) -> str:
 #: the env draws its goals but within 45 degrees of +x: drawn uniformly in direction, a goal lies toward the robot
 #: in a tenth of the episodes only, the table's near edge being 14 cm in front of the objects.
 TOWARD_ROBOT_EVERY = 4
-#: The behaviours that bring an object toward the robot: the draw, and the grasp that puts it down there. An
-#: episode toward the robot records whether each could act on the object where it started (``pulls_at_start``:
+#: The behaviours that bring an object toward the robot: the draw, and the grasp that puts it down there. A
+#: planner's episode toward the robot records whether each could act on the object where it started (``pulls_at_start``:
 #: ``feasible`` of its canonical action).
 PULLING = ("draw", "grasp")
 #: Objects drawn at most for an episode toward the robot: one within about 28-30 cm of the robot leaves no room (or

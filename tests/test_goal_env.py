@@ -82,12 +82,23 @@ def test_pick_and_place_puts_a_held_object_down_at_rest_where_asked(env, object_
     assert not env.feasible("grasp", (1.0, 0.0, 0.0), state=start)
 
 
-def test_a_ball_grasped_at_the_near_edge_and_put_down_on_the_table_stays_on_it(env):
+def test_a_ball_grasped_at_the_near_edge_and_put_down_on_the_table_stays_on_it(env, monkeypatch):
     # 8 mm inside the table's near edge, the closing fingers draw the ball's centre 1 mm beyond it, 5 mm up, and
-    # the hand carries it 8 cm away and puts it down: held over the edge, it never left the table
+    # the hand carries it 8.6 cm away and puts it down: held over the edge, it never left the table
+    from affordance_env.outcome import ObjectMonitor
+
+    samples, sample = [], ObjectMonitor.sample
+
+    def recorded(monitor, time, p, v, w):
+        samples.append((monitor, monitor.held, p[0]))
+        sample(monitor, time, p, v, w)
+
+    monkeypatch.setattr(ObjectMonitor, "sample", recorded)
     x_edge = float(env.unwrapped.world.table.high[0])
     env.reset(seed=0, options={"object_type": "sphere", "size": 0.0456, "position": (x_edge - 0.008, 0.109)})
     _, _, _, _, info = env.step({"behavior": "grasp", "params": np.array([-0.37, -0.23, -0.52], np.float32)})
+    assert any(held and x > x_edge for _, held, x in samples)  # in the hand, over the edge
+    assert not samples[-1][1] and not samples[-1][0].held  # let go: the monitor knows it
     assert info["failure"] is None and info["success"]
     assert info["outcome"] == "rest" and info["object"]["pose"][0] < x_edge - 0.05
 

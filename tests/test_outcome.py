@@ -128,7 +128,7 @@ def test_an_object_held_over_the_edge_has_not_left_the_table_until_it_falls():
     monitor.sample(0.02, start, *still)
     assert not monitor.left_table
     monitor.sample(0.03, np.array([0.0, -0.52, TABLE_TOP - 0.01]), *still)
-    assert monitor.left_table and monitor.exit_time == 0.03
+    assert monitor.left_table and monitor.exit_time == 0.03 and monitor.exit_position[1] == -0.52
     monitor = ObjectMonitor(TABLE_TOP, LOW, HIGH, start, 0.0)
     monitor.held = True
     monitor.sample(0.01, over_the_edge, *still)
