@@ -191,6 +191,18 @@ def test_extending_equals_collecting_at_once(reference, tmp_path):
         collect(out, 16, workers=1, **RUN)
 
 
+def test_a_dataset_labelled_before_is_not_extended_with_rows_labelled_otherwise(tmp_path):
+    import json
+
+    out = tmp_path / "d"
+    collect(out, 4, seed=1, env_options=SMALL, chunk_size=4, progress=False)
+    manifest = json.loads((out / "manifest.json").read_text())
+    del manifest["labels_version"]  # as written before the labels' version was recorded: version 1
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(DatasetError, match="other settings.*labels_version: dataset has 1, asked for 2"):
+        collect(out, 8, seed=1, env_options=SMALL, chunk_size=4, progress=False)
+
+
 def test_other_settings_are_refused_naming_them(tmp_path):
     out = tmp_path / "d"
     collect(out, 4, seed=1, env_options=SMALL, chunk_size=4, progress=False)

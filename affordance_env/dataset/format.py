@@ -3,8 +3,9 @@
 A dataset is a directory::
 
     manifest.json          what the dataset is: settings, package version, feature names and groups, schema
-                           version, progress, the interactions left out (count, kinds, episode -> reason), and
-                           the SHA-256 of every finished chunk (``chunk_sha256``)
+                           version, labels version (:data:`LABELS_VERSION`), progress, the interactions left out
+                           (count, kinds, episode -> reason), and the SHA-256 of every finished chunk
+                           (``chunk_sha256``)
     chunk-00000.parquet    interactions 0 .. chunk_size-1, one row each (columns: :func:`arrow_schema`)
     chunk-00001.parquet    ...
     .lock                  held by the collection writing the dataset (empty)
@@ -55,6 +56,11 @@ if TYPE_CHECKING:  # the results are made by the simulator, which reading a data
 #: ``initial_x``, beside the features) and the images ``image_initial_range`` ... (``initial_range``), and
 #: recorded each chunk's SHA-256 in the manifest.
 SCHEMA_VERSION = 5
+#: Version of what the rows' labels mean, for the same columns: a dataset is resumed or extended only with rows
+#: labelled as its own (one written before this was recorded is of version 1). Version 2: an object the grasp's
+#: hand holds beyond the table's edge has not left the table (``outcome``; version 1 said ``"off_table"`` the
+#: moment its centre crossed the edge, in the hand or not).
+LABELS_VERSION = 2
 FORMAT = "tap-affordance-dataset"
 MANIFEST = "manifest.json"
 METADATA_KEY = b"tap_affordance"
@@ -214,8 +220,8 @@ def dataset_header(seed: int, action: str, chunk_size: int, env_options: dict, s
 
     settings = {"seed": int(seed), "action": action, "chunk_size": int(chunk_size),
                 "save_images": bool(save_images), "env_id": env_id, "env_options": env_options}
-    return {"format": FORMAT, "schema_version": SCHEMA_VERSION, "package_version": __version__,
-            "settings": settings, "feature_names": list(FEATURE_NAMES),
+    return {"format": FORMAT, "schema_version": SCHEMA_VERSION, "labels_version": LABELS_VERSION,
+            "package_version": __version__, "settings": settings, "feature_names": list(FEATURE_NAMES),
             "feature_groups": dict(FEATURE_GROUPS)}
 
 
@@ -239,6 +245,7 @@ def _flat_settings(description: dict) -> dict[str, Any]:
     settings = with_later_defaults(settings) if isinstance(settings, dict) else {}
     env_options = settings.pop("env_options", None)
     return {"schema_version": description.get("schema_version"),
+            "labels_version": description.get("labels_version", 1),
             "package_version": description.get("package_version"),
             **settings, **(env_options if isinstance(env_options, dict) else {})}
 
