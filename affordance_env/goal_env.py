@@ -47,7 +47,6 @@ def draw_target(xy: np.ndarray, rng: np.random.Generator, low, high, distance: t
     return None
 
 
-
 def goal_distance(achieved_goal: np.ndarray, desired_goal: np.ndarray) -> np.ndarray:
     """Distance on the table [m] between achieved and desired goals, (..., 2) -> (...)."""
     return np.linalg.norm(np.asarray(achieved_goal, dtype=float) - np.asarray(desired_goal, dtype=float), axis=-1)

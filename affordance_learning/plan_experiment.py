@@ -162,8 +162,7 @@ def place_target(start_xy: np.ndarray, rng: np.random.Generator, draws: int = 10
     """A place ``PLACE_DISTANCE`` from ``start_xy`` [m] in a uniform direction, where the goal env puts its goals:
     at least ``GOAL_TABLE_MARGIN`` inside the table top's edges and in some behaviour's workspace (a place beyond
     the edge is no place an object can be put). Raises RuntimeError if ``draws`` draws find none."""
-    (x0, y0), (x1, y1) = table_extent()
-    target = draw_target(start_xy, rng, np.array([x0, y0]), np.array([x1, y1]), PLACE_DISTANCE, draws=draws)
+    target = draw_target(start_xy, rng, *table_extent(), PLACE_DISTANCE, draws=draws)
     if target is not None:
         return target
     raise RuntimeError(f"No place {PLACE_DISTANCE} m from the object at {np.asarray(start_xy).tolist()} lies "

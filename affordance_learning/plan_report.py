@@ -15,7 +15,15 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.plan_experiment import GOAL_KINDS, MULTI_POLICIES, POLICIES, SHAPES, share_text, wilson
+from affordance_learning.plan_experiment import (
+    GOAL_KINDS,
+    MULTI_POLICIES,
+    POLICIES,
+    PULLING,
+    SHAPES,
+    share_text,
+    wilson,
+)
 from affordance_learning.plan_results import NOTHING, PlanResults, Share
 
 #: The targets of the planner, each a (direction, value): ">=" or "<=".
@@ -287,15 +295,9 @@ def _why(name: str, results: PlanResults) -> str:
         pulls = (f"of the {len(missed)} missed, {len(no_draw)} started where the draw, the one behaviour that pulls, "
                  f"cannot reach behind the object{where}, {neither} of them out of the grasp's reach too (their "
                  "canonical actions not feasible); " if missed else "")
-        reached = ""
-        if (draw := _pullable(towards, ("draw",))) is not None:
-            either = _pullable(towards, ("draw", "grasp"))
-            reached = ("; where the draw could act on the object at the start, the planner reached "
-                       + share_text(draw[0] / draw[1] if draw[1] else None, draw[1], wilson(*draw), "episodes",
-                                    digits=1)
-                       + ", where the draw or the grasp could, "
-                       + share_text(either[0] / either[1] if either[1] else None, either[1], wilson(*either),
-                                    "episodes", digits=1))
+        draw = _reached_where(towards, ("draw",))
+        reached = ("" if draw is None else f"; where the draw could act on the object at the start, the planner "
+                   f"reached {draw}, where the draw or the grasp could, {_reached_where(towards, PULLING)}")
         return (f"{pulls}{beyond} of the {len(towards)} targets toward the robot lay further than the episode's "
                 "interactions took any object of their type toward it in training" + reached)
     if name.startswith("each left-out"):
@@ -330,13 +332,14 @@ _FAILURE_KINDS = {
 }
 
 
-def _pullable(towards, behaviors: tuple[str, ...]) -> tuple[int, int] | None:
-    """(reached, n) over the episodes toward the robot that started where one of ``behaviors`` could act on the
-    object (``pulls_at_start``); None where that was not recorded for every one of them."""
+def _reached_where(towards, behaviors: tuple[str, ...]) -> str | None:
+    """The share reached (:func:`share_text`) of the episodes toward the robot that started where one of
+    ``behaviors`` could act on the object (``pulls_at_start``); None where that was not recorded for every one."""
     if not towards or any(e.pulls_at_start is None for e in towards):
         return None
     able = [e for e in towards if any(e.pulls_at_start.get(b, False) for b in behaviors)]
-    return sum(e.success for e in able), len(able)
+    k, n = sum(e.success for e in able), len(able)
+    return share_text(k / n if n else None, n, wilson(k, n), "episodes", digits=1)
 
 
 def multi_step_why(results: PlanResults | Mapping[str, Any]) -> str:
