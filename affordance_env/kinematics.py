@@ -115,6 +115,9 @@ class Kinematics:
         self._reach_pin = np.array([names.index(name) for name in self.variant.reach_joints])
         #: Indices of the reach joints in active-joint order.
         self.reach_dofs = np.array([self.joint_names.index(name) for name in self.variant.reach_joints])
+        #: The limits every IK keeps to [rad]: the joints' own, narrowed by the variant's ``ik_ranges`` (what the
+        #: scene forbids); the same arrays as ``lower`` and ``upper`` where it has none.
+        self.ik_lower, self.ik_upper = self._narrowed(self.lower, self.upper, self.variant.ik_ranges)
         #: What :meth:`solve_ik` derives from its arguments alone, kept across calls (a line of the palm asks for
         #: the same joint ranges and damping at every waypoint): limits by joint ranges, regularisers by damping.
         self._limits: dict[tuple, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
@@ -148,16 +151,23 @@ class Kinematics:
     def joint_limits(
         self, joint_ranges: Mapping[str, tuple[float, float]] | None = None
     ) -> tuple[np.ndarray, np.ndarray]:
-        """(lower, upper) joint limits [rad], in the variant's active-joint order: the model's, narrowed by
-        ``joint_ranges``.
+        """(lower, upper) joint limits [rad] the IK keeps to, in the variant's active-joint order: the model's,
+        narrowed by the variant's ``ik_ranges`` and by ``joint_ranges``.
 
         Args:
             joint_ranges: ``{joint name: (low, high)}`` for joints of the variant's reach joints; each range is
-                intersected with the model's. None or empty: the model's limits themselves (the arrays, not copies).
+                intersected with the limits. None or empty: ``(ik_lower, ik_upper)`` themselves (the arrays, not
+                copies).
         """
+        return self._narrowed(self.ik_lower, self.ik_upper, joint_ranges)
+
+    def _narrowed(self, lower: np.ndarray, upper: np.ndarray, joint_ranges: Mapping[str, tuple[float, float]] | None
+                  ) -> tuple[np.ndarray, np.ndarray]:
+        """``(lower, upper)`` intersected with ``joint_ranges`` (reach joints only); the arrays themselves if none."""
         if not joint_ranges:
-            return self.lower, self.upper
-        lower, upper = self.lower.copy(), self.upper.copy()
+            return lower, upper
+        base_lower, base_upper = lower, upper
+        lower, upper = lower.copy(), upper.copy()
         reach = self.variant.reach_joints
         for name, (low, high) in joint_ranges.items():
             if name not in reach:
@@ -166,7 +176,7 @@ class Kinematics:
             lower[j], upper[j] = max(lower[j], float(low)), min(upper[j], float(high))
             if not lower[j] <= upper[j]:
                 raise InvalidValueError(f"joint_ranges: {name!r} range ({low}, {high}) misses the joint's limits "
-                                 f"({self.lower[j]:.3f}, {self.upper[j]:.3f}) rad.")
+                                 f"({base_lower[j]:.3f}, {base_upper[j]:.3f}) rad.")
         return lower, upper
 
     def _ik_limits(self, joint_ranges: Mapping[str, tuple[float, float]] | None

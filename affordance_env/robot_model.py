@@ -174,6 +174,9 @@ class RobotVariant:
         mk3_hand: Whether the left hand is the fingered mk3 hand (moving or held).
         held: Joints that do not move and are held at these angles [rad] instead of at zero (the other arm at its
             home pose).
+        ik_ranges: Narrower ranges ``{joint: (low, high)}`` [rad] of reach joints that every inverse kinematics of
+            this variant keeps to, on top of the joints' own limits: what the scene itself forbids (see
+            :data:`HELD_ARM_TORSO_RANGES`).
         palm_sites: MuJoCo sites at the palms' centres, (site, frame) pairs; ``palm`` is the one the relation
             features are measured to.
         palm_site: The site at the acting palm's centre.
@@ -190,6 +193,7 @@ class RobotVariant:
     fingered: bool
     mk3_hand: bool = False
     held: Mapping[str, float] = dataclasses.field(default_factory=dict)
+    ik_ranges: Mapping[str, tuple[float, float]] = dataclasses.field(default_factory=dict)
     palm_sites: tuple[tuple[str, str], ...] = (("palm", HAND_FRAME),)
     palm_site: str = "palm"
 
@@ -236,13 +240,26 @@ HELD_AT_HOME: dict[str, dict[str, float]] = {
              **{distal: float(coupled_position(distal, HAND_OPEN[proximal]))
                 for distal, (proximal, _) in HAND_COUPLINGS.items()}},
 }
+#: How far the torso may lean while the left arm acts and the right one is held at home beside it (the scene with both
+#: arms), on top of the joints' own limits [rad]: pitched forward at most 35 degrees, rolled to -15 degrees at most.
+#: The held right arm is rigid and touches the table: pitching further and rolling further negative lowers its
+#: forearm onto the table top, which then holds the torso up short of where the inverse kinematics put it.
+#: Unbounded, the grasp's IK pitched the torso 45-50 degrees and rolled it -25 to -30 for objects 38-42 cm in front
+#: of the robot, and those grasps closed their fingers 3 cm above and 2 cm beside where they were planned, on
+#: nothing. Within these ranges the held arm stays at least 1.4 cm above the table top at every torso yaw (its
+#: collision meshes against the table over the whole box, in 5 degree steps). The draw keeps the same 35 degrees
+#: for the same reason (``affordance_env.behaviors.draw.DRAW_JOINT_RANGES``).
+HELD_ARM_TORSO_RANGES: dict[str, tuple[float, float]] = {
+    "torso_pitch": (-np.pi, float(np.radians(35.0))),
+    "torso_roll": (float(np.radians(-15.0)), np.pi),
+}
 _TWO_PALMS = (("palm", HAND_FRAME), ("left_palm", "l_hand_dh_frame"))
 VARIANTS["two_arms"] = dataclasses.replace(
     VARIANTS["tap"], name="two_arms", mk3_hand=True, held=HELD_AT_HOME["left"],
     contact_links=CONTACT_LINKS + _LEFT_CONTACT_LINKS,
     camera_visible_links=CAMERA_VISIBLE_LINKS + _LEFT_VISIBLE_LINKS, palm_sites=_TWO_PALMS)
 VARIANTS["two_arms_left"] = dataclasses.replace(
-    VARIANTS["grasp"], name="two_arms_left", held=HELD_AT_HOME["right"],
+    VARIANTS["grasp"], name="two_arms_left", held=HELD_AT_HOME["right"], ik_ranges=HELD_ARM_TORSO_RANGES,
     contact_links=_LEFT_CONTACT_LINKS + CONTACT_LINKS,
     camera_visible_links=_LEFT_VISIBLE_LINKS + CAMERA_VISIBLE_LINKS, palm_sites=_TWO_PALMS, palm_site="left_palm")
 

@@ -103,6 +103,22 @@ def test_a_ball_grasped_at_the_near_edge_and_put_down_on_the_table_stays_on_it(e
     assert info["outcome"] == "rest" and info["object"]["pose"][0] < x_edge - 0.05
 
 
+def test_a_grasp_40_cm_out_lifts_the_ball_without_leaning_onto_the_held_arm(env):
+    # There the torso's IK, unbounded, pitched it 49 degrees and rolled it -29: the held right arm's forearm met the
+    # table and held the torso up, and the hand closed 3 cm above the ball, on nothing
+    world = env.unwrapped.world
+    held_arm_on_table = []
+    world.on_step(lambda time: held_arm_on_table.append("chest" in world.physics.links_touching_table()))
+    try:
+        env.reset(seed=0, options={"object_type": "sphere", "size": 0.07, "position": (-0.40, 0.10), "yaw": 0.0})
+        assert env.feasible("grasp", np.zeros(3))
+        _, _, _, _, info = env.step({"behavior": "grasp", "params": np.zeros(3, np.float32)})
+    finally:
+        world.on_step(None)
+    assert held_arm_on_table and not any(held_arm_on_table)
+    assert info["failure"] is None and info["success"] and info["grasp"]["rise"] > 0.05
+
+
 def test_feasible_from_a_snapshot_answers_for_it_and_leaves_the_env_as_it_was(env):
     env.reset(seed=0, options={"object_type": "box", "size": 0.06, "position": (-0.30, 0.05)})
     start = env.get_state()
@@ -231,7 +247,7 @@ def test_feasible_answers_as_the_whole_ik_budget_would_in_fewer_iterations(env, 
             answers[check] += [env.feasible(b, a) for b, a in actions]
         spent[check] = sum(iterations)
     assert answers[True] == answers[False] and 0 < sum(answers[True]) < len(answers[True])
-    assert spent[True] < 0.9 * spent[False]  # 15 % fewer here
+    assert spent[True] < 0.95 * spent[False]  # 9 % fewer here (the grasp's IK, bounded, slides along its torso range)
 
 
 def test_feasible_refuses_a_grasp_whose_lift_from_a_high_first_touch_is_out_of_reach(env):

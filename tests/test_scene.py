@@ -177,3 +177,33 @@ def test_joint_queries_follow_the_simulation_in_every_variant(variant):
         np.testing.assert_array_equal(physics.joint_velocities(), physics.data.qvel[physics.robot_qvel])
         np.testing.assert_array_equal(physics.joint_positions(), physics.data.qpos[physics.robot_qpos])
     assert np.abs(physics.joint_velocities()).max() > 0.1  # the robot moves
+
+
+def test_the_held_right_arm_stays_above_the_table_within_the_left_arms_torso_ranges():
+    # HELD_ARM_TORSO_RANGES' claim: anywhere in the box (5 degree steps, every yaw) the held arm's collision meshes
+    # stay at least 1.4 cm above the table top; beyond it (the 49 degrees and -29 an unbounded grasp IK asked for)
+    # its forearm is in the table
+    from affordance_env.robot_model import HELD_ARM_TORSO_RANGES, get_variant
+
+    assert get_variant("two_arms_left").ik_ranges == HELD_ARM_TORSO_RANGES
+    model = build_model("two_arms_left")
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    table = model.geom("table_top").id
+    chest = model.body("chest").id
+    held = [g for g in range(model.ngeom) if model.geom_bodyid[g] == chest and model.geom_contype[g]]
+    assert len(held) == 3  # the right forearm, wrist and hand
+    adr = {name: model.joint(name).qposadr[0] for name in ("torso_pitch", "torso_roll", "torso_yaw")}
+    (_, pitch_max), (roll_min, _) = HELD_ARM_TORSO_RANGES["torso_pitch"], HELD_ARM_TORSO_RANGES["torso_roll"]
+
+    def clearance(pitch: float, roll: float, yaw: float) -> float:
+        data.qpos[adr["torso_pitch"]], data.qpos[adr["torso_roll"]], data.qpos[adr["torso_yaw"]] = pitch, roll, yaw
+        mujoco.mj_kinematics(model, data)
+        return min(mujoco.mj_geomDistance(model, data, g, table, 0.5, None) for g in held)
+
+    lower, upper = model.jnt_range[model.joint("torso_pitch").id]
+    box = [clearance(p, r, y) for p in np.arange(lower, pitch_max + 1e-9, np.radians(5.0))
+           for r in np.arange(roll_min, model.jnt_range[model.joint("torso_roll").id][1] + 1e-9, np.radians(5.0))
+           for y in np.radians(np.arange(-50.0, 50.1, 10.0))]
+    assert min(box) > 0.01
+    assert clearance(np.radians(49.0), np.radians(-29.0), np.radians(8.0)) < 0.0
