@@ -241,7 +241,7 @@ HELD_AT_HOME: dict[str, dict[str, float]] = {
                 for distal, (proximal, _) in HAND_COUPLINGS.items()}},
 }
 #: How far the torso may lean while the left arm acts and the right one is held at home beside it (the scene with both
-#: arms), on top of the joints' own limits [rad]: pitched forward at most 35 degrees, rolled to -15 degrees at most.
+#: arms), on top of the joints' own limits [rad]: pitched forward at most 35 degrees, rolled to -20 degrees at most.
 #: The held right arm is rigid and touches the table: pitching further and rolling further negative lowers its
 #: forearm onto the table top, which then holds the torso up short of where the inverse kinematics put it.
 #: Unbounded, the grasp's IK pitched the torso 45-50 degrees and rolled it -25 to -30 for objects 38-42 cm in front
@@ -251,7 +251,7 @@ HELD_AT_HOME: dict[str, dict[str, float]] = {
 #: for the same reason (``affordance_env.behaviors.draw.DRAW_JOINT_RANGES``).
 HELD_ARM_TORSO_RANGES: dict[str, tuple[float, float]] = {
     "torso_pitch": (-np.pi, float(np.radians(35.0))),
-    "torso_roll": (float(np.radians(-15.0)), np.pi),
+    "torso_roll": (float(np.radians(-20.0)), np.pi),
 }
 _TWO_PALMS = (("palm", HAND_FRAME), ("left_palm", "l_hand_dh_frame"))
 VARIANTS["two_arms"] = dataclasses.replace(
