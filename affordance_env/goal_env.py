@@ -164,9 +164,9 @@ class TapAffordanceGoalEnv(gym.Env):
       Fixed since its first release: an object the hand holds over the table's edge has not left the table
       (``outcome`` ``"off_table"`` only once it is let go, or falls, there); a grasp of an object within a centimetre
       of the near edge was labelled off the table, wherever it was put down. The left arm's inverse kinematics keeps
-      the torso within ``HELD_ARM_TORSO_RANGES`` (pitch at most 35 degrees, roll at least -20): unbounded, grasps
-      38-42 cm in front of the robot leaned it onto the held right arm, whose forearm met the table and held the
-      torso up, and the hand closed above the object.
+      the torso within ``affordance_env.robot_model.HELD_ARM_TORSO_RANGES`` (pitch at most 35 degrees, roll at
+      least -20): unbounded, grasps 38-42 cm in front of the robot leaned it onto the held right arm, whose forearm
+      met the table and held the torso up, and the hand closed above the object.
     * v1: the motors of TapAffordance-v2 (each with its torque-speed curve) and its hand's controller (a finger's
       target kept within its servo's reach of the finger); the put-down lowers a held object at 2 cm/s, carries it
       along a straight line to above where it goes, and stops where fingertips under it meet the table first. Data

@@ -38,7 +38,9 @@ MAX_CACHED_RANGES = 32
 #: episodes, those whose whole budget ends within the caller's tolerances (5 mm, 0.35 rad) never varied by less than
 #: 0.44 % over 21 iterations beyond them (one stood at 33 mm for 40 iterations, then fell to 3 mm): a spread of
 #: 0.1 % keeps a margin of 4 (a window of 11 iterations would leave none). Those that give up save 23 % of all
-#: iterations.
+#: iterations. (Measured before the left arm's torso was bounded in the scene with both arms,
+#: ``affordance_env.robot_model.HELD_ARM_TORSO_RANGES``: the bounded grasp IK slides along the bound before its error
+#: stands still, and gives up later.)
 STALL_WINDOW, STALL_SPREAD, STALL_MARGIN = 20, 1e-3, 1.05
 
 
@@ -47,8 +49,9 @@ class IKResult:
     """Outcome of :meth:`Kinematics.solve_ik`.
 
     Attributes:
-        q: Joint configuration reached, in the variant's active-joint order [rad]; within the joint limits (and
-            the ``joint_ranges`` asked for).
+        q: Joint configuration reached, in the variant's active-joint order [rad]; within the joint limits the IK
+            keeps to (:meth:`Kinematics.joint_limits`: the variant's ``ik_ranges`` and the ``joint_ranges`` asked
+            for).
         success: Whether both errors are within the requested tolerances.
         position_error: Distance between reached and target hand position [m].
         orientation_error: Angle between reached and target hand orientation [rad] (0 if none was asked).
@@ -108,7 +111,7 @@ class Kinematics:
                 raise InvalidValueError(f"Frame {frame!r} does not exist in the model. Available frames: {available}")
         self.hand_frame_id = self.model.getFrameId(hand_frame)
         self.head_frame_id = self.model.getFrameId(head_frame)
-        #: Joint limits [rad] in active-joint order.
+        #: The model's (URDF) joint limits [rad] in active-joint order; the IK keeps to ``ik_lower`` and ``ik_upper``.
         self.lower = self.model.lowerPositionLimit[self._from_pin].copy()
         self.upper = self.model.upperPositionLimit[self._from_pin].copy()
         #: Indices of the reach joints in Pinocchio's order (the IK works in that order).
@@ -117,7 +120,7 @@ class Kinematics:
         self.reach_dofs = np.array([self.joint_names.index(name) for name in self.variant.reach_joints])
         #: The limits every IK keeps to [rad]: the joints' own, narrowed by the variant's ``ik_ranges`` (what the
         #: scene forbids); the same arrays as ``lower`` and ``upper`` where it has none.
-        self.ik_lower, self.ik_upper = self._narrowed(self.lower, self.upper, self.variant.ik_ranges)
+        self.ik_lower, self.ik_upper = self._narrowed(self.lower, self.upper, self.variant.ik_ranges, "ik_ranges")
         #: What :meth:`solve_ik` derives from its arguments alone, kept across calls (a line of the palm asks for
         #: the same joint ranges and damping at every waypoint): limits by joint ranges, regularisers by damping.
         self._limits: dict[tuple, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = {}
@@ -159,11 +162,12 @@ class Kinematics:
                 intersected with the limits. None or empty: ``(ik_lower, ik_upper)`` themselves (the arrays, not
                 copies).
         """
-        return self._narrowed(self.ik_lower, self.ik_upper, joint_ranges)
+        return self._narrowed(self.ik_lower, self.ik_upper, joint_ranges, "joint_ranges")
 
-    def _narrowed(self, lower: np.ndarray, upper: np.ndarray, joint_ranges: Mapping[str, tuple[float, float]] | None
-                  ) -> tuple[np.ndarray, np.ndarray]:
-        """``(lower, upper)`` intersected with ``joint_ranges`` (reach joints only); the arrays themselves if none."""
+    def _narrowed(self, lower: np.ndarray, upper: np.ndarray, joint_ranges: Mapping[str, tuple[float, float]] | None,
+                  what: str) -> tuple[np.ndarray, np.ndarray]:
+        """``(lower, upper)`` intersected with ``joint_ranges`` (reach joints only; ``what`` names them in errors);
+        the arrays themselves if none."""
         if not joint_ranges:
             return lower, upper
         base_lower, base_upper = lower, upper
@@ -171,11 +175,11 @@ class Kinematics:
         reach = self.variant.reach_joints
         for name, (low, high) in joint_ranges.items():
             if name not in reach:
-                raise InvalidValueError(f"joint_ranges: {name!r} is not a joint the IK moves; those are {reach}.")
+                raise InvalidValueError(f"{what}: {name!r} is not a joint the IK moves; those are {reach}.")
             j = self.joint_names.index(name)
             lower[j], upper[j] = max(lower[j], float(low)), min(upper[j], float(high))
             if not lower[j] <= upper[j]:
-                raise InvalidValueError(f"joint_ranges: {name!r} range ({low}, {high}) misses the joint's limits "
+                raise InvalidValueError(f"{what}: {name!r} range ({low}, {high}) misses the limits the IK keeps to "
                                  f"({base_lower[j]:.3f}, {base_upper[j]:.3f}) rad.")
         return lower, upper
 
@@ -227,9 +231,9 @@ class Kinematics:
     ) -> IKResult:
         """Damped least-squares IK of the palm over the variant's reach joints (torso and arm).
 
-        The neck and the fingers keep their values from ``q_init``. Every iterate is clipped to the joint limits
-        (narrowed by ``joint_ranges``), so the returned configuration is always feasible; ``success`` tells whether
-        it reaches the target.
+        The neck and the fingers keep their values from ``q_init``. Every iterate is clipped to
+        :meth:`joint_limits` (the variant's ``ik_ranges``, narrowed by ``joint_ranges``), so the returned
+        configuration is always feasible; ``success`` tells whether it reaches the target.
 
         Args:
             p_world_target: Target palm position in the world frame [m], shape (3,).

@@ -135,7 +135,8 @@ class HandTarget:
 
     Attributes:
         R_world_hand: Palm orientation in the world frame (3x3 rotation matrix).
-        joint_ranges: Narrower ranges for some joints, ``{name: (low, high)}`` [rad]; None: the joints' own.
+        joint_ranges: Narrower ranges for some joints, ``{name: (low, high)}`` [rad]; None: the joints' own,
+            narrowed by the robot variant's ``ik_ranges``.
     """
 
     R_world_hand: np.ndarray

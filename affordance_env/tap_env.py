@@ -243,7 +243,9 @@ class TapAffordanceEnv(gym.Env):
       not 2), and the hand's controller keeps each finger's target within its servo's reach of the finger, so a
       finger that loses the object never outruns its limit; the put-down is slower (2 cm/s). Data of v1 are not
       comparable. Fixed since its first release: an object the hand holds over the table's edge has not left the
-      table (a grasp's ``outcome`` was ``"off_table"`` for an object within a centimetre of the near edge).
+      table (a grasp's ``outcome`` was ``"off_table"`` for an object within a centimetre of the near edge). With
+      ``two_arms=True`` the grasp's inverse kinematics keeps the torso within
+      ``affordance_env.robot_model.HELD_ARM_TORSO_RANGES``: further, it leaned onto the held right arm.
     * v1: the iCub's motor limits (joint speeds planned within 100 deg/s for the arm, torso and neck and 180 deg/s
       for the fingers, motor torques limited, gravity compensation included), stiff contacts (10 ms, impedance
       0.995), the palm's restitution 0.3, every move one minimum-jerk or line trajectory with feedforward, the

@@ -6,7 +6,7 @@ import pytest
 
 from affordance_env.behaviors import BEHAVIORS
 from affordance_env.kinematics import Kinematics
-from affordance_env.robot_model import ACTIVE_JOINTS
+from affordance_env.robot_model import ACTIVE_JOINTS, HELD_ARM_TORSO_RANGES
 
 
 @pytest.fixture(scope="module")
@@ -65,10 +65,31 @@ def test_ik_keeps_to_narrower_joint_ranges(kinematics):
     assert kinematics.lower[wrist] <= result.q[wrist] <= -0.30
     # without ranges, the limits are the model's
     assert kinematics.joint_limits(None)[0] is kinematics.lower
+    assert kinematics.ik_lower is kinematics.lower and kinematics.ik_upper is kinematics.upper
+
+
+def test_the_left_arms_ik_keeps_the_torso_off_the_held_right_arm():
+    # in the scene with both arms, from home to 41 cm out, the unbounded grasp IK pitches the torso 46 degrees and
+    # rolls it -28, which lowers the held right arm onto the table
+    from affordance_env.behaviors.grasp import grasp_orientation
+    from affordance_env.scene import home_qpos
+
+    left = Kinematics(variant="two_arms_left")
+    pitch, roll = left.joint_names.index("torso_pitch"), left.joint_names.index("torso_roll")
+    lower, upper = left.joint_limits()
+    assert lower is left.ik_lower and upper is left.ik_upper
+    assert upper[pitch] == HELD_ARM_TORSO_RANGES["torso_pitch"][1] < left.upper[pitch]
+    assert lower[roll] == HELD_ARM_TORSO_RANGES["torso_roll"][0] > left.lower[roll]
+    home = home_qpos("two_arms_left")
+    result = left.solve_ik(np.array([-0.41, 0.06, 0.0]), np.array([home[name] for name in left.joint_names]),
+                           grasp_orientation(0.0))
+    assert result.success and result.q[pitch] <= upper[pitch] and result.q[roll] >= lower[roll]
+    with pytest.raises(ValueError, match="misses the limits the IK keeps to"):
+        left.joint_limits({"torso_pitch": (0.7, 0.8)})
 
 
 @pytest.mark.parametrize("ranges, match", [({"neck_yaw": (0.0, 0.1)}, "not a joint the IK moves"),
-                                           ({"r_wrist_yaw": (0.5, 0.6)}, "misses the joint's limits")])
+                                           ({"r_wrist_yaw": (0.5, 0.6)}, "misses the limits the IK keeps to")])
 def test_bad_joint_ranges_raise(kinematics, ranges, match):
     with pytest.raises(ValueError, match=match):
         kinematics.solve_ik(np.array([-0.30, 0.08, 0.0]), np.zeros(kinematics.nq), joint_ranges=ranges)

@@ -31,8 +31,9 @@ def test_every_motor_has_its_torque_limit_and_carries_gravity_compensation(varia
 
 
 def test_the_torso_holds_both_arms_when_a_grasp_leans_it_over_the_table():
-    # A grasp that leans the torso 0.66 rad forward in the scene with both arms: with one 20 N m motor's torque at
-    # the torso pitch (instead of the differential's two) it fell forward onto the table on its way home.
+    # A grasp that leans the torso forward as far as the scene with both arms lets it (35 degrees; it leaned 0.66 rad
+    # before the bound): with one 20 N m motor's torque at the torso pitch (instead of the differential's two) it fell
+    # forward onto the table on its way home.
     env = TapAffordanceEnv(behavior="grasp", two_arms=True, camera_width=32, camera_height=24)
     env.reset(seed=0, options={"object_type": "vertical_cylinder", "size": 0.0435, "position": (-0.3116, 0.0458)})
     pitch = env.physics.variant.active_joints.index("torso_pitch")
@@ -41,6 +42,7 @@ def test_the_torso_holds_both_arms_when_a_grasp_leans_it_over_the_table():
                                            targets.append(physics.joint_targets()[pitch]))
     _, _, _, _, info = env.step(np.array([0.664, 0.678, -0.721], np.float32))
     assert info["failure"] is None and info["success"]
+    assert max(targets) > np.radians(34.0)  # leaning to its bound
     assert max(angles) < max(targets) + 0.02  # never leaning further than it was sent (it fell to 0.92 rad)
 
 
