@@ -17,6 +17,8 @@ from affordance_learning.default_model import (
     predict_effect,
     train_action_models,
 )
+from affordance_learning.effect_model import BEHAVIOR_FLAG_WEIGHTS, FLAG_WEIGHT
+from affordance_learning.plan_experiment import fit_models
 
 N = len(FEATURE_NAMES)
 
@@ -113,8 +115,6 @@ def test_the_shipped_models_predict_each_behaviours_way(monkeypatch, tmp_path):
 
 
 def test_the_plan_and_the_shipped_models_fit_each_behaviour_with_its_flag_weight(tmp_path):
-    from affordance_learning.effect_model import BEHAVIOR_FLAG_WEIGHTS, FLAG_WEIGHT
-    from affordance_learning.plan_experiment import fit_models
 
     frame = goal_frame(120)
     frame["behavior"] = np.where(frame["behavior"] == "push", "grasp", "tap")  # the grasp's flags weigh more

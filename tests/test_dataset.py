@@ -192,8 +192,6 @@ def test_extending_equals_collecting_at_once(reference, tmp_path):
 
 
 def test_a_dataset_labelled_before_is_not_extended_with_rows_labelled_otherwise(tmp_path):
-    import json
-
     out = tmp_path / "d"
     collect(out, 4, seed=1, env_options=SMALL, chunk_size=4, progress=False)
     manifest = json.loads((out / "manifest.json").read_text())

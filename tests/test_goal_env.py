@@ -9,6 +9,7 @@ import affordance_env  # noqa: F401 (registers the envs)
 from affordance_env.features import FEATURE_NAMES
 from affordance_env.goal_env import BEHAVIORS, FlatActionWrapper, TapAffordanceGoalEnv, goal_distance
 from affordance_env.objects import as_resting, object_geometry
+from affordance_env.outcome import ObjectMonitor
 from affordance_env.tap_env import TapAffordanceEnv
 from affordance_env.workspace import in_any_workspace, in_workspace, sample_in_workspace
 
@@ -85,8 +86,6 @@ def test_pick_and_place_puts_a_held_object_down_at_rest_where_asked(env, object_
 def test_a_ball_grasped_at_the_near_edge_and_put_down_on_the_table_stays_on_it(env, monkeypatch):
     # 8 mm inside the table's near edge, the closing fingers draw the ball's centre 1 mm beyond it, 5 mm up, and
     # the hand carries it 8.6 cm away and puts it down: held over the edge, it never left the table
-    from affordance_env.outcome import ObjectMonitor
-
     samples, sample = [], ObjectMonitor.sample
 
     def recorded(monitor, time, p, v, w):

@@ -5,8 +5,10 @@ import numpy as np
 import pytest
 
 from affordance_env.behaviors import BEHAVIORS
+from affordance_env.behaviors.grasp import grasp_orientation
 from affordance_env.kinematics import Kinematics
 from affordance_env.robot_model import ACTIVE_JOINTS, HELD_ARM_TORSO_RANGES
+from affordance_env.scene import home_qpos
 
 
 @pytest.fixture(scope="module")
@@ -71,8 +73,6 @@ def test_ik_keeps_to_narrower_joint_ranges(kinematics):
 def test_the_left_arms_ik_keeps_the_torso_off_the_held_right_arm():
     # in the scene with both arms, from home to 41 cm out, the unbounded grasp IK pitches the torso 46 degrees and
     # rolls it -28, which lowers the held right arm onto the table
-    from affordance_env.behaviors.grasp import grasp_orientation
-    from affordance_env.scene import home_qpos
 
     left = Kinematics(variant="two_arms_left")
     pitch, roll = left.joint_names.index("torso_pitch"), left.joint_names.index("torso_roll")
