@@ -214,8 +214,9 @@ class RangeCamera:
         self._scratch = np.empty(self._n_rays)
         self._scratch_test = np.empty(self._n_rays, dtype=bool)
         #: The geoms of group 0 other than the support face and the planes, for the geom groups they were read from
-        #: (``set_object`` moves the object's geoms between group 0 and a hidden one): ``(groups, geoms)``.
-        self._others: tuple[bytes, np.ndarray] | None = None
+        #: (``set_object`` moves the object's geoms between group 0 and a hidden one): ``(groups, geoms, whether they
+        #: are exactly the geoms of group 0 on moving bodies)``.
+        self._others: tuple[bytes, np.ndarray, bool] | None = None
 
     def _support_face(self, name: str) -> tuple[int, float, np.ndarray, np.ndarray]:
         """(geom id, height, lower and upper x-y corners) of the upward face of the box ``name``."""
@@ -241,25 +242,32 @@ class RangeCamera:
         return int(geom), top, centre[:2] - half[:2], centre[:2] + half[:2]
 
     def _cast(self, data: mujoco.MjData, p_world_camera: np.ndarray, d_world: np.ndarray, rays: np.ndarray,
-              group: np.ndarray, normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+              group: np.ndarray, normal: np.ndarray | None, static: bool = True) -> tuple[np.ndarray, np.ndarray]:
         """MuJoCo's nearest hit (geom ids, distances [m]; normals written into ``normal``, (3 * rays.size,)) of
-        the rays ``rays`` (flat pixel indices; ``d_world``: the unit ray directions as rows x, y, z, (3, n))."""
+        the rays ``rays`` (flat pixel indices; ``d_world``: the unit ray directions as rows x, y, z, (3, n)) among
+        the geoms of ``group``; ``static=False``: only those of bodies that are not fixed to the world."""
         ids, dist = np.empty(rays.size, np.int32), np.empty(rays.size)
         # The rays' directions gathered as (rays.size, 3) rows, the layout mj_multiRay reads (a copy either way).
         directions = d_world.take(rays, axis=1).T.copy()
-        mujoco.mj_multiRay(self.model, data, p_world_camera, directions.reshape(-1), group, True, -1, ids, dist,
+        mujoco.mj_multiRay(self.model, data, p_world_camera, directions.reshape(-1), group, static, -1, ids, dist,
                            normal, rays.size, self.max_range)
         return ids, dist
 
-    def _world_others(self, support: int) -> np.ndarray:
+    def _world_others(self, support: int) -> tuple[np.ndarray, bool]:
         """The geoms of group 0 that may end a ray before the support face ``support``: all but that box and the
-        planes (which lie below it). Recomputed only when the geom groups changed since the last call."""
+        planes (which lie below it), and whether none of them is fixed to the world (a cast among the bodies that
+        are not, ``static=False``, then meets exactly them). Recomputed only when the geom groups changed since
+        the last call."""
         groups = self.model.geom_group
         key = groups.tobytes()  # 4 bytes per geom: cheaper to compare than the geoms are to find again
         if self._others is None or self._others[0] != key:
+            world = np.flatnonzero(groups == 0)
             others = np.flatnonzero((groups == 0) & self._not_plane)
-            self._others = key, others[others != support]
-        return self._others[1]
+            others = others[others != support]
+            model = self.model
+            moving = world[model.body_weldid[model.geom_bodyid[world]] != 0]
+            self._others = key, others, np.array_equal(moving, others)
+        return self._others[1], self._others[2]
 
     def _world_pass(self, data: mujoco.MjData, p_world_camera: np.ndarray, R_world_camera: np.ndarray,
                     d_world: np.ndarray, normal: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, bool]:
@@ -298,15 +306,34 @@ class RangeCamera:
             geom_ids, dist = np.full(n, geom, np.int32), t
             if normal is not None:
                 normal[:] = (0.0, 0.0, 1.0)
-            cast = np.logical_not(on_face, out=on_face)  # the rays that miss the face ...
+            face = on_face
+            cast = np.logical_not(on_face)  # the rays that miss the face ...
         else:  # the camera below the face never sees its top: every ray is cast
             geom_ids, dist = np.empty(n, np.int32), np.empty(n)
-            cast = np.ones(n, dtype=bool)
+            face, cast = None, np.ones(n, dtype=bool)
         # ... and the face's rays that may meet the other geoms of group 0 (the object), which may end them first.
-        others = self._world_others(geom)
-        if others.size:
-            K = self.intrinsics
+        others, moving = self._world_others(geom)
+        K = self.intrinsics
+        face_rays = None
+        if others.size and face is not None and moving:
+            # The face's rays near the object are cast among the moving bodies alone (those geoms, see
+            # _world_others): the face ends them at t, and MuJoCo's nearest hit among the floor (below the face),
+            # the table (t) and the others is the others' where it is nearer than t, or as near and of a lower id.
+            near = np.zeros((K.height, K.width), dtype=bool)
+            self._mark_near(others, data, p_world_camera, R_world_camera, near)
+            face_rays = np.logical_and(near.ravel(), face, out=face).nonzero()[0]  # the near rays off it are cast
+        elif others.size:
             self._mark_near(others, data, p_world_camera, R_world_camera, cast.reshape(K.height, K.width))
+        if face_rays is not None and face_rays.size:
+            face_normal = None if normal is None else np.empty(3 * face_rays.size)
+            ids, ray_dist = self._cast(data, p_world_camera, d_world, face_rays, self._world_group, face_normal,
+                                       static=False)
+            on_face_dist = dist[face_rays]
+            nearer = (ids >= 0) & ((ray_dist < on_face_dist) | ((ray_dist == on_face_dist) & (ids < geom)))
+            hit = face_rays[nearer]
+            geom_ids[hit], dist[hit] = ids[nearer], ray_dist[nearer]
+            if normal is not None:
+                normal[hit] = face_normal.reshape(-1, 3)[nearer]
         rays = cast.nonzero()[0]
         if not rays.size:
             return geom_ids, dist, False
