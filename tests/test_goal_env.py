@@ -261,6 +261,21 @@ def test_feasible_refuses_a_grasp_whose_lift_from_a_high_first_touch_is_out_of_r
     assert not info["ik"]["success"]
 
 
+@pytest.mark.parametrize(("object_type", "xy", "size", "params"), [
+    ("vertical_cylinder", (-0.2381, 0.1192), 0.0679, (-0.868, 0.683, -0.867)),
+    ("box", (-0.2199, 0.2022), 0.0473, (-0.951, 0.317, -0.177)),
+])
+def test_feasible_refuses_a_pick_and_place_whose_carry_ends_out_of_reach(env, object_type, xy, size, params):
+    # Put down at the edge of the left arm's reach: the object hangs in the closed hand 1-2 cm from where the grasp
+    # aimed it, so the carry, which brings the object over the place asked, ends that far beyond the nominal pose,
+    # out of reach (the nominal pose and the line to it are within it).
+    env.reset(seed=0, options={"object_type": object_type, "size": size, "position": xy})
+    params = np.array(params, dtype=np.float32)
+    assert not env.feasible("grasp", params)
+    _, _, _, _, info = env.step({"behavior": "grasp", "params": params})
+    assert not info["ik"]["success"]
+
+
 def test_bad_actions_options_and_goals_get_clear_errors(env):
     env.reset(seed=0)
     with pytest.raises(ValueError, match="Unknown behavior 'kick'"):
