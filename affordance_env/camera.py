@@ -155,9 +155,11 @@ class RangeCamera:
         support: Name of a static, axis-aligned box of group 0 whose upward face most rays end on (the table top),
             or None. The rays that meet that face are intersected with its plane in closed form, a few
             nanoseconds each instead of MuJoCo's generic ray query (150-300 ns per ray in this scene); MuJoCo still
-            casts every ray that misses the face, and every ray that something else of group 0 (the object) may
-            end first: inside the image rectangle that bounds that geom's box and the cone of its bounding sphere.
-            The image is the same, to the last bits of the face's ranges.
+            casts every ray that misses the face, among all of group 0, and every ray that something else of group
+            0 (the object) may end first, among the moving bodies alone (the face ends it otherwise): inside the
+            image rectangle that bounds that geom's box and the cone of its bounding sphere. The image is the same:
+            the same geoms hit and the same float32 ranges; a face pixel's float64 distance (and point) may differ
+            from MuJoCo's box distance in its last bit.
 
     Group 0 is ray cast for every pixel; the geoms of the other groups (the arm's detailed meshes, whose rays
     cost microseconds each) only in a second pass, for the pixels whose rays may meet them (inside the image

@@ -86,9 +86,9 @@ def interaction_action(seed: int, episode: int, action: str) -> np.ndarray:
 PARAM_DRAWS = 10
 #: How goal episodes are collected, recorded in the settings of every goal dataset (a dataset collected otherwise
 #: is not resumed with it): only feasible actions are run; an episode ends where none is drawn or the head does
-#: not see the object. What ``feasible`` checks is part of the rule: since it checks a grasp's carry and put-down
-#: to where the held object is expected to hang, a dataset whose grasps it chose before is not resumed.
-GOAL_EPISODE_RULE = (f"feasible actions only (a grasp's carry and put-down checked to where the object hangs), the "
+#: not see the object. What ``feasible`` checks is part of the rule: since it checks the end of a pick and place's
+#: carry where the held object will hang, a dataset whose grasps it chose before is not resumed.
+GOAL_EPISODE_RULE = (f"feasible actions only (a pick and place's carry checked where the object hangs), the "
                      f"behaviours in a random order, {PARAM_DRAWS} draws each per step; truncated where none is or the "
                      "object is not seen")
 
