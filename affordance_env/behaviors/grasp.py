@@ -362,7 +362,8 @@ def grasp_reachable(motion: MotionExecutor, plan: GraspPlan) -> bool:
     both ends are checked.
     Every pose and line decides the answer by whether it is reached: each IK gives up once it stands still
     (``check``). The carry's and the put-down's lines are not checked: of 200 random pick and place draws, those
-    lines refused 3 whose poses were all reachable, and 2 of them reached (the third's object was not seen)."""
+    lines refused 3 whose poses were all reachable, and 2 of those reached (the third, whose object the head had
+    not seen at the start, did not)."""
     above, at, lifted = grasp_poses(motion, plan, check=True)
     hand = hand_target(plan)
     place = motion.ik(plan.p_put_down, lifted.q, hand, check=True)
