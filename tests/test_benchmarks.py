@@ -16,6 +16,7 @@ ROOT = Path(__file__).resolve().parents[1]
     ["benchmarks/step_cost.py", "--episodes", "2", "--rounds", "1"],
     ["benchmarks/draw.py", "--episodes", "2"],
     ["benchmarks/feasible.py", "--draws", "3"],  # patches MotionExecutor.ik to time the IK's whole budget
+    ["benchmarks/put_down_offset.py", "--draws", "4"],  # wraps MotionExecutor.line and grasp.plan_grasp
 ])
 def test_benchmark_runs(argv):
     done = subprocess.run([sys.executable, *argv], cwd=ROOT, capture_output=True, text=True, timeout=600)
