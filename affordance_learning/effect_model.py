@@ -367,9 +367,11 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
     @staticmethod
     def weighted_share(weights: sparse.csr_matrix, hits: np.ndarray) -> np.ndarray:
         """(m,) the weighted share of each query's training outcomes that ``hits`` marks, ``hits`` given for the
-        stored entries of ``weights`` (CSR, in its order)."""
-        return np.add.reduceat(np.append(weights.data * hits, 0.0), weights.indptr[:-1])[: weights.shape[0]] \
+        stored entries of ``weights`` (CSR, in its order). At most 1: weights that sum to 1 may add up to an ulp
+        more in floating point."""
+        share = np.add.reduceat(np.append(weights.data * hits, 0.0), weights.indptr[:-1])[: weights.shape[0]] \
             * (np.diff(weights.indptr) > 0)
+        return np.minimum(share, 1.0, out=share)
 
     def sample(self, X, n_samples: int, random_state: int | np.random.Generator | None = None) -> np.ndarray:
         """(m, n_samples, n_outcomes) outcomes drawn from each query's predictive distribution

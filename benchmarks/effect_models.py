@@ -101,8 +101,6 @@ def main() -> None:
     for name, s in scores.items():
         for key, goals in (("", "all"), ("place_", "place")):
             p, y = np.concatenate(s[f"{key}p"]), np.concatenate(s[f"{key}y"])
-            # a share of weights that sum to 1 in floating point may exceed 1 by an ulp, which scikit-learn refuses
-            p = np.clip(p, 0.0, 1.0)
             clipped = np.clip(p, 1e-3, 1 - 1e-3)
             print(f"{name:<15} {goals:<6} {log_loss(y, clipped):9.3f} {brier_score_loss(y, p):7.3f} "
                   f"{calibration(p, y)['ece']:7.3f} {roc_auc_score(y, p):7.3f} {s['fit']:8.1f}")

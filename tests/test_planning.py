@@ -7,6 +7,7 @@ import json
 import numpy as np
 import pandas as pd
 import pytest
+from scipy import sparse
 
 from affordance_learning.effect_model import ActionEffectModel
 from affordance_learning.goals import Lift, Move, Percept, Place, Roll, goal_from_dict
@@ -531,3 +532,13 @@ def test_an_episode_toward_the_robot_takes_an_object_the_table_leaves_room_for_s
     assert target[0] <= SCENE_TABLE[1][0] - GOAL_TABLE_MARGIN + 1e-9
     # an episode that is not one toward the robot keeps the goal env's object and target
     np.testing.assert_allclose(obs_kept["achieved_goal"][0], -0.22, atol=0.01)
+
+
+def test_a_weighted_share_is_at_most_one():
+    # weights that sum to 1 may add up to an ulp more in floating point; a probability may not
+    w = np.array([0.18620170802956595, 0.1387585731752892, 0.23867430191277866, 0.2082440595395123,
+                  0.0006989935750115445, 0.21884975106272195, 0.008572612705120415])
+    assert np.add.reduceat(np.append(w, 0.0), [0])[0] > 1.0  # the sum, as the share adds it
+    weights = sparse.csr_matrix(w[None, :])
+    share = ActionEffectModel.weighted_share(weights, np.ones(w.size))
+    assert share.tolist() == [1.0]
