@@ -349,3 +349,51 @@ def test_locate_gives_the_window_capture_s_object_pixels_and_points():
         assert points.flags.c_contiguous  # summed row after row, as p_world_points[mask] is
         seen += pixels.size > 0
     assert 0 < seen
+
+
+SUPPORT_SCENE = """
+<mujoco>
+  <worldbody>
+    <geom name="floor" type="plane" size="2 2 0.1" pos="0 0 0"/>
+    <geom name="table" type="box" size="0.4 0.5 0.02" pos="0 0 0.5"/>
+    {post}
+    <body name="ball" pos="-0.05 0.05 0.56">
+      <freejoint/>
+      <geom name="ball" type="sphere" size="0.04"/>
+    </body>
+    <camera name="above" pos="0.7 0 1.1" xyaxes="0 1 0 -0.6 0 0.8" fovy="60"/>
+    <camera name="below" pos="0.7 0 0.515" xyaxes="0 1 0 -0.15 0 1" fovy="60"/>
+  </worldbody>
+</mujoco>
+"""
+
+
+@pytest.mark.parametrize("camera", ["above", "below"])
+@pytest.mark.parametrize("static_post", [True, False])
+def test_the_support_face_gives_mujocos_image_beside_a_fixed_geom_and_from_below(camera, static_post):
+    # A geom of group 0 fixed to the world beside the object (the rays near it are cast among all of group 0, not
+    # among the moving bodies alone), and a camera below the face (which never sees its top: every ray is cast):
+    # the closed-form face must give the image MuJoCo gives alone.
+    box = '<geom name="post" type="box" size="0.03 0.03 0.06"/>'
+    # a post fixed to the world, or on a body of its own (then every geom beside the face moves)
+    where = 'pos="0.12 -0.1 0.58"'
+    xml = box.replace("/>", f" {where}/>") if static_post else f"<body {where}><freejoint/>{box}</body>"
+    model = mujoco.MjModel.from_xml_string(SUPPORT_SCENE.format(post=xml))
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    ball, post = model.geom("ball").id, model.geom("post").id
+    fast = RangeCamera(model, camera, width=64, height=48, geom_groups=(0,), support="table")
+    slow = RangeCamera(model, camera, width=64, height=48, geom_groups=(0,))
+    for normals in (False, True):
+        a = fast.capture(data, normals=normals, occluded=ball)
+        b = slow.capture(data, normals=normals, occluded=ball)
+        np.testing.assert_array_equal(a.geom_ids, b.geom_ids)
+        np.testing.assert_array_equal(a.ranges, b.ranges)
+        mask = a.mask_of(ball)
+        np.testing.assert_array_equal(a.p_world_points[mask], b.p_world_points[mask])
+        if normals:
+            np.testing.assert_array_equal(a.normals, b.normals)
+    assert {ball, post} <= set(np.unique(a.geom_ids).tolist())  # both are in view ...
+    on_table = a.p_world_points[a.geom_ids == model.geom("table").id]
+    top = fast._support[1]
+    assert (np.abs(on_table[:, 2] - top) < 1e-9).any() == (camera == "above")  # ... and the face only from above
