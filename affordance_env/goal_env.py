@@ -168,8 +168,10 @@ class TapAffordanceGoalEnv(gym.Env):
       least -20): unbounded, grasps 38-42 cm in front of the robot leaned it onto the held right arm, whose forearm
       met the table and held the torso up, and the hand closed above the object. ``feasible`` checks the carry's
       end where it will be (the held object hangs 1-2 cm from where the grasp aimed it, and the carry brings it
-      over the place), not the nominal pose, where 9 of 122 pick and place grasps it accepted failed to reach. The
-      interactions are unchanged; goal datasets collected before are not resumed.
+      over the place), not the nominal pose, where 9 of 122 pick and place grasps it accepted failed to reach; and a
+      stroke's or a draw's reach must keep its targets 2 mm from the object (they were let through down to 0 mm, and
+      the arm, following them a millimetre or two behind, touched the object on the way down in 1-2 % of the
+      planner's interactions). The interactions are unchanged; goal datasets collected before are not resumed.
     * v1: the motors of TapAffordance-v2 (each with its torque-speed curve) and its hand's controller (a finger's
       target kept within its servo's reach of the finger); the put-down lowers a held object at 2 cm/s, carries it
       along a straight line to above where it goes, and stops where fingertips under it meet the table first. Data

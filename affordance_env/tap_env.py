@@ -246,6 +246,9 @@ class TapAffordanceEnv(gym.Env):
       table (a grasp's ``outcome`` was ``"off_table"`` for an object within a centimetre of the near edge). With
       ``two_arms=True`` the grasp's inverse kinematics keeps the torso within
       ``affordance_env.robot_model.HELD_ARM_TORSO_RANGES``: further, it leaned onto the held right arm.
+      ``feasible`` refuses a stroke or draw whose reach brings the arm's targets within 2 mm of the object (it
+      allowed 0 mm, and the arm, a millimetre or two behind its targets, sometimes touched the object on the way
+      down); the interactions are unchanged.
     * v1: the iCub's motor limits (joint speeds planned within 100 deg/s for the arm, torso and neck and 180 deg/s
       for the fingers, motor torques limited, gravity compensation included), stiff contacts (10 ms, impedance
       0.995), the palm's restitution 0.3, every move one minimum-jerk or line trajectory with feedforward, the

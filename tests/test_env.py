@@ -516,6 +516,21 @@ def test_feasible_refuses_a_stroke_whose_reach_sweeps_the_arm_into_the_object():
     assert info["ik"]["success"] and info["failure"].startswith("reach: the arm moved the object")
 
 
+def test_feasible_refuses_a_reach_whose_targets_pass_within_a_few_millimetres_of_the_object(monkeypatch):
+    # A push whose reach's targets pass 0.7 mm from a box on the way down: the arm, a millimetre or two behind its
+    # targets, touches the box and moves it 7 mm before the stroke.
+    import affordance_env.behaviors.stroke as stroke
+
+    env = TapAffordanceEnv(behavior="push", position_range="workspace", camera_width=40, camera_height=30)
+    params = np.array([0.9981, -0.4757, 0.6981])
+    env.reset(seed=62)
+    assert not env.feasible(params)
+    monkeypatch.setattr(stroke, "REACH_CLEARANCE", 0.0)  # only no penetration of the targets asked: accepted
+    assert env.feasible(params)
+    _, _, _, _, info = env.step(params.astype(np.float32))
+    assert info["ik"]["success"] and info["failure"].startswith("reach: the arm moved the object by 7.2 mm")
+
+
 def test_an_object_out_of_view_is_searched_for_and_seen():
     env = TapAffordanceEnv(behavior="grasp", camera_width=32, camera_height=24)
     # 26 cm to the robot's left: outside the view of the head's first gaze, inside the grasp's workspace

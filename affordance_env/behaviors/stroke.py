@@ -181,12 +181,16 @@ def plan_stroke(
 
 #: The reach's servo targets must keep the arm's geoms (hand, fingers, wrist, forearm) at least this far from the
 #: object [m] (checked every REACH_SWEEP_STRIDE control ticks), else the stroke is not feasible: an arm that sweeps
-#: into the object moves it before the stroke (a "reach" failure). Over 150 random strokes per behaviour at
-#: positions over the workspaces, no penetration (0 m) flags 4 of 4 such failures of tap (and 4 strokes that would
-#: have moved the object less than the 3 mm allowed), 11 of 15 of tap_back (none wrongly; of the other 4, 3 started
-#: the stroke more than 1 cm from its pose and 1 passed 0.8 mm from the object on its targets) and 4 of 4 of push
-#: (1 wrongly); a 1 cm margin would refuse 8, 17 and 11 strokes that work.
-REACH_CLEARANCE, REACH_SWEEP_STRIDE = 0.0, 5
+#: into the object moves it before the stroke (a "reach" failure). The arm follows its targets to within a
+#: millimetre or two on the way down (servo lag at the reach's speed), so targets that pass nearer than that may
+#: touch: over 150 random strokes per behaviour at positions over the workspaces, no penetration (0 m) flags 4 of 4
+#: such failures of tap (and 4 strokes that would have moved the object less than the 3 mm allowed), 11 of 15 of
+#: tap_back and 4 of 4 of push (1 wrongly), and lets through strokes whose targets pass 0.6-1.3 mm from the object,
+#: which touched it on the way down and moved it 3-15 mm (1 of 571 feasible strokes and draws at random actions, 2
+#: of 150 interactions of ``affordance plan``'s multi-step episodes at seed 0, where the planner chose actions at the
+#: edge of their range); 2 mm refuses those and 8 of the 571 (1.4 %) that work, 1 cm 8, 17 and 11 strokes per 150
+#: that work.
+REACH_CLEARANCE, REACH_SWEEP_STRIDE = 0.002, 5
 #: The reach's servo targets may put the arm's geoms at most this far into the table [m] (checked at the same
 #: samples and at the pre-stroke pose), else the stroke is not feasible: the forearm then rests on the table and
 #: holds the hand off its pre-stroke pose. Over 375 random tap_backs that passed the checks above (objects over its
