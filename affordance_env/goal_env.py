@@ -18,6 +18,7 @@ from affordance_env.options import EnvOptions
 from affordance_env.placement import RESET_OPTIONS, draw_placement
 from affordance_env.registry import BEHAVIOR_ARMS, BEHAVIOR_NAMES
 from affordance_env.results import InteractionResult, Snapshot
+from affordance_env.values import float_array, restored_generator
 from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
 from affordance_env.world import World, WorldState
 
@@ -45,6 +46,15 @@ def draw_target(xy: np.ndarray, rng: np.random.Generator, low, high, distance: t
         if np.all(target >= inner_low) and np.all(target <= inner_high) and in_any_workspace(target):
             return target
     return None
+
+
+def _behavior_index(behavior: Any) -> int:
+    """A behaviour given by number: its index (an integer, or a float with an integer value), else -1."""
+    value = np.asarray(behavior) if not isinstance(behavior, Mapping | set | frozenset) else np.asarray(None)
+    if value.ndim != 0 or value.dtype.kind not in "iuf":  # not booleans, strings, None, complex numbers
+        return -1
+    number = float(value)
+    return int(number) if np.isfinite(number) and number == int(number) else -1
 
 
 def goal_distance(achieved_goal: np.ndarray, desired_goal: np.ndarray) -> np.ndarray:
@@ -255,8 +265,18 @@ class TapAffordanceGoalEnv(gym.Env):
     def compute_reward(self, achieved_goal: np.ndarray, desired_goal: np.ndarray, info: Any) -> np.ndarray | float:
         """The reward of reaching ``achieved_goal`` when ``desired_goal`` is wanted, (..., 2) each; ``info`` is
         not used. Vectorised: a batch of goals gives a batch of rewards."""
-        d = goal_distance(achieved_goal, desired_goal)
-        reward = -(d > self.goal_tolerance).astype(np.float64) if self.reward_type == "sparse" else -d
+        achieved, desired = (float_array(name, goal, finite=False, expected="positions on the table, (..., 2) [m]")
+                             for name, goal in (("achieved_goal", achieved_goal), ("desired_goal", desired_goal)))
+        if achieved.shape[-1:] != (2,) or desired.shape[-1:] != (2,):
+            raise InvalidValueError(f"achieved_goal and desired_goal must be positions on the table, (..., 2) [m], got "
+                                    f"shapes {achieved.shape} and {desired.shape}.")
+        try:
+            d = goal_distance(achieved, desired)
+        except ValueError:  # batches that do not broadcast
+            raise InvalidValueError(f"achieved_goal and desired_goal must be batches of the same length, got shapes "
+                                    f"{achieved.shape} and {desired.shape}.") from None
+        # a NaN distance (a goal without a position) is not within the tolerance: not d <= tolerance
+        reward = -(~(d <= self.goal_tolerance)).astype(np.float64) if self.reward_type == "sparse" else -d
         return float(reward) if np.ndim(reward) == 0 else reward
 
     def _check_goal(self, goal: Any) -> np.ndarray:
@@ -315,7 +335,7 @@ class TapAffordanceGoalEnv(gym.Env):
             if name not in BEHAVIORS:
                 raise InvalidValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
         else:
-            index = int(behavior) if np.ndim(behavior) == 0 and float(behavior) == int(behavior) else -1
+            index = _behavior_index(behavior)
             if not 0 <= index < len(BEHAVIORS):
                 raise InvalidValueError(f"action 'behavior' must be an index in 0..{len(BEHAVIORS) - 1} "
                                  f"({', '.join(BEHAVIORS)}), got {behavior!r}.")
@@ -376,9 +396,13 @@ class TapAffordanceGoalEnv(gym.Env):
         """Put back the world and the episode as :meth:`get_state` saw them."""
         if not isinstance(state, GoalEnvState):
             raise TypeError(f"state must be what get_state() returned (a GoalEnvState), got {type(state).__name__}.")
+        rng = restored_generator(state.rng)  # checked before anything is restored
+        goal = float_array("the state's goal", state.goal, (2,), expected="a place on the table (x, y) [m]")
+        if state.obs is not None and not isinstance(state.obs, Mapping):
+            raise InvalidValueError(f"the state is damaged: its observation is {state.obs!r:.80}.")
         self.world.set_state(state.world)
-        self.np_random.bit_generator.state = copy.deepcopy(state.rng)
-        self._goal = state.goal.copy()
+        self.np_random.bit_generator.state = rng.bit_generator.state
+        self._goal = goal.copy()
         self._obs = state.obs
 
     def render(self):
@@ -398,10 +422,9 @@ class FlatActionWrapper(gym.ActionWrapper):
         self.action_space = spaces.Box(-1.0, 1.0, (len(BEHAVIORS) + ACTION_DIM,), np.float32)
 
     def action(self, action: Any) -> dict[str, Any]:
-        a = np.asarray(action, dtype=np.float64)
-        if a.shape != self.action_space.shape or not np.all(np.isfinite(a)):
-            raise InvalidValueError(f"action must be {self.action_space.shape[0]} finite values ({len(BEHAVIORS)} "
-                                    f"behaviour scores, 3 parameters in [-1, 1]), got {action!r}.")
+        a = float_array("action", action, self.action_space.shape,
+                        expected=f"{self.action_space.shape[0]} finite values ({len(BEHAVIORS)} behaviour scores, 3 "
+                                 "parameters in [-1, 1])")
         return {"behavior": int(np.argmax(a[: len(BEHAVIORS)])), "params": a[len(BEHAVIORS):].astype(np.float32)}
 
 

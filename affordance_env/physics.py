@@ -14,7 +14,7 @@ from collections.abc import Callable
 import mujoco
 import numpy as np
 
-from affordance_env.exceptions import InvalidValueError
+from affordance_env.exceptions import IncompatibleStateError, InvalidValueError
 from affordance_env.linalg import dot, norm
 from affordance_env.objects import PRIMITIVES, ObjectGeometry
 from affordance_env.outcome import ObjectMonitor
@@ -532,14 +532,22 @@ class TapPhysics:
 
     def set_state(self, snapshot: tuple[ObjectGeometry | None, mujoco.MjData]) -> None:
         """Put the world back as :meth:`get_state` saw it: the same steps then follow, bit for bit."""
-        geometry, data = snapshot
-        if not isinstance(data, mujoco.MjData):
-            raise TypeError(f"snapshot must be what get_state() returned, got {type(snapshot).__name__}.")
+        geometry, data = snapshot if isinstance(snapshot, tuple) and len(snapshot) == 2 else (None, None)
+        if not isinstance(data, mujoco.MjData) or not (geometry is None or isinstance(geometry, ObjectGeometry)):
+            raise TypeError(f"snapshot must be what get_state() returned, got {snapshot!r:.80}.")
+        if (data.qpos.shape, data.qvel.shape, data.act.shape) != (self.data.qpos.shape, self.data.qvel.shape,
+                                                                    self.data.act.shape):
+            raise IncompatibleStateError(
+                f"the snapshot's MuJoCo data has {data.qpos.size} positions and {data.qvel.size} velocities, this "
+                f"model {self.model.nq} and {self.model.nv}: it was taken of another model.")
         current = self.geometry
         if geometry is not None and (current is None or (geometry.object_type, geometry.size)
                                      != (current.object_type, current.size)):
             self._make_object(geometry)
-        mujoco.mj_copyData(self.data, self.model, data)  # into the same arrays: the views into them stay valid
+        try:
+            mujoco.mj_copyData(self.data, self.model, data)  # into the same arrays: the views into them stay valid
+        except mujoco.FatalError as exc:  # buffers of another size: data of another model
+            raise IncompatibleStateError(f"the snapshot's MuJoCo data was made for another model ({exc}).") from None
 
     def object_pose(self) -> np.ndarray:
         """Object pose: position [m] and orientation quaternion (w, x, y, z), (7,)."""

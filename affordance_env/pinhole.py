@@ -12,6 +12,10 @@ import numpy as np
 
 from affordance_env.exceptions import InvalidValueError
 
+#: The widest and tallest image [pixels]: 4096, six times a Kinect's 640 x 480 on either side; the camera keeps a few
+#: arrays of 8 to 24 bytes per pixel (rays, distances, points), 1.2 GB at 4096 x 4096.
+MAX_RESOLUTION = 4096
+
 
 @dataclass(frozen=True)
 class Intrinsics:
@@ -27,10 +31,11 @@ class Intrinsics:
     @classmethod
     def from_fovy(cls, width: int, height: int, fovy_deg: float) -> Intrinsics:
         """Square pixels with vertical field of view ``fovy_deg`` [deg], principal point at the image centre."""
-        if not (isinstance(width, int | np.integer) and isinstance(height, int | np.integer)) or min(
-            width, height
-        ) < 2:
-            raise InvalidValueError(f"camera resolution must be integers >= 2, got width={width!r}, height={height!r}.")
+        if (not (isinstance(width, int | np.integer) and isinstance(height, int | np.integer))
+                or isinstance(width, bool) or isinstance(height, bool)
+                or min(width, height) < 2 or max(width, height) > MAX_RESOLUTION):
+            raise InvalidValueError(f"camera resolution must be integers in 2..{MAX_RESOLUTION}, got width={width!r}, "
+                                    f"height={height!r}.")
         if not 1.0 <= float(fovy_deg) <= 170.0:
             raise InvalidValueError(f"fovy_deg must be within [1, 170] degrees, got {fovy_deg!r}.")
         f = 0.5 * height / np.tan(np.deg2rad(fovy_deg) / 2.0)

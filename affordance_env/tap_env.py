@@ -27,6 +27,7 @@ from affordance_env.placement import (
     draw_placement,
 )
 from affordance_env.results import InteractionResult, Snapshot
+from affordance_env.values import restored_generator
 from affordance_env.world import World, WorldState
 
 
@@ -293,6 +294,9 @@ class TapAffordanceEnv(gym.Env):
         self.options = options
         #: The behaviour each step runs (:mod:`affordance_env.behaviors`).
         self.behavior = get_behavior(options.behavior)
+        if reward_fn is not None and not callable(reward_fn):
+            raise InvalidValueError(f"reward_fn must be a function of the step's info returning a number, got "
+                                    f"{reward_fn!r}.")
         self.reward_fn = default_reward if reward_fn is None else reward_fn
         self.render_mode = render_mode
         #: The world the behaviour acts in: the robot, the table, the object, the camera.
@@ -377,7 +381,12 @@ class TapAffordanceEnv(gym.Env):
         else:
             obs = observation(result.final)
         info = result.info()
-        return obs, float(self.reward_fn(info)), True, False, info
+        reward = self.reward_fn(info)
+        try:
+            reward = float(reward)
+        except (TypeError, ValueError):
+            raise InvalidValueError(f"reward_fn must return a number, returned {reward!r}.") from None
+        return obs, reward, True, False, info
 
     def feasible(self, params: Any) -> bool:
         """Whether the arm can reach every pose of the interaction with ``params`` on the object where the last
@@ -396,8 +405,9 @@ class TapAffordanceEnv(gym.Env):
         another model than the tap, tap back and push, and ``two_arms=True`` another again."""
         if not isinstance(state, EnvState):
             raise TypeError(f"state must be what get_state() returned (an EnvState), got {type(state).__name__}.")
+        rng = restored_generator(state.rng)  # checked before anything is restored
         self.world.set_state(state.world)
-        self.np_random.bit_generator.state = copy.deepcopy(state.rng)
+        self.np_random.bit_generator.state = rng.bit_generator.state
 
     def _record_frame(self, time: float) -> None:
         if time >= self._next_frame_time - 1e-9:

@@ -420,17 +420,24 @@ class World:
         that arm (IncompatibleStateError otherwise)."""
         if not isinstance(state, WorldState):
             raise TypeError(f"state must be what get_state() returned (a WorldState), got {type(state).__name__}.")
-        arm = self._arms.get(state.arm)
+        arm = self._arms.get(state.arm) if isinstance(state.arm, str) else None
         if arm is None or arm.variant != state.variant:
             have = ", ".join(f"{name} arm: {a.variant!r}" for name, a in self._arms.items())
             raise IncompatibleStateError(
                 f"the state was made with the {state.variant!r} robot model of the {state.arm} arm; this world has "
                 f"{have}: a state restores only into a world of the same robot model (behavior='grasp' builds "
                 "another model than the strokes, and two_arms=True another again).")
+        q_home = np.asarray(state.q_home) if isinstance(state.q_home, np.ndarray) else None
+        if (q_home is None or q_home.shape != arm.physics.joint_targets().shape or q_home.dtype.kind != "f"
+                or not np.all(np.isfinite(q_home))):
+            raise InvalidValueError(f"the state is damaged: its home posture is {state.q_home!r:.80}, not the "
+                                    "arm's joint angles.")
+        if state.initial is not None and not isinstance(state.initial, InitialSnapshot):
+            raise InvalidValueError(f"the state is damaged: its observation is {state.initial!r:.80}.")
         arm.physics.set_state(state.physics)
         self._acting = arm
         self._initial = state.initial
-        self._q_home = state.q_home.copy()
+        self._q_home = q_home.copy()
 
     # --- pictures ------------------------------------------------------------------------------------------------
     def on_step(self, callback: Callable[[float], None] | None) -> None:

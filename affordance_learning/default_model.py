@@ -41,6 +41,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import ArrayLike
 
+from affordance_env.values import float_array
 from affordance_learning.behaviors import check_behavior
 from affordance_learning.exceptions import DefaultModelError, DefaultModelMissingError, InvalidValueError
 from affordance_learning.model import AffordanceModel, EffectPrediction
@@ -67,6 +68,8 @@ FORMAT = 3
 #: The command that rebuilds the default tap model (see :func:`rebuild_command` for the others).
 REBUILD_COMMAND = "affordance train-default"
 _N_FEATURES = 49
+#: The largest float32: the models (their trees, scikit-learn's scalers) read their inputs as float32.
+_FLOAT32_MAX = float(np.finfo(np.float32).max)
 
 
 def user_model_dir() -> Path:
@@ -298,7 +301,11 @@ def predict_effect(
                 "expected the names of affordance_env's FEATURE_NAMES."
             )
         features = features[names].to_numpy()
-    X = np.asarray(features)
+    try:
+        X = np.asarray(features)
+    except (ValueError, TypeError):  # ragged rows
+        raise InvalidValueError(f"features must be real numbers, ({_N_FEATURES},) or (n, {_N_FEATURES}), got "
+                                f"{features!r}.") from None
     if X.dtype == object or not (np.issubdtype(X.dtype, np.number) or X.dtype == bool) or np.iscomplexobj(X):
         raise InvalidValueError(f"features must be real numbers, got dtype {X.dtype}.")
     if X.ndim not in (1, 2) or X.shape[-1] != _N_FEATURES or (X.ndim == 2 and X.shape[0] == 0):
@@ -312,6 +319,9 @@ def predict_effect(
         count, row, col, value = found
         raise InvalidValueError(
             f"features must be finite; row {row}, feature {col} is {value} ({count} non-finite value(s)).")
+    largest = float(np.max(np.abs(X)))
+    if largest > _FLOAT32_MAX:  # the models compare float32 inputs: larger values would be infinite
+        raise InvalidValueError(f"features must be within +-{_FLOAT32_MAX:.3g} (float32), got one of {largest!r}.")
     if action is not None:
         return _predict_action(X, behavior, action, path, single)
     model, names = _load_checked(path, behavior)
@@ -473,7 +483,8 @@ def load_action_model(behavior: str = "tap", path: str | Path | None = None):
 def _predict_action(X: np.ndarray, behavior: str, action: ArrayLike, path: str | Path | None,
                     single: bool) -> ActionEffectPrediction:
     """:func:`predict_effect` with an ``action``: the action-conditioned model's mean outcome."""
-    a = np.asarray(action, dtype=np.float64)
+    a = float_array("action", action, finite=False, error=InvalidValueError,
+                    expected="the behaviour's 3 parameters in [-1, 1], (3,) or (n, 3)")
     if a.ndim not in (1, 2) or a.shape[-1] != 3 or not np.all(np.isfinite(a)) or np.any(np.abs(a) > 1):
         raise InvalidValueError(f"action must be the behaviour's 3 parameters in [-1, 1], (3,) or (n, 3), got "
                                 f"{action!r}.")

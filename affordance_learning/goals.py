@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from affordance_env.values import float_array
 from affordance_learning.exceptions import InvalidValueError
 
 
@@ -36,12 +37,11 @@ def _column(outcomes: Any, name: str) -> np.ndarray:
             f"the outcomes lack {name!r} (an outcome table of affordance_learning.outcomes)") from None
 
 
-def _finite(name: str, value: Any, shape: tuple[int, ...] | None = None) -> np.ndarray:
-    array = np.asarray(value, dtype=np.float64)
-    if (shape is not None and array.shape != shape) or not np.all(np.isfinite(array)):
-        raise InvalidValueError(f"{name} must be {'a finite number' if not shape else f'{shape} finite values'}, "
-                         f"got {value!r}.")
-    return array
+def _finite(name: str, value: Any, shape: tuple[int, ...] | None = ()) -> np.ndarray:
+    """``value`` as a float array of ``shape`` (a number by default; None: any), finite, else InvalidValueError
+    naming it."""
+    expected = "a finite number" if shape == () else ("finite values" if shape is None else f"{shape} finite values")
+    return float_array(name, value, shape, expected=expected, error=InvalidValueError)
 
 
 @dataclass(frozen=True)
@@ -103,8 +103,8 @@ def check_start(start_xy: Any) -> np.ndarray:
     if start_xy is None:
         raise InvalidValueError("a Place goal needs start_xy, where the object is (x, y) [m]; got None.")
     try:
-        start = np.asarray(start_xy, dtype=np.float64)
-    except (TypeError, ValueError):
+        start = float_array("start_xy", start_xy, finite=False, error=InvalidValueError)
+    except InvalidValueError:
         start = np.full(1, np.nan)
     if start.ndim not in (1, 2) or start.shape[-1] != 2 or not np.all(np.isfinite(start)):
         raise InvalidValueError(f"start_xy must be where the object is, finite (x, y) [m] ((2,) or (n, 2)), got "
@@ -150,7 +150,7 @@ class Percept:
     kind = "percept"
 
     def __post_init__(self) -> None:
-        target = _finite("target_effect", self.target_effect)
+        target = _finite("target_effect", self.target_effect, None)
         if target.ndim != 1 or target.size == 0:
             raise InvalidValueError(f"target_effect must be a vector of effect features, got shape {target.shape}.")
         object.__setattr__(self, "target_effect", tuple(float(v) for v in target))
@@ -202,7 +202,7 @@ def check_goal(goal: Any) -> Goal:
 
 def goal_from_dict(data: Mapping[str, Any]) -> Goal:
     """The goal ``goal.to_dict()`` wrote; an unknown kind or a wrong field raises ValueError naming it."""
-    if not isinstance(data, Mapping) or data.get("kind") not in GOAL_KINDS:
+    if not isinstance(data, Mapping) or not isinstance(data.get("kind"), str) or data["kind"] not in GOAL_KINDS:
         raise InvalidValueError(f"a goal must be a dict with 'kind' one of {sorted(GOAL_KINDS)}, got {data!r}.")
     fields = {k: v for k, v in data.items() if k != "kind"}
     try:

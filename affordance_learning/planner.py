@@ -25,6 +25,7 @@ import numpy as np
 from scipy.stats import qmc
 
 from affordance_env.scene import table_extent
+from affordance_env.values import float_array
 from affordance_learning.behaviors import BEHAVIORS
 from affordance_learning.effect_model import ActionEffectModel, PredictiveOutcomes
 from affordance_learning.exceptions import InvalidValueError
@@ -33,6 +34,11 @@ from affordance_learning.goals import Goal, Move, Place, check_goal, check_start
 #: The scene's table top, ((x_low, y_low), (x_high, y_high)) [m] in the robot's root frame: the planner's default
 #: ``table``.
 SCENE_TABLE = table_extent()
+#: The largest float32: the trees compare their inputs as float32.
+FLOAT32_MAX = float(np.finfo(np.float32).max)
+#: Where the object is (``start_xy``) may lie this far [m] beyond the table top's edge: the centre of an object on
+#: the table is over it, but where the camera sees it (its top's mean) may hang a few centimetres over the edge.
+SEEN_MARGIN = 0.05
 #: An outcome that leaves the table counts as this far from any place [m] when actions are ranked by distance.
 OFF_TABLE_DISTANCE = 1.0
 #: The search over two interactions (:meth:`Planner.toward`): first actions looked at (the nearest on average,
@@ -182,9 +188,12 @@ class Planner:
         self.models = dict(models)
         self.threshold = float(threshold)
         self.max_checks = int(max_checks)
+        if isinstance(random_state, bool) or not isinstance(random_state, int | np.integer) or random_state < 0:
+            raise InvalidValueError(f"random_state must be an integer >= 0, got {random_state!r}.")
         self.params = candidate_params(n_candidates, random_state)
         if table is not None:
-            corners = np.asarray(table, dtype=np.float64)
+            corners = float_array("table", table, finite=False, error=InvalidValueError,
+                                  expected="the table top's ((x_low, y_low), (x_high, y_high)) [m]")
             if corners.shape != (2, 2) or not np.all(np.isfinite(corners)) or np.any(corners[0] >= corners[1]):
                 raise InvalidValueError(f"table must be the table top's ((x_low, y_low), (x_high, y_high)) [m], "
                                         f"got {table!r}.")
@@ -207,9 +216,22 @@ class Planner:
         """Remember that ``behavior`` with ``params`` failed on the object at ``start_xy`` [m] (or, without a
         position, seen with ``features``): it failed to reach it, or left it where it was. No later decision on that
         object there chooses it, or an action of ``behavior`` within :data:`REFUSAL_RADIUS` of it, again."""
+        if behavior not in self.models:
+            raise InvalidValueError(f"Unknown behavior {behavior!r}: the planner's are {', '.join(self.models)}.")
+        params = float_array("params", params, (self.params.shape[1],), error=InvalidValueError,
+                             expected=f"the behaviour's {self.params.shape[1]} finite parameters")
         where = None if start_xy is None else _check_start(start_xy)
-        seen = np.zeros(0) if features is None else np.asarray(features, dtype=np.float64).ravel()
-        self.failures.append((str(behavior), np.asarray(params, dtype=np.float64).ravel().copy(), where, seen))
+        seen = np.zeros(0) if features is None else self._inputs(features, params[None])[0, : self.n_features]
+        self.failures.append((str(behavior), params.copy(), where, seen))
+
+    def _check_where(self, start_xy) -> np.ndarray:
+        """``start_xy``, where the object is: one (x, y) [m], on the table top (:attr:`table`, widened by
+        :data:`SEEN_MARGIN`) if there is one."""
+        start = _check_start(start_xy)
+        if self.table is not None:
+            low, high = self.table
+            _check_on_table("start_xy", start_xy, start, (low - SEEN_MARGIN, high + SEEN_MARGIN))
+        return start
 
     def forget_failures(self) -> None:
         """Forget every failure noted (:meth:`note_failure`): for a new object or episode."""
@@ -236,15 +258,19 @@ class Planner:
     def _inputs(self, features: np.ndarray, params: np.ndarray | None = None) -> np.ndarray:
         """The models' inputs: ``features`` beside every row of ``params`` (default: the candidates)."""
         params = self.params if params is None else params
-        x = np.asarray(features, dtype=np.float64)
+        named = " (affordance_env.FEATURE_NAMES)" if self.n_features == 49 else ""
+        x = float_array("features", features, finite=False, error=InvalidValueError,
+                        expected=f"the object's {self.n_features} feature values{named}")
         if x.size != self.n_features or x.ndim > 2:
-            named = " (affordance_env.FEATURE_NAMES)" if self.n_features == 49 else ""
             raise InvalidValueError(
                 f"features must be the object's {self.n_features} feature values{named}, the models' "
                              f"inputs but the {self.params.shape[1]} action parameters; got shape {x.shape}.")
         x = x.ravel()
         if not np.all(np.isfinite(x)):
             raise InvalidValueError("features must be finite (the object must have been seen).")
+        largest = float(np.max(np.abs(x)))
+        if largest > FLOAT32_MAX:  # the trees compare float32 inputs: larger values would be infinite
+            raise InvalidValueError(f"features must be within +-{FLOAT32_MAX:.3g} (float32), got one of {largest!r}.")
         return np.hstack([np.repeat(x[None], len(params), axis=0), params])
 
     def on_table(self, outcomes: PredictiveOutcomes, start) -> PredictiveOutcomes:
@@ -336,9 +362,11 @@ class Planner:
         distance (:class:`Move`, :class:`Place`) the actions around the one found are scored too
         (:data:`REFINE_POINTS` within :data:`REFINE_RADIUS`), and the best of them that ranks above it is taken
         if feasible (at most :data:`REFINE_CHECKS` asked)."""
+        start = None if start_xy is None else self._check_where(start_xy)
+        if isinstance(goal, Place) and self.table is not None:
+            _check_on_table("the goal's target_xy", goal.target_xy, np.asarray(goal.target_xy), self.table)
         scores = self._score(features, goal, start_xy)
         candidates = dict.fromkeys(scores, self.params)
-        start = None if start_xy is None else _check_start(start_xy)
         seen = self._inputs(features)[0, : self.n_features]
         asked: dict[tuple[str, int], bool] = {}
         best = self._first_feasible(self._ranked(scores, goal), feasible, self._excluded(seen, start, candidates),
@@ -393,7 +421,7 @@ class Planner:
         goal = Place(target_xy, tolerance)
         target = np.asarray(goal.target_xy)
         _check_on_table("target_xy", target_xy, target, self.table)
-        start = _check_start(start_xy)
+        start = self._check_where(start_xy)
         X = self._inputs(features)
         features = X[0, : self.n_features]
         names = list(self.models)

@@ -227,6 +227,9 @@ def check_fingerprint(where: str | Path, workers: int = 1) -> FingerprintCheck:
     except (OSError, ValueError) as exc:
         raise InvalidValueError(f"{where / FINGERPRINT} cannot be read ({exc}); write it with `affordance fingerprint "
                          f"{where}`.") from None
+    if not isinstance(expected, dict) or not isinstance(expected.get("interactions"), list):
+        raise InvalidValueError(f"{where / FINGERPRINT} is not a fingerprint (an object with its 'interactions'); "
+                                f"write it again with `affordance fingerprint {where}`.")
     return compare_fingerprints(expected, _collect_reference(where, workers))
 
 

@@ -137,3 +137,113 @@ def test_predict_effect_gives_one_result_for_one_vector_and_a_batch_for_a_batch(
     np.testing.assert_array_equal(one.effect, batch.effect[1])
     row = predict_effect(features[1:2])  # a batch of one stays a batch
     assert row.category.shape == (1,) and row.effect.shape == (1, N)
+
+
+# --- values that are not numbers --------------------------------------------------------------------------------
+NOT_NUMBERS = ("abc", ["a", "b", "c"], b"abc", {"a": 1}, {1, 2, 3}, [[0], [0, 0], 0], [1j, 0, 0], [True, False, True],
+               ["0.1", "0", "0"])
+
+
+def test_an_action_that_is_not_three_real_numbers_is_refused_naming_it():
+    env = TapAffordanceEnv(camera_width=32, camera_height=24)
+    env.reset(seed=0)
+    for action in NOT_NUMBERS:
+        for call in (env.step, env.feasible):
+            with pytest.raises(ValueError, match=r"action must be 3 real numbers in \[-1, 1\], got") as error:
+                call(action)
+            assert repr(action) in str(error.value)
+    assert env.step([0, 0, 0])[4]["failure"] is None  # plain numbers in a list are an action
+
+
+def test_the_goal_envs_behaviour_must_be_a_name_or_an_integer_index():
+    from affordance_env.goal_env import TapAffordanceGoalEnv
+
+    env = TapAffordanceGoalEnv(camera_width=32, camera_height=24)
+    env.reset(seed=0)
+    for behavior in (np.nan, np.inf, None, True, 1j, b"tap", 1.5, -1, 5):
+        with pytest.raises(ValueError, match=r"'behavior' must be an index in 0..4") as error:
+            env.feasible(behavior, np.zeros(3))
+        assert repr(behavior) in str(error.value)
+    assert isinstance(env.feasible(np.int64(0), np.zeros(3)), bool) and isinstance(env.feasible(2.0, np.zeros(3)), bool)
+
+
+def test_compute_reward_refuses_goals_that_are_not_positions_and_never_rewards_a_nan_goal():
+    from affordance_env.goal_env import TapAffordanceGoalEnv
+
+    env = TapAffordanceGoalEnv(camera_width=32, camera_height=24)
+    assert env.compute_reward(np.zeros(2), np.zeros(2), {}) == 0.0  # reached
+    assert env.compute_reward(np.zeros(2), np.array([np.nan, np.nan]), {}) == -1.0  # a goal without a place
+    np.testing.assert_array_equal(env.compute_reward(np.zeros((3, 2)), np.full((3, 2), 0.5), {}), -np.ones(3))
+    for achieved, desired, match in ((np.zeros(3), np.zeros(2), r"\(\.\.\., 2\) \[m\], got shapes \(3,\) and \(2,\)"),
+                                     (np.zeros((3, 2)), np.zeros((4, 2)), "same length, got shapes"),
+                                     ("ab", np.zeros(2), "achieved_goal must be positions")):
+        with pytest.raises(ValueError, match=match):
+            env.compute_reward(achieved, desired, {})
+
+
+def test_the_planner_refuses_what_is_not_a_number_and_a_start_off_the_table(planner):
+    with pytest.raises(ValueError, match="features must be the object's 49 feature values"):
+        planner.choose(["a"] * N, Roll())
+    with pytest.raises(ValueError, match=r"within \+-3.4e\+38 \(float32\)"):
+        planner.choose(np.full(N, 1e39), Roll())
+    with pytest.raises(ValueError, match="start_xy must be .* on the table top"):
+        planner.choose(np.zeros(N), Roll(), start_xy=(5.0, 5.0))
+    with pytest.raises(ValueError, match="target_xy must be .* on the table top"):
+        planner.choose(np.zeros(N), Place((5.0, 5.0)), start_xy=(-0.3, 0.0))
+    with pytest.raises(ValueError, match="Unknown behavior 'kick'"):
+        planner.note_failure("kick", np.zeros(3))
+    with pytest.raises(ValueError, match=r"params must be the behaviour's 3 finite parameters, got shape \(2,\)"):
+        planner.note_failure("push", np.zeros(2))
+    with pytest.raises(ValueError, match="tolerance must be a finite number, got 'x'"):
+        planner.toward(np.zeros(N), (-0.3, 0.0), (-0.25, 0.0), "x")
+    with pytest.raises(ValueError, match="random_state must be an integer >= 0"):
+        Planner(planner.models, random_state=-1)
+
+
+def test_predict_effect_refuses_an_action_or_features_that_are_not_real_numbers():
+    for action in ("abc", {"a": 1}, [1j, 0, 0]):
+        with pytest.raises(ValueError, match=r"action must be the behaviour's 3 parameters in \[-1, 1\]"):
+            predict_effect(np.zeros(N), behavior="tap", action=action)
+    with pytest.raises(ValueError, match="features must be real numbers"):
+        predict_effect([[0.0] * N, [0.0] * (N - 1)], behavior="tap")
+    with pytest.raises(ValueError, match=r"within \+-3.4e\+38 \(float32\)"):
+        predict_effect(np.full(N, 1e39), behavior="tap")
+
+
+def test_a_damaged_state_is_refused_before_anything_is_restored():
+    import dataclasses
+
+    env = TapAffordanceEnv(camera_width=32, camera_height=24)
+    env.reset(seed=0)
+    state = env.get_state()
+    env.reset(seed=1)
+    before = env.get_state()
+    world = state.world
+    for damaged, match in ((dataclasses.replace(state, rng={}), "random generator's state"),
+                           (dataclasses.replace(state, world=dataclasses.replace(world, q_home=None)), "home posture"),
+                           (dataclasses.replace(state, world=dataclasses.replace(world, initial="x")), "observation"),
+                           (dataclasses.replace(state, world=dataclasses.replace(world, arm=["x"])), "robot model")):
+        with pytest.raises(ValueError, match=match):
+            env.set_state(damaged)
+        np.testing.assert_array_equal(env.get_state().world.physics[1].qpos, before.world.physics[1].qpos)
+
+
+def test_a_camera_too_large_to_allocate_and_a_reward_fn_that_is_no_function_are_refused_at_construction():
+    with pytest.raises(ValueError, match=r"camera resolution must be integers in 2..4096, got width=20000"):
+        gym.make("TapAffordance-v2", camera_width=20000, camera_height=20000)
+    with pytest.raises(ValueError, match="reward_fn must be a function of the step's info"):
+        TapAffordanceEnv(reward_fn=5)
+    env = TapAffordanceEnv(camera_width=32, camera_height=24, reward_fn=lambda info: "high")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match="reward_fn must return a number, returned 'high'"):
+        env.step(np.zeros(3))
+
+
+def test_a_fingerprint_file_that_is_not_a_fingerprint_is_refused_before_any_collection(tmp_path):
+    import json
+
+    from affordance_learning.reproduce import check_fingerprint
+
+    (tmp_path / "fingerprint.json").write_text(json.dumps([1, 2]))
+    with pytest.raises(ValueError, match="fingerprint.json is not a fingerprint"):
+        check_fingerprint(tmp_path)

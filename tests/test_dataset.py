@@ -275,6 +275,39 @@ def test_newer_schema_corrupt_and_half_written_chunks(reference, tmp_path):
         load_dataset(out)
 
 
+def test_a_damaged_manifest_or_chunk_metadata_is_a_dataset_error_naming_it(tmp_path):
+    out = tmp_path / "d"
+    collect(out, 4, seed=1, env_options=SMALL, chunk_size=4, progress=False)
+    good = (out / "manifest.json").read_text()
+    for episodes in (-3, 0, True, 10**12):  # a count of nothing, or more than a chunk list can be made for
+        manifest = json.loads(good)
+        manifest["episodes"] = episodes
+        (out / "manifest.json").write_text(json.dumps(manifest))
+        with pytest.raises(DatasetError, match=rf"manifest.json is damaged: episodes {episodes!r}"):
+            load_dataset(out)
+    manifest = json.loads(good)
+    del manifest["settings"]["env_options"]
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(DatasetError, match="manifest.json is damaged: its settings, with the env's options"):
+        load_dataset(out)
+    # a chunk whose metadata names a failure of no episode (its checksum recorded anew: not a changed file)
+    (out / "manifest.json").write_text(good)
+    chunk = out / "chunk-00000.parquet"
+    table = pq.read_table(chunk)
+    meta = json.loads(table.schema.metadata[b"tap_affordance"])
+    meta["chunk"]["failures"] = {"abc": "ik: out of reach"}
+    pq.write_table(table.replace_schema_metadata({**table.schema.metadata,
+                                                  b"tap_affordance": json.dumps(meta).encode()}), chunk)
+    manifest = json.loads(good)
+    manifest["chunk_sha256"][chunk.name] = hashlib.sha256(chunk.read_bytes()).hexdigest()
+    (out / "manifest.json").write_text(json.dumps(manifest))
+    with pytest.raises(DatasetError, match=r"chunk-00000.parquet is corrupt: a failure 'abc': 'ik: out of reach' is "
+                                           r"not an episode of 0..3"):
+        load_dataset(out)
+    with pytest.raises(ValueError, match="episodes must be at most 100,000,000"):
+        collect(tmp_path / "huge", 10**12, env_options=SMALL, progress=False)
+
+
 def assert_same_dataset_prefix(path, reference, episodes):
     frame = load_dataset(path)
     pd.testing.assert_frame_equal(frame, reference[reference.episode < episodes], check_exact=True)

@@ -39,6 +39,7 @@ from affordance_env.dataset.format import (
     GOAL_ENV_ID,
     IMAGE_COLUMNS,
     MANIFEST,
+    MAX_EPISODES,
     METADATA_KEY,
     ChunkResult,
     DatasetError,
@@ -314,6 +315,8 @@ def collect(
                              ("chunk_size", chunk_size, 1), ("seed", seed, 0)):
         if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
             raise InvalidValueError(f"{name} must be an integer >= {low}, got {value!r}.")
+    if episodes > MAX_EPISODES:
+        raise InvalidValueError(f"episodes must be at most {MAX_EPISODES:,} (a dataset's limit), got {episodes!r}.")
     if action not in ACTIONS:
         raise InvalidValueError(f"action must be one of {ACTIONS}, got {action!r}.")
     if isinstance(max_failure_share, bool) or not (isinstance(max_failure_share, int | float | np.floating)

@@ -64,6 +64,9 @@ LABELS_VERSION = 2
 FORMAT = "tap-affordance-dataset"
 MANIFEST = "manifest.json"
 METADATA_KEY = b"tap_affordance"
+#: The most episodes (interactions, or goal episodes) a dataset may hold: a hundred million, two weeks of collection
+#: at a hundred interactions a second, and a chunk list that fits in memory.
+MAX_EPISODES = 100_000_000
 POSE_FIELDS = ("x", "y", "z", "qw", "qx", "qy", "qz")
 #: The stages of an interaction whose features (and images) are stored, and the prefix of its effects.
 STAGES = ("initial", "final")
@@ -209,6 +212,11 @@ def chunk_name(index: int) -> str:
     return f"chunk-{index:05d}.parquet"
 
 
+def _count(value: Any) -> bool:
+    """Whether ``value`` is an integer (not a boolean)."""
+    return isinstance(value, int) and not isinstance(value, bool)
+
+
 def chunk_ranges(episodes: int, chunk_size: int) -> list[tuple[int, int]]:
     return [(s, min(s + chunk_size, episodes)) for s in range(0, episodes, chunk_size)]
 
@@ -327,10 +335,15 @@ def read_manifest(path: str | os.PathLike) -> dict[str, Any]:
                            f"versions 1 to {SCHEMA_VERSION}: upgrade the package "
                            "(pip install -U tap-affordance).")
     settings = manifest.get("settings")
-    chunk_size = settings.get("chunk_size") if isinstance(settings, dict) else None
-    if not isinstance(manifest.get("episodes"), int) or not isinstance(chunk_size, int) or chunk_size < 1:
-        raise DatasetError(f"{path / MANIFEST} is damaged: episodes {manifest.get('episodes')!r}, "
-                           f"chunk_size {chunk_size!r}.")
+    if not isinstance(settings, dict) or not isinstance(settings.get("env_options"), dict):
+        raise DatasetError(f"{path / MANIFEST} is damaged: its settings, with the env's options, are "
+                           f"{settings!r}.")
+    chunk_size = settings.get("chunk_size")
+    episodes = manifest.get("episodes")
+    if (not _count(episodes) or not 1 <= episodes <= MAX_EPISODES or not _count(chunk_size)
+            or not 1 <= chunk_size <= MAX_EPISODES):
+        raise DatasetError(f"{path / MANIFEST} is damaged: episodes {episodes!r}, chunk_size {chunk_size!r} "
+                           f"(each an integer in 1..{MAX_EPISODES}).")
     return manifest
 
 
@@ -373,6 +386,11 @@ def check_chunk(path: Path, header: dict, start: int, stop: int) -> dict:
     span = (chunk.get("start"), chunk.get("stop")) if isinstance(chunk, dict) else None
     if span != (start, stop) or not isinstance(chunk.get("failures"), dict):
         raise DatasetError(f"{path} holds episodes {span}, expected ({start}, {stop}).")
+    for episode, reason in chunk["failures"].items():  # {"episode number": "why it failed"}
+        if not (isinstance(episode, str) and episode.isdigit() and start <= int(episode) < stop
+                and isinstance(reason, str)):
+            raise DatasetError(f"{path} is corrupt: a failure {episode!r}: {reason!r} is not an episode of "
+                               f"{start}..{stop - 1} with its reason.")
     diffs = settings_differences(meta, header)
     if diffs:
         raise DatasetError(f"{path} was made with other settings than its dataset ({'; '.join(diffs)}).")
