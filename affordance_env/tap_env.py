@@ -230,6 +230,8 @@ class TapAffordanceEnv(gym.Env):
       ``"rgb_array_list"``: every frame of the interaction, for a video (Gymnasium's ``RecordVideo`` keeps one
       frame per step, so for one-step episodes use this mode and write the frames yourself); any other mode
       (``"human"`` too) is refused with a ValueError naming these |
+    | ``render_width``, ``render_height`` | 480, 360 | size of those pictures [pixels] (240 x 180 has a quarter of
+      the pixels, for a cheaper render without a GPU) |
     | ``two_arms`` | False | the scene with both arms (:data:`affordance_env.robot_model.VARIANTS` ``"two_arms"``):
       the other arm waits rigid at its home pose, and the relation features are measured to the right palm for every
       behaviour (the scene of ``TapAffordanceGoal-v2``) |

@@ -10,6 +10,7 @@ import argparse
 import json
 import os
 import sys
+import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -104,9 +105,23 @@ def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
     return datasets
 
 
+def _check_writable_directory(directory: Path, what: str) -> None:
+    """Refuse, before any work, a directory that cannot be made or written into (``what`` names it: the option and
+    the path given)."""
+    if directory.exists() and not directory.is_dir():
+        raise InvalidValueError(f"{what} is a file, not a directory.")
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=directory):
+            pass
+    except OSError as exc:
+        raise InvalidValueError(f"{what} cannot be written: {directory} ({exc.strerror}).") from None
+
+
 def _reproduce(args: argparse.Namespace) -> int:
     from affordance_learning.reproduce import DEFAULT_BEHAVIORS, reproduce
 
+    _check_writable_directory(args.out, f"--out {args.out}")
     behaviors = args.behavior or list(DEFAULT_BEHAVIORS)
     reproduce(args.out, behaviors=behaviors, episodes=args.episodes, trials=args.trials, seed=args.seed,
               workers=args.workers, datasets=_datasets(args.dataset, behaviors), range_noise=args.range_noise,
@@ -122,9 +137,10 @@ def _train_action_models(args: argparse.Namespace) -> int:
     from affordance_learning.plan_experiment import PlanSettings, collect_training
 
     dataset = args.dataset or Path("default-actions")
+    out = args.out or user_model_dir()
+    _check_writable_directory(out, f"--out {out}")
     settings = PlanSettings(max_per_behavior=ACTION_INTERACTIONS)
     frame = collect_training(dataset, settings, seed=0, workers=args.workers, camera=(160, 120))
-    out = args.out or user_model_dir()
     written = train_action_models(frame, out)
     print(f"action-conditioned default models of {', '.join(written)} written to {out} "
           f"({', '.join(f'{b} {int((frame.behavior == b).sum())}' for b in written)} interactions collected)")
@@ -141,6 +157,10 @@ def _train_default(args: argparse.Namespace) -> int:
     from affordance_learning.default_model import train_default_model, user_model_path
 
     dataset = args.dataset or Path("default-taps" if behavior == "tap" else f"default-{behavior}")
+    out = args.out or user_model_path(behavior)
+    if out.is_dir():
+        raise InvalidValueError(f"--out {out} is a directory, not a model file.")
+    _check_writable_directory(out.parent, f"--out {out}")
     if (dataset / MANIFEST).exists():  # say so plainly, before the collection refuses its other settings
         found = read_manifest(dataset)["settings"]["env_options"].get("behavior", "tap")
         if found != behavior:
@@ -148,7 +168,6 @@ def _train_default(args: argparse.Namespace) -> int:
                              f"dataset of {behavior} interactions, or a new directory to collect them into.")
     check_env_offers([behavior])
     collect(dataset, 1000, seed=0, workers=args.workers, env_options={"behavior": behavior})
-    out = args.out or user_model_path(behavior)
     model = train_default_model(load_dataset(dataset), out, behavior=behavior)
     print(f"default {behavior} model ({model.n_clusters} categories, {len(model.selected_features_)} features "
           f"selected: {', '.join(model.selected_feature_names_)}) written to {out}")
@@ -328,7 +347,8 @@ def build_parser() -> argparse.ArgumentParser:
     reproduce.add_argument("--dataset", action="append", default=[], metavar="[BEHAVIOR=]PATH",
                            help="a behaviour's dataset directory, collected there or reused (default "
                            "OUT/BEHAVIOR/dataset); repeatable; a bare PATH when one behaviour runs")
-    reproduce.add_argument("--out", type=Path, default=Path("reproduction"), help="output directory")
+    reproduce.add_argument("--out", type=Path, default=Path("reproduction"),
+                           help="output directory (default reproduction)")
     reproduce.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                            help="progress bars (default: on a terminal, unless CI is set)")
     reproduce.add_argument("--range-noise", default=None, choices=("kinect_v1",),
@@ -387,14 +407,15 @@ def build_parser() -> argparse.ArgumentParser:
 
     train = sub.add_parser("train-default", help="rebuild a behaviour's default model behind predict_effect")
     train.add_argument("--behavior", default="tap", metavar="NAME",
-                       help="whose model: tap (default, shipped), grasp, tap_back or push")
+                       help="whose model: tap (default) or grasp (both shipped), tap_back, push or draw")
     train.add_argument("--dataset", type=Path, default=None,
                        help="where the behaviour's 1000 canonical interactions (seed 0) are collected, or reused "
                        "(default ./default-taps for the tap, ./default-BEHAVIOR otherwise)")
     train.add_argument("--workers", type=positive_int, default=2, help="worker processes (default 2)")
     train.add_argument("--out", type=Path, default=None,
                        help="model file (default: BEHAVIOR_model.joblib in the user's data directory, "
-                       "$TAP_AFFORDANCE_DATA or ~/.local/share/tap-affordance, where predict_effect finds it); "
+                       "$TAP_AFFORDANCE_DATA, $XDG_DATA_HOME/tap-affordance or ~/.local/share/tap-affordance, "
+                       "where predict_effect finds it); "
                        "with --action-conditioned the directory of the models")
     train.add_argument("--action-conditioned", action="store_true",
                        help="build every behaviour's action-conditioned model (predict_effect(..., action=...)) "

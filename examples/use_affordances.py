@@ -1,9 +1,10 @@
 """Use learned affordances: a goal, a plan, an executed interaction, then a multi-step episode to a place.
 
-Needs the goal-episode dataset of an ``affordance plan`` run (``--dataset``, default ``plan/dataset``)::
+The planner uses the shipped action-conditioned effect models (``affordance_learning.load_action_model``), or
+models fitted on the goal episodes of an ``affordance plan`` run::
 
-    affordance plan --out plan
     python examples/use_affordances.py
+    affordance plan --out plan && python examples/use_affordances.py --dataset plan/dataset
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ import numpy as np
 
 import affordance_env  # noqa: F401  (registers the environments)
 from affordance_env.workspace import in_workspace
+from affordance_learning.behaviors import BEHAVIORS
+from affordance_learning.default_model import load_action_model
 from affordance_learning.goals import Move, describe
 from affordance_learning.plan_experiment import fit_models, load_training, training_frames
 from affordance_learning.planner import Planner
@@ -22,10 +25,18 @@ from affordance_learning.planner import Planner
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--dataset", default="plan/dataset", help="goal episodes (affordance plan's OUT/dataset)")
+    parser.add_argument("--dataset", default=None, help="goal episodes to fit the models on (affordance plan's "
+                        "OUT/dataset); default: the shipped models")
     parser.add_argument("--seed", type=int, default=3)
     args = parser.parse_args()
-    planner = Planner(fit_models(training_frames(load_training(args.dataset), 1000), random_state=0))
+    if args.dataset is None:
+        models = {behavior: load_action_model(behavior) for behavior in BEHAVIORS}
+    else:
+        try:
+            models = fit_models(training_frames(load_training(args.dataset), 1000), random_state=0)
+        except (OSError, ValueError) as exc:  # no dataset there, or not one of goal episodes
+            parser.error(str(exc))
+    planner = Planner(models)
     env = gym.make("TapAffordanceGoal-v2")
     world = env.unwrapped
 

@@ -152,7 +152,15 @@ def test_paths_that_cannot_be_used_are_one_line_errors(tmp_path, capsys, monkeyp
     assert main(["collect", "--episodes", "2", "--out", str(read_only / "taps"), *small]) == 2
     assert capsys.readouterr().err == f"affordance: error: {read_only / 'taps'}: Read-only file system\n"
     assert main(["reproduce", "--behavior", "tap", "--episodes", "20", "--out", str(read_only / "repro")]) == 2
-    assert capsys.readouterr().err == f"affordance: error: {read_only / 'repro'}: Read-only file system\n"
+    assert capsys.readouterr().err == (f"affordance: error: --out {read_only / 'repro'} cannot be written: "
+                                       f"{read_only / 'repro'} (Read-only file system).\n")
+    assert main(["reproduce", "--behavior", "tap", "--episodes", "20", "--out", str(a_file)]) == 2
+    assert capsys.readouterr().err == f"affordance: error: --out {a_file} is a file, not a directory.\n"
+    # the model's place is checked before 1000 interactions are collected for it
+    assert main(["train-default", "--dataset", str(tmp_path / "taps"), "--out", str(read_only / "m.joblib")]) == 2
+    assert capsys.readouterr().err == (f"affordance: error: --out {read_only / 'm.joblib'} cannot be written: "
+                                       f"{read_only} (Read-only file system).\n")
+    assert not (tmp_path / "taps").exists()
     assert main(["export", str(tmp_path / "missing"), "--minari", "tap-affordance/y-v0"]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "affordance: error:" in err and "missing" in err

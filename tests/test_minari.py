@@ -84,6 +84,16 @@ def test_without_minari_a_clear_error(taps, monkeypatch, capsys):
     assert "tap-affordance[minari]" in capsys.readouterr().err
 
 
+def test_the_hdf5_format_without_h5py_is_a_clear_error(taps, minari_home, monkeypatch, capsys):
+    monkeypatch.setitem(sys.modules, "h5py", None)  # as if it were not installed
+    with pytest.raises(ImportError, match=r"hdf5 format needs the h5py package: pip install 'minari\[hdf5\]'"):
+        export_minari(taps, "tap-affordance/h5-v0", data_format="hdf5")
+    assert main(["export", str(taps), "--minari", "tap-affordance/h5-v0", "--data-format", "hdf5"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "minari[hdf5]" in err
+    assert not (minari_home / "tap-affordance" / "h5-v0").exists()
+
+
 @pytest.mark.parametrize("bad_id", ["tap-affordance/canonical-taps", "taps-vX", "", "a//b-v0"])
 def test_a_malformed_id_is_refused_before_anything_is_written(taps, minari_home, capsys, bad_id):
     import minari

@@ -197,6 +197,12 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
     if data_format not in DATA_FORMATS:
         raise InvalidValueError(f"data_format must be one of {DATA_FORMATS}, got {data_format!r}.")
     minari, EpisodeBuffer = _minari()
+    if data_format == "hdf5":
+        try:
+            import h5py  # noqa: F401 (Minari's HDF5 storage needs it)
+        except ImportError as exc:
+            raise MissingDependencyError("Minari's hdf5 format needs the h5py package: pip install 'minari[hdf5]' "
+                                         "(or export with data_format='arrow')") from exc
     namespace, _, _ = check_dataset_id(dataset_id)
     from minari.storage.datasets_root_dir import get_dataset_path
 
