@@ -30,23 +30,26 @@ def float_array(name: str, value: Any, shape: tuple[int, ...] | None = None, *, 
         finite: Whether NaN and infinities are refused.
         error: The exception raised (a package's own ``InvalidValueError``).
     """
-    if expected is None:
-        expected = "a finite number" if shape == () else (f"{shape[0]} finite numbers" if shape and len(shape) == 1
+    def refused(got: str = "") -> Exception:  # the message is made only when it is raised
+        what = expected
+        if what is None:
+            what = "a finite number" if shape == () else (f"{shape[0]} finite numbers" if shape and len(shape) == 1
                                                          else f"finite numbers of shape {shape}")
-    refused = error(f"{name} must be {expected}, got {value!r}.")
+        return error(f"{name} must be {what}, got {got}{value!r}.")
+
     if isinstance(value, str | bytes | Mapping | set | frozenset):
-        raise refused
+        raise refused()
     try:
         array = np.asarray(value)
     except (ValueError, TypeError):  # ragged sequences, objects numpy cannot read as an array
-        raise refused from None
+        raise refused() from None
     if array.dtype.kind not in _REAL_KINDS:
-        raise refused
+        raise refused()
     array = array.astype(np.float64, copy=False)
     if shape is not None and array.shape != shape:
-        raise error(f"{name} must be {expected}, got shape {array.shape}: {value!r}.")
+        raise refused(f"shape {array.shape}: ")
     if finite and not np.all(np.isfinite(array)):
-        raise refused
+        raise refused()
     return array
 
 
