@@ -31,8 +31,9 @@ def __dir__() -> list[str]:
 #: ``affordance`` command, which checks its arguments before any work) stays light, with no scikit-learn, SciPy,
 #: pandas or matplotlib until a name is used.
 _LAZY = {
-    **dict.fromkeys(("ActionEffectPrediction", "DefaultModelError", "DefaultModelMissingError", "load_default_model",
-                     "predict_effect", "train_default_model"), "affordance_learning.default_model"),
+    **dict.fromkeys(("ActionEffectPrediction", "DefaultModelError", "DefaultModelMissingError", "load_action_model",
+                     "load_default_model", "predict_effect", "train_default_model"),
+                    "affordance_learning.default_model"),
     "ActionEffectModel": "affordance_learning.effect_model",
     **dict.fromkeys(("Lift", "Move", "Percept", "Place", "Roll", "goal_from_dict"), "affordance_learning.goals"),
     **dict.fromkeys(("adjusted_rand", "cluster_purity", "svm_cv_accuracy", "uniformity"),
@@ -77,6 +78,7 @@ __all__ = [
     "SOMClustering",
     "adjusted_rand",
     "cluster_purity",
+    "load_action_model",
     "load_default_model",
     "make_synthetic_frame",
     "predict_effect",
