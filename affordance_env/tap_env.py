@@ -425,8 +425,8 @@ class TapAffordanceEnv(gym.Env):
         """Pictures of the scene from the ``overview`` camera, (H, W, 3) uint8, headless.
 
         ``render_mode="rgb_array"``: the picture of the current state. ``"rgb_array_list"``: every picture taken
-        since the last ``reset`` or ``render`` call (at ``render_fps`` of simulated time: a whole interaction is
-        some 90 of them), as Gymnasium's ``rgb_array_list`` convention has it; the list is then emptied. None
+        since the last ``reset`` or ``render`` call (at ``render_fps`` of simulated time: a canonical tap is 66-104
+        of them), as Gymnasium's ``rgb_array_list`` convention has it; the list is then emptied. None
         without a render mode.
         """
         if self.render_mode == "rgb_array":
