@@ -7,10 +7,10 @@ that a command-line mistake is a one-line error at once, before any work starts 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import sys
-import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -107,15 +107,22 @@ def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
 
 def _check_writable_directory(directory: Path, what: str) -> None:
     """Refuse, before any work, a directory that cannot be made or written into (``what`` names it: the option and
-    the path given)."""
+    the path given); what the check makes (the directory, a probe file) is removed again."""
     if directory.exists() and not directory.is_dir():
         raise InvalidValueError(f"{what} is a file, not a directory.")
+    missing = [d for d in (directory, *directory.parents) if not d.exists()]
+    probe = directory / f".affordance-write-test-{os.getpid()}"
     try:
         directory.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=directory):
+        with open(probe, "w"):
             pass
     except OSError as exc:
         raise InvalidValueError(f"{what} cannot be written: {directory} ({exc.strerror}).") from None
+    finally:
+        probe.unlink(missing_ok=True)
+        for made in missing:  # deepest first: only what the check made, and only if still empty
+            with contextlib.suppress(OSError):
+                made.rmdir()
 
 
 def _reproduce(args: argparse.Namespace) -> int:
