@@ -169,7 +169,7 @@ def _train_default(args: argparse.Namespace) -> int:
         raise InvalidValueError(f"--out {out} is a directory, not a model file.")
     _check_writable_directory(out.parent, f"--out {out}")
     if (dataset / MANIFEST).exists():  # say so plainly, before the collection refuses its other settings
-        found = read_manifest(dataset)["settings"]["env_options"].get("behavior", "tap")
+        found = read_manifest(dataset)["settings"].get("env_options", {}).get("behavior", "tap")
         if found != behavior:
             raise InvalidValueError(f"{dataset} holds {found!r} interactions, not {behavior!r} ones: give --dataset a "
                              f"dataset of {behavior} interactions, or a new directory to collect them into.")

@@ -286,7 +286,7 @@ def test_a_damaged_manifest_or_chunk_metadata_is_a_dataset_error_naming_it(tmp_p
         with pytest.raises(DatasetError, match=rf"manifest.json is damaged: episodes {episodes!r}"):
             load_dataset(out)
     manifest = json.loads(good)
-    del manifest["settings"]["env_options"]
+    manifest["settings"]["env_options"] = "tap"
     (out / "manifest.json").write_text(json.dumps(manifest))
     with pytest.raises(DatasetError, match="manifest.json is damaged: its settings, with the env's options"):
         load_dataset(out)

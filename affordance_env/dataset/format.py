@@ -335,7 +335,7 @@ def read_manifest(path: str | os.PathLike) -> dict[str, Any]:
                            f"versions 1 to {SCHEMA_VERSION}: upgrade the package "
                            "(pip install -U tap-affordance).")
     settings = manifest.get("settings")
-    if not isinstance(settings, dict) or not isinstance(settings.get("env_options"), dict):
+    if not isinstance(settings, dict) or not isinstance(settings.get("env_options", {}), dict):
         raise DatasetError(f"{path / MANIFEST} is damaged: its settings, with the env's options, are "
                            f"{settings!r}.")
     chunk_size = settings.get("chunk_size")
