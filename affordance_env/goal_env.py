@@ -18,7 +18,7 @@ from affordance_env.options import EnvOptions
 from affordance_env.placement import RESET_OPTIONS, draw_placement
 from affordance_env.registry import BEHAVIOR_ARMS, BEHAVIOR_NAMES
 from affordance_env.results import InteractionResult, Snapshot
-from affordance_env.values import float_array, restored_generator
+from affordance_env.values import float_array, set_generator_state
 from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
 from affordance_env.world import World, WorldState
 
@@ -396,12 +396,16 @@ class TapAffordanceGoalEnv(gym.Env):
         """Put back the world and the episode as :meth:`get_state` saw them."""
         if not isinstance(state, GoalEnvState):
             raise TypeError(f"state must be what get_state() returned (a GoalEnvState), got {type(state).__name__}.")
-        rng = restored_generator(state.rng)  # checked before anything is restored
         goal = float_array("the state's goal", state.goal, (2,), expected="a place on the table (x, y) [m]")
         if state.obs is not None and not isinstance(state.obs, Mapping):
             raise InvalidValueError(f"the state is damaged: its observation is {state.obs!r:.80}.")
-        self.world.set_state(state.world)
-        self.np_random.bit_generator.state = rng.bit_generator.state
+        before = self.np_random.bit_generator.state
+        set_generator_state(self.np_random, state.rng)  # checked first: a damaged one restores nothing
+        try:
+            self.world.set_state(state.world)
+        except Exception:
+            self.np_random.bit_generator.state = before
+            raise
         self._goal = goal.copy()
         self._obs = state.obs
 

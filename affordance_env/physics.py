@@ -538,8 +538,9 @@ class TapPhysics:
         if (data.qpos.shape, data.qvel.shape, data.act.shape) != (self.data.qpos.shape, self.data.qvel.shape,
                                                                     self.data.act.shape):
             raise IncompatibleStateError(
-                f"the snapshot's MuJoCo data has {data.qpos.size} positions and {data.qvel.size} velocities, this "
-                f"model {self.model.nq} and {self.model.nv}: it was taken of another model.")
+                f"the snapshot's MuJoCo data has {data.qpos.size} positions, {data.qvel.size} velocities and "
+                f"{data.act.size} actuator states, this model {self.model.nq}, {self.model.nv} and {self.model.na}: "
+                "it was taken of another model.")
         current = self.geometry
         if geometry is not None and (current is None or (geometry.object_type, geometry.size)
                                      != (current.object_type, current.size)):

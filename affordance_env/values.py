@@ -4,6 +4,7 @@ names the value and what was expected, never numpy's own conversion error or a s
 from __future__ import annotations
 
 import copy
+import numbers
 from collections.abc import Mapping
 from typing import Any
 
@@ -14,28 +15,33 @@ from affordance_env.exceptions import InvalidValueError
 #: numpy's kinds of real numbers: signed and unsigned integers, floating point. Not booleans, complex numbers,
 #: strings, bytes or objects.
 _REAL_KINDS = "iuf"
+#: The longest value a message shows [characters]: a whole feature vector or batch would bury the message.
+_SHOWN = 120
 
 
 def float_array(name: str, value: Any, shape: tuple[int, ...] | None = None, *, expected: str | None = None,
                 finite: bool = True, error: type[Exception] = InvalidValueError) -> np.ndarray:
     """``value`` as a float64 array, refused (``error``, a message naming ``name``, the value and ``expected``) unless
-    its entries are real numbers (integers or floats, not booleans, complex numbers or strings), of ``shape`` (if
-    given) and, with ``finite``, finite.
+    its entries are real numbers (integers or floats, also in an array of objects such as a pandas row of mixed
+    columns; not booleans, complex numbers or strings), of ``shape`` (if given) and, with ``finite``, finite.
 
     Args:
         name: What the value is, as the message names it (``"action"``, ``"start_xy"``).
         value: The value given.
         shape: The shape it must have; None: any.
-        expected: What it must be, in words (default: from ``shape``).
+        expected: What it must be, in words (default: from ``shape`` and ``finite``).
         finite: Whether NaN and infinities are refused.
         error: The exception raised (a package's own ``InvalidValueError``).
     """
     def refused(got: str = "") -> Exception:  # the message is made only when it is raised
         what = expected
         if what is None:
-            what = "a finite number" if shape == () else (f"{shape[0]} finite numbers" if shape and len(shape) == 1
-                                                         else f"finite numbers of shape {shape}")
-        return error(f"{name} must be {what}, got {got}{value!r}.")
+            kind = "finite real" if finite else "real"
+            what = (f"a {kind} number" if shape == () else f"{kind} numbers" if shape is None
+                    else f"{kind} numbers of shape {shape}")
+        shown = repr(value)
+        shown = shown if len(shown) <= _SHOWN else shown[: _SHOWN - 3] + "..."
+        return error(f"{name} must be {what}, got {got}{shown}.")
 
     if isinstance(value, str | bytes | Mapping | set | frozenset):
         raise refused()
@@ -43,7 +49,11 @@ def float_array(name: str, value: Any, shape: tuple[int, ...] | None = None, *, 
         array = np.asarray(value)
     except (ValueError, TypeError):  # ragged sequences, objects numpy cannot read as an array
         raise refused() from None
-    if array.dtype.kind not in _REAL_KINDS:
+    if array.dtype.kind == "O":  # numbers held as objects: each must be a real number
+        if not all(isinstance(v, numbers.Real) and not isinstance(v, bool | np.bool_) for v in array.flat):
+            raise refused()
+        array = array.astype(np.float64)
+    elif array.dtype.kind not in _REAL_KINDS:
         raise refused()
     array = array.astype(np.float64, copy=False)
     if shape is not None and array.shape != shape:
@@ -53,12 +63,12 @@ def float_array(name: str, value: Any, shape: tuple[int, ...] | None = None, *, 
     return array
 
 
-def restored_generator(state: Any) -> np.random.Generator:
-    """A PCG64 generator (Gymnasium's ``np_random``) in the saved bit-generator ``state`` (a copy of it), or
-    InvalidValueError if ``state`` is not one."""
-    rng = np.random.Generator(np.random.PCG64())
+def set_generator_state(generator: np.random.Generator, state: Any) -> None:
+    """Put ``generator`` (Gymnasium's ``np_random``) in the saved bit-generator ``state`` (a copy of it), or raise
+    InvalidValueError, the generator as it was, if ``state`` is not one of its kind."""
     try:
-        rng.bit_generator.state = copy.deepcopy(state)
+        generator.bit_generator.state = copy.deepcopy(state)
     except (TypeError, ValueError, KeyError):
-        raise InvalidValueError(f"the state is damaged: its random generator's state is {state!r:.80}.") from None
-    return rng
+        shown = repr(state)
+        raise InvalidValueError(f"the state is damaged: its random generator's state is "
+                                f"{shown if len(shown) <= _SHOWN else shown[: _SHOWN - 3] + '...'}.") from None

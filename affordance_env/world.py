@@ -428,7 +428,7 @@ class World:
                 f"{have}: a state restores only into a world of the same robot model (behavior='grasp' builds "
                 "another model than the strokes, and two_arms=True another again).")
         q_home = np.asarray(state.q_home) if isinstance(state.q_home, np.ndarray) else None
-        if (q_home is None or q_home.shape != arm.physics.joint_targets().shape or q_home.dtype.kind != "f"
+        if (q_home is None or q_home.shape != arm.physics.joint_positions().shape or q_home.dtype.kind != "f"
                 or not np.all(np.isfinite(q_home))):
             raise InvalidValueError(f"the state is damaged: its home posture is {state.q_home!r:.80}, not the "
                                     "arm's joint angles.")

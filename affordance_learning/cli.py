@@ -140,12 +140,13 @@ def _train_action_models(args: argparse.Namespace) -> int:
     """``affordance train-default --action-conditioned``: goal episodes with random actions (collected into
     ``--dataset`` or reused from there) until every behaviour has 1000 interactions, then an action-conditioned
     model per behaviour."""
-    from affordance_learning.default_model import ACTION_INTERACTIONS, train_action_models, user_model_dir
+    from affordance_learning.default_model import ACTION_INTERACTIONS, DATA_ENV, train_action_models, user_model_dir
     from affordance_learning.plan_experiment import PlanSettings, collect_training
 
     dataset = args.dataset or Path("default-actions")
     out = args.out or user_model_dir()
-    _check_writable_directory(out, f"--out {out}")
+    _check_writable_directory(out, f"--out {out}" if args.out else f"the models' directory {out} (set it with --out "
+                              f"or ${DATA_ENV})")
     settings = PlanSettings(max_per_behavior=ACTION_INTERACTIONS)
     frame = collect_training(dataset, settings, seed=0, workers=args.workers, camera=(160, 120))
     written = train_action_models(frame, out)
@@ -161,13 +162,14 @@ def _train_default(args: argparse.Namespace) -> int:
 
     behavior = check_behavior(args.behavior)
     from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
-    from affordance_learning.default_model import train_default_model, user_model_path
+    from affordance_learning.default_model import DATA_ENV, train_default_model, user_model_path
 
     dataset = args.dataset or Path("default-taps" if behavior == "tap" else f"default-{behavior}")
     out = args.out or user_model_path(behavior)
+    what = f"--out {out}" if args.out else f"the model's place {out} (set it with --out or ${DATA_ENV})"
     if out.is_dir():
-        raise InvalidValueError(f"--out {out} is a directory, not a model file.")
-    _check_writable_directory(out.parent, f"--out {out}")
+        raise InvalidValueError(f"{what} is a directory, not a model file.")
+    _check_writable_directory(out.parent, what)
     if (dataset / MANIFEST).exists():  # say so plainly, before the collection refuses its other settings
         found = read_manifest(dataset)["settings"].get("env_options", {}).get("behavior", "tap")
         if found != behavior:

@@ -162,8 +162,8 @@ class Planner:
 
     Every method checks its inputs before any work: ``features`` must have as many values as the models take
     (ValueError), the goal must be a goal of :mod:`affordance_learning.goals` (TypeError), a
-    :class:`~affordance_learning.goals.Place` needs ``start_xy`` and :meth:`toward` a target on the table top
-    (ValueError).
+    :class:`~affordance_learning.goals.Place` needs ``start_xy``; with a ``table``, a place's target (and
+    :meth:`toward`'s) must lie on the table top, and ``start_xy`` within :data:`SEEN_MARGIN` of it (ValueError).
     """
 
     def __init__(self, models: Mapping[str, ActionEffectModel], n_candidates: int = 64, threshold: float = 0.5,
@@ -302,7 +302,9 @@ class Planner:
         every behaviour). ``start_xy`` (where the object is) is needed for a :class:`Place`, and for any goal, when
         given, says which outcomes leave the object beyond the table's edge."""
         check_goal(goal)
-        start = _check_start(start_xy) if isinstance(goal, Place) or start_xy is not None else None
+        start = self._check_where(start_xy) if isinstance(goal, Place) or start_xy is not None else None
+        if isinstance(goal, Place) and self.table is not None:
+            _check_on_table("the goal's target_xy", goal.target_xy, np.asarray(goal.target_xy), self.table)
         if candidates is None:
             candidates = dict.fromkeys(self.models, self.params)
         out = {}
@@ -363,8 +365,6 @@ class Planner:
         (:data:`REFINE_POINTS` within :data:`REFINE_RADIUS`), and the best of them that ranks above it is taken
         if feasible (at most :data:`REFINE_CHECKS` asked)."""
         start = None if start_xy is None else self._check_where(start_xy)
-        if isinstance(goal, Place) and self.table is not None:
-            _check_on_table("the goal's target_xy", goal.target_xy, np.asarray(goal.target_xy), self.table)
         scores = self._score(features, goal, start_xy)
         candidates = dict.fromkeys(scores, self.params)
         seen = self._inputs(features)[0, : self.n_features]

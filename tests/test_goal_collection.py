@@ -131,3 +131,12 @@ def test_every_behaviour_is_tried_at_each_step_each_first_as_often():
     assert counts.min() > 200 / len(BEHAVIOR_NAMES) / 2  # none neglected
     same = [a["params"] for a in goal_step_actions(0, 7, 2, "random")]
     np.testing.assert_array_equal(same, [a["params"] for a in goal_step_actions(0, 7, 2, "random")])
+
+
+def test_the_episode_rule_says_the_reach_clearance_feasible_keeps():
+    # A goal dataset is resumed only under the same rule: a clearance changed without its rule would resume data
+    # whose actions another feasible() chose.
+    from affordance_env.behaviors.stroke import REACH_CLEARANCE
+    from affordance_env.dataset.collect import GOAL_EPISODE_RULE
+
+    assert f"a reach kept {1000 * REACH_CLEARANCE:g} mm from the object" in GOAL_EPISODE_RULE

@@ -340,10 +340,9 @@ def read_manifest(path: str | os.PathLike) -> dict[str, Any]:
                            f"{settings!r}.")
     chunk_size = settings.get("chunk_size")
     episodes = manifest.get("episodes")
-    if (not _count(episodes) or not 1 <= episodes <= MAX_EPISODES or not _count(chunk_size)
-            or not 1 <= chunk_size <= MAX_EPISODES):
-        raise DatasetError(f"{path / MANIFEST} is damaged: episodes {episodes!r}, chunk_size {chunk_size!r} "
-                           f"(each an integer in 1..{MAX_EPISODES}).")
+    if not _count(episodes) or not 1 <= episodes <= MAX_EPISODES or not _count(chunk_size) or chunk_size < 1:
+        raise DatasetError(f"{path / MANIFEST} is damaged: episodes {episodes!r} (an integer in 1..{MAX_EPISODES}), "
+                           f"chunk_size {chunk_size!r} (an integer >= 1).")
     return manifest
 
 
