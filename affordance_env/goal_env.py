@@ -18,7 +18,7 @@ from affordance_env.options import EnvOptions
 from affordance_env.placement import RESET_OPTIONS, draw_placement
 from affordance_env.registry import BEHAVIOR_ARMS, BEHAVIOR_NAMES
 from affordance_env.results import InteractionResult, Snapshot
-from affordance_env.values import float_array, set_generator_state
+from affordance_env.values import float_array, restore_with_generator
 from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
 from affordance_env.world import World, WorldState
 
@@ -399,13 +399,8 @@ class TapAffordanceGoalEnv(gym.Env):
         goal = float_array("the state's goal", state.goal, (2,), expected="a place on the table (x, y) [m]")
         if state.obs is not None and not isinstance(state.obs, Mapping):
             raise InvalidValueError(f"the state is damaged: its observation is {state.obs!r:.80}.")
-        before = self.np_random.bit_generator.state
-        set_generator_state(self.np_random, state.rng)  # checked first: a damaged one restores nothing
-        try:
-            self.world.set_state(state.world)
-        except Exception:
-            self.np_random.bit_generator.state = before
-            raise
+        # the generator's state checked first: a damaged one restores nothing
+        restore_with_generator(self.np_random, state.rng, lambda: self.world.set_state(state.world))
         self._goal = goal.copy()
         self._obs = state.obs
 

@@ -27,7 +27,7 @@ from affordance_env.placement import (
     draw_placement,
 )
 from affordance_env.results import InteractionResult, Snapshot
-from affordance_env.values import set_generator_state
+from affordance_env.values import restore_with_generator
 from affordance_env.world import World, WorldState
 
 
@@ -407,13 +407,8 @@ class TapAffordanceEnv(gym.Env):
         another model than the tap, tap back and push, and ``two_arms=True`` another again."""
         if not isinstance(state, EnvState):
             raise TypeError(f"state must be what get_state() returned (an EnvState), got {type(state).__name__}.")
-        before = self.np_random.bit_generator.state
-        set_generator_state(self.np_random, state.rng)  # checked first: a damaged one restores nothing
-        try:
-            self.world.set_state(state.world)
-        except Exception:
-            self.np_random.bit_generator.state = before
-            raise
+        # the generator's state checked first: a damaged one restores nothing
+        restore_with_generator(self.np_random, state.rng, lambda: self.world.set_state(state.world))
 
     def _record_frame(self, time: float) -> None:
         if time >= self._next_frame_time - 1e-9:

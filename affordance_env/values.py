@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import copy
 import numbers
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -72,3 +72,15 @@ def set_generator_state(generator: np.random.Generator, state: Any) -> None:
         shown = repr(state)
         raise InvalidValueError(f"the state is damaged: its random generator's state is "
                                 f"{shown if len(shown) <= _SHOWN else shown[: _SHOWN - 3] + '...'}.") from None
+
+
+def restore_with_generator(generator: np.random.Generator, state: Any, restore: Callable[[], None]) -> None:
+    """Put ``generator`` in the saved bit-generator ``state`` (:func:`set_generator_state`, checked first), then call
+    ``restore()`` (the rest of a snapshot); if that raises, the generator is put back as it was."""
+    before = generator.bit_generator.state
+    set_generator_state(generator, state)
+    try:
+        restore()
+    except Exception:
+        generator.bit_generator.state = before
+        raise
