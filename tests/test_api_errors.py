@@ -226,6 +226,7 @@ def test_a_damaged_state_is_refused_before_anything_is_restored():
         with pytest.raises(ValueError, match=match):
             env.set_state(damaged)
         np.testing.assert_array_equal(env.get_state().world.physics[1].qpos, before.world.physics[1].qpos)
+        assert env.np_random.bit_generator.state == before.rng  # the generator put back too
 
 
 def test_a_camera_too_large_to_allocate_and_a_reward_fn_that_is_no_function_are_refused_at_construction():
