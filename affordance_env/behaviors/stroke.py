@@ -183,13 +183,11 @@ def plan_stroke(
 #: object [m] (checked every REACH_SWEEP_STRIDE control ticks), else the stroke is not feasible: an arm that sweeps
 #: into the object moves it before the stroke (a "reach" failure). The arm follows its targets to within a
 #: millimetre or two on the way down (servo lag at the reach's speed), so targets that pass nearer than that may
-#: touch: over 150 random strokes per behaviour at positions over the workspaces, no penetration (0 m) flags 4 of 4
-#: such failures of tap (and 4 strokes that would have moved the object less than the 3 mm allowed), 11 of 15 of
-#: tap_back and 4 of 4 of push (1 wrongly), and lets through strokes whose targets pass 0.6-1.3 mm from the object,
-#: which touched it on the way down and moved it 3-15 mm (1 of 571 feasible strokes and draws at random actions, 2
-#: of 150 interactions of ``affordance plan``'s multi-step episodes at seed 0, where the planner chose actions at the
-#: edge of their range); 2 mm refuses those and 8 of the 571 (1.4 %) that work, 1 cm 8, 17 and 11 strokes per 150
-#: that work.
+#: touch. Over 599 strokes and draws at random actions (``python benchmarks/reach_clearance.py``), of the 570 that
+#: the other checks accept, 2 moved the object before the stroke, their targets 0.1 and 0.7 mm from it; so did 2 of
+#: the 150 interactions of ``affordance plan``'s multi-step episodes at seed 0 (0.6 and 1.3 mm, moving it 3 and 15
+#: mm), where the planner chose actions at the edge of their range. 2 mm refuses those and 6 of the 570 that work
+#: (1 %); 1 mm lets one through, 1 cm refuses 48 that work.
 REACH_CLEARANCE, REACH_SWEEP_STRIDE = 0.002, 5
 #: The reach's servo targets may put the arm's geoms at most this far into the table [m] (checked at the same
 #: samples and at the pre-stroke pose), else the stroke is not feasible: the forearm then rests on the table and
