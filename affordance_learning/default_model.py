@@ -45,7 +45,7 @@ from affordance_env.values import float_array
 from affordance_learning.behaviors import check_behavior
 from affordance_learning.exceptions import DefaultModelError, DefaultModelMissingError, InvalidValueError
 from affordance_learning.model import AffordanceModel, EffectPrediction
-from affordance_learning.validation import first_non_finite
+from affordance_learning.validation import check_float32_range, first_non_finite
 
 #: Where the package's own default models are, one file per behaviour (read only).
 MODEL_DIR = Path(__file__).resolve().parent / "data"
@@ -68,8 +68,6 @@ FORMAT = 3
 #: The command that rebuilds the default tap model (see :func:`rebuild_command` for the others).
 REBUILD_COMMAND = "affordance train-default"
 _N_FEATURES = 49
-#: The largest float32: the models (their trees, scikit-learn's scalers) read their inputs as float32.
-_FLOAT32_MAX = float(np.finfo(np.float32).max)
 
 
 def user_model_dir() -> Path:
@@ -301,27 +299,20 @@ def predict_effect(
                 "expected the names of affordance_env's FEATURE_NAMES."
             )
         features = features[names].to_numpy()
-    try:
-        X = np.asarray(features)
-    except (ValueError, TypeError):  # ragged rows
-        raise InvalidValueError(f"features must be real numbers, ({_N_FEATURES},) or (n, {_N_FEATURES}), got "
-                                f"{features!r}.") from None
-    if X.dtype == object or not (np.issubdtype(X.dtype, np.number) or X.dtype == bool) or np.iscomplexobj(X):
-        raise InvalidValueError(f"features must be real numbers, got dtype {X.dtype}.")
+    X = float_array("features", features, finite=False, error=InvalidValueError,
+                    expected=f"real numbers, ({_N_FEATURES},) or (n, {_N_FEATURES})")
     if X.ndim not in (1, 2) or X.shape[-1] != _N_FEATURES or (X.ndim == 2 and X.shape[0] == 0):
         raise InvalidValueError(
             f"features must have shape ({_N_FEATURES},) or (n, {_N_FEATURES}) with n >= 1, got {X.shape}."
         )
     single = X.ndim == 1
-    X = np.atleast_2d(X).astype(np.float64)
+    X = np.atleast_2d(X)  # float64 (float_array)
     found = first_non_finite(X)
     if found:
         count, row, col, value = found
         raise InvalidValueError(
             f"features must be finite; row {row}, feature {col} is {value} ({count} non-finite value(s)).")
-    largest = float(np.max(np.abs(X)))
-    if largest > _FLOAT32_MAX:  # the models compare float32 inputs: larger values would be infinite
-        raise InvalidValueError(f"features must be within +-{_FLOAT32_MAX:.3g} (float32), got one of {largest!r}.")
+    check_float32_range("features", X)
     if action is not None:
         return _predict_action(X, behavior, action, path, single)
     model, names = _load_checked(path, behavior)

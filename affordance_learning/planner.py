@@ -30,12 +30,11 @@ from affordance_learning.behaviors import BEHAVIORS
 from affordance_learning.effect_model import ActionEffectModel, PredictiveOutcomes
 from affordance_learning.exceptions import InvalidValueError
 from affordance_learning.goals import Goal, Move, Place, check_goal, check_start
+from affordance_learning.validation import check_float32_range
 
 #: The scene's table top, ((x_low, y_low), (x_high, y_high)) [m] in the robot's root frame: the planner's default
 #: ``table``.
 SCENE_TABLE = table_extent()
-#: The largest float32: the trees compare their inputs as float32.
-FLOAT32_MAX = float(np.finfo(np.float32).max)
 #: Where the object is (``start_xy``) may lie this far [m] beyond the table top's edge: the centre of an object on
 #: the table is over it, but where the camera sees it (its top's mean) may hang a few centimetres over the edge.
 SEEN_MARGIN = 0.05
@@ -268,9 +267,7 @@ class Planner:
         x = x.ravel()
         if not np.all(np.isfinite(x)):
             raise InvalidValueError("features must be finite (the object must have been seen).")
-        largest = float(np.max(np.abs(x)))
-        if largest > FLOAT32_MAX:  # the trees compare float32 inputs: larger values would be infinite
-            raise InvalidValueError(f"features must be within +-{FLOAT32_MAX:.3g} (float32), got one of {largest!r}.")
+        check_float32_range("features", x)
         return np.hstack([np.repeat(x[None], len(params), axis=0), params])
 
     def on_table(self, outcomes: PredictiveOutcomes, start) -> PredictiveOutcomes:
