@@ -354,6 +354,8 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
         if som is not None:
             record["som_categories"] = record["canonical"][som.choose(features, goal, start)[0]]
         record["oracle"] = any(hits.values())
+        record["oracle_hits"] = sum(hits.values())
+        record["size"] = float(info["object"]["size"])
         p = np.concatenate([predicted[b].probability(goal, start) for b in BEHAVIORS])
         record["pooled"] = (p, np.array([hits[(b, k)] for b in BEHAVIORS for k in range(len(oracle_set))]))
         records.append(record)
@@ -848,8 +850,9 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         "decision_seconds": {**seconds_summary(choose_s + toward_s), "choose": seconds_summary(choose_s),
                              "toward": seconds_summary(toward_s)},
         "timings_s": timings,
-        "goals": [{k: r[k] for k in ("kind", "type", "object", "goal", "planner", "planner_p", "planner_behavior",
-                                     "oracle")} for r in records],
+        "goals": [{k: r.get(k) for k in ("kind", "type", "object", "size", "goal", "planner", "planner_p",
+                                         "planner_behavior", "oracle", "oracle_hits", "planner_left_out")}
+                  for r in records],
     }
     import json
 

@@ -21,10 +21,11 @@ from affordance_learning.plan_experiment import (
     POLICIES,
     PULLING,
     SHAPES,
+    calibration,
     share_text,
     wilson,
 )
-from affordance_learning.plan_results import NOTHING, PlanResults, Share
+from affordance_learning.plan_results import NOTHING, GoalRecord, PlanResults, Share
 
 #: The targets of the planner, each a (direction, value): ">=" or "<=".
 TARGETS: dict[str, tuple[str, float]] = {
@@ -261,6 +262,12 @@ def _reached(outcomes: Mapping[str, Any], policy: str) -> Share:
 def _why(name: str, results: PlanResults) -> str:
     """Why a target is missed, from the data."""
     single = results.single_step_by_goal
+    if name.startswith("single-step") and single_step_why(results):
+        return single_step_why(results)
+    if name.startswith("calibration") and calibration_why(results, name.endswith("AUROC")):
+        return calibration_why(results, name.endswith("AUROC"))
+    if name.startswith("each left-out") and left_out_why(results):
+        return left_out_why(results)
     if name.startswith("single-step"):
         gaps = sorted(((single[k]["oracle"].reached.value or 0) - (single[k]["planner"].reached.value or 0), k)
                       for k in GOAL_KINDS if single.get(k))
@@ -321,6 +328,127 @@ def _why(name: str, results: PlanResults) -> str:
         return (f"{multi.reach_failure_count} of {multi.interactions} "
                 f"interactions failed to reach although the kinematics said they would: {listed}")
     return multi_step_why(results)
+
+
+#: A feasible goal that at most this many of the oracle's actions reached is *narrow*: an action within a few
+#: centimetres, or degrees, of the few that reach it may not.
+NARROW_HITS = 3
+#: The calibration's why names at most this many objects, those whose chosen actions were the most overconfident.
+WORST_OBJECTS = 3
+
+
+def _object_name(goals: list[GoalRecord]) -> str:
+    """An object as the report names it: its type and size, from one of its goals."""
+    g = goals[0]
+    return g.type.replace("_", " ") + ("" if g.size is None else f" of {100 * g.size:.1f} cm")
+
+
+def _by_object(goals: list[GoalRecord]) -> dict[int, list[GoalRecord]]:
+    out: dict[int, list[GoalRecord]] = {}
+    for g in goals:
+        out.setdefault(g.object, []).append(g)
+    return out
+
+
+def single_step_why(results: PlanResults | Mapping[str, Any]) -> str | None:
+    """Why the planner missed feasible single-step goals, from its goals: how many of the oracle's actions reached
+    the goals it missed and those it reached, how many of the missed were narrow (:data:`NARROW_HITS`), how many it
+    chose below its threshold (expecting to miss), and on which objects it missed the others; None for results
+    without the oracle's hits per goal."""
+    results = PlanResults.from_dict(results)
+    feasible = [g for g in results.goals if g.oracle]
+    missed = [g for g in feasible if not g.planner]
+    if not missed or any(g.oracle_hits is None for g in feasible):
+        return None
+    reached = [g for g in feasible if g.planner]
+    actions = results.oracle.get("actions_per_behavior")
+    of = f"of the oracle's {actions * len(results.training)} actions" if actions else "of the oracle's actions"
+    narrow = [g for g in missed if g.oracle_hits <= NARROW_HITS]
+    kinds = ", ".join(f"{k} {n}" for k, n in sorted(_counts(g.kind for g in narrow).items(), key=lambda e: -e[1]))
+    threshold = float(results.settings.get("threshold", 0.5))
+    unsure = sum(g.planner_p < threshold for g in missed)
+    sure = [g for g in missed if g.planner_p >= threshold]
+    where = sorted(_by_object(sure).values(), key=len, reverse=True)
+    named = ", ".join(f"{_object_name(gs)} {len(gs)}" for gs in where[:WORST_OBJECTS] if len(gs) > 1)
+    text = (f"the {len(missed)} feasible goals it missed were reached by a median of "
+            f"{np.median([g.oracle_hits for g in missed]):g} {of}")
+    if reached:
+        text += f", the {len(reached)} it reached by {np.median([g.oracle_hits for g in reached]):g}"
+    text += (f"; {len(narrow)} of the missed by at most {NARROW_HITS} (narrow goals: {kinds})" if narrow else "")
+    text += (f"; it chose {unsure} of the missed at P below its threshold {threshold:g} (it expected to miss) and "
+             f"{len(sure)} at P >= {threshold:g}")
+    return text + (f", most on few objects ({named})" if named else "")
+
+
+def _counts(values) -> dict[str, int]:
+    out: dict[str, int] = {}
+    for v in values:
+        out[v] = out.get(v, 0) + 1
+    return out
+
+
+def calibration_why(results: PlanResults | Mapping[str, Any], auroc: bool = False) -> str | None:
+    """Where the planner's P(goal) on its chosen actions is off, from its goals: the largest miscalibration of the
+    reliability curve, the :data:`WORST_OBJECTS` objects whose chosen actions were the most overconfident (the
+    sum of P minus reached), and the ECE (or, with ``auroc``, the AUROC) without them; None for results without
+    the goals."""
+    results = PlanResults.from_dict(results)
+    acted = [g for g in results.goals if g.planner_behavior]
+    if not acted:
+        return None
+    curve = results.calibration.curve
+    off = max(curve, key=lambda c: abs(c.p - c.observed) * c.n) if curve else None
+    text = ("" if off is None else f"the largest miscalibration is at P = {off.p:.2f}: observed {off.observed:.2f} "
+            f"over {off.n} actions")
+    objects = _by_object(acted)
+    excess = {o: sum(g.planner_p - g.planner for g in gs) for o, gs in objects.items()}
+    key = "auroc" if auroc else "ece"
+    name = "calibration AUROC" if auroc else "calibration ECE"
+    ranked = [o for o in sorted(objects, key=lambda o: -excess[o])[:WORST_OBJECTS] if excess[o] > 1e-9]
+    direction, bound = TARGETS[name]
+    if not ranked:
+        return text
+    best = None  # the fewest of them without which the rest meets the target, else those leaving it best
+    for k in range(1, len(ranked) + 1):
+        rest = [g for g in acted if g.object not in ranked[:k]]
+        metric = calibration([g.planner_p for g in rest], [g.planner for g in rest])[key]
+        better = metric is not None and (best is None or best[1] is None
+                                         or (metric > best[1] if auroc else metric < best[1]))
+        if best is None or better:
+            best = (k, metric, len(rest))
+        if metric is not None and (metric >= bound if direction == ">=" else metric <= bound):
+            break
+    worst, (_, metric, n_rest) = ranked[: best[0]], best
+
+    def described(goals: list[GoalRecord]) -> str:
+        chosen = ", ".join(f"{b} {n}" for b, n in sorted(_counts(g.planner_behavior for g in goals).items(),
+                                                          key=lambda e: -e[1]))
+        return (f"{_object_name(goals)}: {len(goals)} actions ({chosen}) at a mean P "
+                f"{np.mean([g.planner_p for g in goals]):.2f}, {sum(g.planner for g in goals)} reached")
+
+    value = "not measured" if metric is None else f"{metric:.3f}"
+    named = "; ".join(described(objects[o]) for o in worst)
+    return (f"{text + '. ' if text else ''}The most overconfident objects: {named}; without "
+            f"{'it' if len(worst) == 1 else 'them'} the {'AUROC' if auroc else 'ECE'} is {value} "
+            f"(n={n_rest} chosen actions)")
+
+
+def left_out_why(results: PlanResults | Mapping[str, Any]) -> str | None:
+    """Per left-out shape, its success on its feasible goals beside the same goals' with the shape in the
+    training data (the planner of every other target) and the best fixed behaviour's; None for results without
+    the left-out planner's outcome per goal."""
+    results = PlanResults.from_dict(results)
+    loso = results.leave_one_shape_out
+    parts = []
+    for shape in loso:
+        goals = [g for g in results.goals if g.type == shape and g.oracle]
+        if not goals or any(g.planner_left_out is None for g in goals):
+            return None
+        k, n = sum(g.planner for g in goals), len(goals)
+        parts.append(f"{shape}: {_share(loso[shape]['planner'].feasible, 'feasible')} left out, "
+                     f"{share_text(k / n, n, wilson(k, n), 'feasible', digits=1)} with {shape} in the training "
+                     f"data (best fixed {_share(loso[shape]['best_fixed'].feasible, 'feasible')})")
+    return "; ".join(parts)
 
 
 #: What an interaction's failure message (up to its measure) says, for the report.

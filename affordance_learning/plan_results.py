@@ -175,6 +175,37 @@ class Calibration:
 
 
 @dataclass(frozen=True)
+class GoalRecord:
+    """One goal of the single-step evaluation and how it went.
+
+    Attributes:
+        kind: The goal's kind ("roll", "lift", "move", "place").
+        type: The object type.
+        object: The held-out object's index.
+        planner: Whether the planner's action reached the goal.
+        planner_p: The P(goal) the planner gave its action (0 where it chose none).
+        planner_behavior: The behaviour it chose; None where no candidate it asked about was feasible.
+        oracle: Whether some action of the oracle's set reached it (the goal is *feasible*).
+        size: The object's size [m]; None in results written before it was recorded.
+        oracle_hits: How many actions of the oracle's set reached it; None in results written before it was
+            recorded.
+        planner_left_out: Whether the planner fitted without the object's type reached it; None in results
+            written before it was recorded.
+    """
+
+    kind: str
+    type: str
+    object: int
+    planner: bool
+    planner_p: float
+    planner_behavior: str | None
+    oracle: bool
+    size: float | None = None
+    oracle_hits: int | None = None
+    planner_left_out: bool | None = None
+
+
+@dataclass(frozen=True)
 class DecisionTimes:
     """How long the planner's decisions took [s], ``feasible``'s calls included: median, 99th percentile and n
     (None without decisions)."""
@@ -213,6 +244,7 @@ class PlanResults:
         workers: The worker processes of the run (None when not recorded).
         oracle: How the single-step evaluation was made: ``objects``, ``objects_per_shape``, ``goals_per_object``,
             ``actions_per_behavior``, ``levels`` (empty in results written before it was recorded).
+        goals: The single-step goals, one record each (empty in results written without them).
     """
 
     seed: int
@@ -232,6 +264,7 @@ class PlanResults:
     workers: int | None = None
     oracle: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
     placement_error_committed: tuple[float | None, int] = (None, 0)
+    goals: tuple[GoalRecord, ...] = ()
 
     @classmethod
     def from_dict(cls, results: PlanResults | Mapping[str, Any]) -> PlanResults:
@@ -273,6 +306,7 @@ class PlanResults:
                 _number(top.get("placement_error_committed_median_m"), ("placement_error_committed_median_m",), True),
                 _count(top.get("placement_error_committed_n", 0), ("placement_error_committed_n",))),
             oracle=MappingProxyType(dict(_mapping(top.get("oracle", {}), ("oracle",)))),
+            goals=tuple(_goal(g, ("goals", i)) for i, g in enumerate(_list(top.get("goals", []), ("goals",)))),
         )
 
     @property
@@ -405,6 +439,19 @@ def _calibration(value: Any, path: _Path) -> Calibration:
                        pooled=None if pooled is None else _calibration(pooled, (*path, "pooled")))
 
 
+def _goal(value: Any, path: _Path) -> GoalRecord:
+    entry = _entry(value, path, ("kind", "type", "object", "planner", "planner_p", "planner_behavior", "oracle"))
+    behavior, left_out = entry["planner_behavior"], entry.get("planner_left_out")
+    hits = entry.get("oracle_hits")
+    return GoalRecord(kind=_text(entry["kind"], (*path, "kind")), type=_text(entry["type"], (*path, "type")),
+                      object=_count(entry["object"], (*path, "object")), planner=bool(entry["planner"]),
+                      planner_p=_number(entry["planner_p"], (*path, "planner_p")),
+                      planner_behavior=_text(behavior, (*path, "planner_behavior")) if behavior else None,
+                      oracle=bool(entry["oracle"]), size=_number(entry.get("size"), (*path, "size"), True),
+                      oracle_hits=None if hits is None else _count(hits, (*path, "oracle_hits")),
+                      planner_left_out=None if left_out is None else bool(left_out))
+
+
 def _decisions(value: Any, path: _Path) -> DecisionTimes:
     if value is None:
         return DecisionTimes(None, None, 0)
@@ -423,5 +470,5 @@ def _placements(results: Mapping[str, Any]) -> int:
                for i, g in enumerate(goals))
 
 
-__all__ = ["NOTHING", "PLAN_RESULTS_FORMAT", "Calibration", "CalibrationBin", "DecisionTimes", "Episode", "MultiStep",
-           "MultiStepOutcome", "PlanResults", "PolicyOutcome", "Share"]
+__all__ = ["NOTHING", "PLAN_RESULTS_FORMAT", "Calibration", "CalibrationBin", "DecisionTimes", "Episode", "GoalRecord",
+           "MultiStep", "MultiStepOutcome", "PlanResults", "PolicyOutcome", "Share"]

@@ -431,7 +431,7 @@ def test_the_evaluation_hands_each_item_to_the_first_free_process_and_keeps_the_
 
 @pytest.mark.slow
 def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
-    from affordance_learning.plan_experiment import PlanSettings, run_plan
+    from affordance_learning.plan_experiment import PlanSettings, oracle_params, run_plan
     from affordance_learning.plan_report import TARGETS, write_plan_figures, write_plan_report
 
     settings = PlanSettings(episodes=40, max_episodes=40, objects=2, multi_episodes=2, candidates=8,
@@ -456,6 +456,10 @@ def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     for policy in ("planner", "direction", "random"):
         assert 0 <= results["multi_step"][policy]["reach_failures"] <= 1
     assert {"ece", "auroc"} <= set(results["calibration"])
+    actions = 5 * len(oracle_params())  # every goal says how many of the oracle's actions reached it
+    for goal in results["goals"]:
+        assert goal["oracle"] == (0 < goal["oracle_hits"] <= actions)
+        assert 0.03 <= goal["size"] <= 0.1 and isinstance(goal["planner_left_out"], bool)
     assert json.loads((tmp_path / "results.json").read_text())["seed"] == 1
     write_plan_figures(results, tmp_path)
     report = write_plan_report(results, tmp_path).read_text()
