@@ -368,16 +368,18 @@ def single_step_why(results: PlanResults | Mapping[str, Any]) -> str | None:
     threshold = float(results.settings.get("threshold", 0.5))
     unsure = sum(g.planner_p < threshold for g in missed)
     sure = [g for g in missed if g.planner_p >= threshold]
-    where = sorted(_by_object(sure).values(), key=len, reverse=True)
-    named = ", ".join(f"{_object_name(gs)} {len(gs)}" for gs in where[:WORST_OBJECTS] if len(gs) > 1)
+    nothing = sum(g.planner_behavior is None for g in missed)
+    groups = [gs for gs in sorted(_by_object(sure).values(), key=len, reverse=True)[:WORST_OBJECTS] if len(gs) > 1]
+    named = ", ".join(f"{_object_name(gs)} {len(gs)}" for gs in groups)
     text = (f"the {len(missed)} feasible goals it missed were reached by a median of "
             f"{np.median([g.oracle_hits for g in missed]):g} {of}")
     if reached:
         text += f", the {len(reached)} it reached by {np.median([g.oracle_hits for g in reached]):g}"
     text += (f"; {len(narrow)} of the missed by at most {NARROW_HITS} (narrow goals: {kinds})" if narrow else "")
-    text += (f"; it chose {unsure} of the missed at P below its threshold {threshold:g} (it expected to miss) and "
-             f"{len(sure)} at P >= {threshold:g}")
-    return text + (f", most on few objects ({named})" if named else "")
+    text += (f"; it chose {unsure} of the missed at P below its threshold {threshold:g} (it expected to miss"
+             + (f"; for {nothing} none of the candidates it asked about was feasible" if nothing else "")
+             + f") and {len(sure)} at P >= {threshold:g}")
+    return text + (f", {sum(map(len, groups))} of them on {len(groups)} objects ({named})" if groups else "")
 
 
 def _counts(values) -> dict[str, int]:

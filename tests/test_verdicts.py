@@ -193,8 +193,8 @@ def test_missed_feasible_goals_are_explained_by_how_many_oracle_actions_reached_
     row = _missed_target_row(results, SINGLE_TARGET, tmp_path)
     assert ("the 6 feasible goals it missed were reached by a median of 3.5 of the oracle's 65 actions, the 8 it "
             "reached by 30; 3 of the missed by at most 3 (narrow goals: place 3); it chose 1 of the missed at P "
-            "below its threshold 0.5 (it expected to miss) and 5 at P >= 0.5, most on few objects (box of 6.0 cm 3, "
-            "box of 7.1 cm 2)") in row
+            "below its threshold 0.5 (it expected to miss) and 5 at P >= 0.5, 5 of them on 2 objects (box of 6.0 cm "
+            "3, box of 7.1 cm 2)") in row
     # results written before the oracle's hits were recorded: the gap to the oracle per goal kind, as before
     results["goals"] = [{k: v for k, v in goal.items() if k != "oracle_hits"} for goal in results["goals"]]
     assert "the gap to the oracle is largest for" in _missed_target_row(results, SINGLE_TARGET, tmp_path)
