@@ -26,6 +26,7 @@ from affordance_learning.plan_experiment import (
     wilson,
 )
 from affordance_learning.plan_results import NOTHING, GoalRecord, PlanResults, Share
+from affordance_learning.planner import MAX_CHECKS
 
 #: The targets of the planner, each a (direction, value): ">=" or "<=".
 TARGETS: dict[str, tuple[str, float]] = {
@@ -495,7 +496,8 @@ def multi_step_why(results: PlanResults | Mapping[str, Any]) -> str:
             f"({towards} of them towards the robot); on the "
             f"{inside.n} targets within that reach the planner reached "
             f"{share_text(inside.value, inside.n, digits=1)}. In "
-            f"{gave_up} missed episodes the object ended where no candidate action was reachable")
+            f"{gave_up} missed episodes the planner stopped where none of the candidates it asked about (at most "
+            f"{MAX_CHECKS} a decision, the most promising first) was reachable")
 
 
 def write_plan_report(results: PlanResults | Mapping[str, Any], out: str | os.PathLike) -> Path:

@@ -71,7 +71,8 @@ class Episode:
         success: Whether it got there.
         within_reach: Whether the episode's interactions could take it there at all
             (:func:`~affordance_learning.plan_experiment.within_reach`).
-        gave_up: Whether the planner stopped where no candidate action was reachable.
+        gave_up: Whether the planner stopped because none of the candidates it asked ``feasible`` about (at most
+            its ``max_checks``) was reachable.
         failures: The messages of its interactions that failed to reach.
         toward_robot: Whether its target lay toward the robot (within 45 degrees of +x from the object).
         pulls_at_start: For an episode toward the robot: whether each behaviour that brings objects toward it

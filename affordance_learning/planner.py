@@ -122,7 +122,7 @@ class Choice:
     """A planner's decision.
 
     Attributes:
-        behavior: The behaviour chosen (None when it abstained and nothing was feasible).
+        behavior: The behaviour chosen (None where none of the candidates it asked ``feasible`` about was).
         params: Its parameters, (3,).
         probability: P(goal) of the choice under the model (for :meth:`Planner.toward` when no action is likely
             to reach the place: still P(within tolerance)).

@@ -58,7 +58,7 @@ def main() -> None:
                                 world.goal_tolerance, feasible=world.feasible, steps_left=steps - step + 1,
                                 reachable=in_workspace)
         if choice.behavior is None:
-            print("  no candidate action is reachable: stopping")
+            print("  none of the candidates asked about is reachable: stopping")
             break
         obs, reward, terminated, truncated, info = env.step(
             {"behavior": choice.behavior, "params": choice.params.astype(np.float32)})
