@@ -625,11 +625,17 @@ def _parallel(function, items: list, workers: int, **kwargs) -> list:
     the first process free, so that none is left idle while another works through its costlier objects (a grasp's
     oracle costs 4-20 times a stroke's); ``kwargs`` (the planners: tens of MB) are written once to a temporary
     file and read once per process, and the processes (with the env each has built) serve every call. Each call
-    depends on its item and ``kwargs`` alone, so the results are the same for any number of processes."""
+    depends on its item and ``kwargs`` alone, so the results are the same for any number of processes.
+
+    The processes are new ones, not those joblib keeps from earlier work (the collection's): joblib's process pool
+    measures a process's memory after its first call and restarts it, with a warning, once it holds 300 MB more,
+    which the planners read in a process that served the collection first are."""
     if workers == 1 or len(items) <= 1:
         return [function(item, **kwargs) for item in items]
     from joblib import Parallel, delayed
+    from joblib.externals.loky import get_reusable_executor
 
+    get_reusable_executor().shutdown(wait=True)  # the next Parallel starts new processes
     with tempfile.TemporaryDirectory(prefix="affordance-plan-") as tmp:
         task = Path(tmp) / "task.pickle"
         task.write_bytes(pickle.dumps((function, kwargs), protocol=pickle.HIGHEST_PROTOCOL))

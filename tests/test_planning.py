@@ -429,6 +429,20 @@ def test_the_evaluation_hands_each_item_to_the_first_free_process_and_keeps_the_
     assert _parallel(_sleep_then_pid, items[1:3], 1, scale=0.0)[0][0] == 0.01
 
 
+def test_the_evaluation_takes_new_processes_not_those_joblib_kept_from_the_collection():
+    """joblib restarts, with a warning, a kept process that holds 300 MB more than after its first call: the
+    planners, read by a process that served the collection first."""
+    import os
+
+    from joblib import Parallel, delayed
+
+    from affordance_learning.plan_experiment import _parallel
+
+    kept = set(Parallel(n_jobs=2, batch_size=1)(delayed(os.getpid)() for _ in range(4)))
+    fresh = {pid for _, pid in _parallel(_sleep_then_pid, [0.2, 0.2, 0.2], 2, scale=1.0)}
+    assert fresh and not fresh & kept
+
+
 @pytest.mark.slow
 def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     from affordance_learning.plan_experiment import PlanSettings, oracle_params, run_plan
