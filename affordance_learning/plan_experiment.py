@@ -331,7 +331,7 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
     for p in (planner, left_out):
         if p is not None:
             p.forget_failures()
-    shape = info["object"]["type"]
+    shape, size = info["object"]["type"], float(info["object"]["size"])
     records = []
     for j, goal in enumerate(draw_goals(start, rng)):
         record: dict[str, Any] = {"kind": goal.kind, "type": shape, "goal": goal.to_dict(), "object": item["index"],
@@ -355,7 +355,7 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
             record["som_categories"] = record["canonical"][som.choose(features, goal, start)[0]]
         record["oracle"] = any(hits.values())
         record["oracle_hits"] = sum(hits.values())
-        record["size"] = float(info["object"]["size"])
+        record["size"] = size
         p = np.concatenate([predicted[b].probability(goal, start) for b in BEHAVIORS])
         record["pooled"] = (p, np.array([hits[(b, k)] for b in BEHAVIORS for k in range(len(oracle_set))]))
         records.append(record)
@@ -623,13 +623,14 @@ def _items(seed: int, part: int, n: int) -> list[dict]:
 def _parallel(function, items: list, workers: int, **kwargs) -> list:
     """``[function(item, **kwargs) for item in items]`` on ``workers`` processes. The items go one at a time to
     the first process free, so that none is left idle while another works through its costlier objects (a grasp's
-    oracle costs 4-20 times a stroke's); ``kwargs`` (the planners: tens of MB) are written once to a temporary
+    oracle costs 4-20 times a stroke's); ``kwargs`` (the planners: about 300 MB) are written once to a temporary
     file and read once per process, and the processes (with the env each has built) serve every call. Each call
     depends on its item and ``kwargs`` alone, so the results are the same for any number of processes.
 
     The processes are new ones, not those joblib keeps from earlier work (the collection's): joblib's process pool
     measures a process's memory after its first call and restarts it, with a warning, once it holds 300 MB more,
-    which the planners read in a process that served the collection first are."""
+    as a process that served the collection first does once it has read the planners. So this shuts down the
+    process pool joblib keeps for the calling process (``get_reusable_executor``), whoever started it."""
     if workers == 1 or len(items) <= 1:
         return [function(item, **kwargs) for item in items]
     from joblib import Parallel, delayed

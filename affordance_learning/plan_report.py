@@ -263,12 +263,12 @@ def _reached(outcomes: Mapping[str, Any], policy: str) -> Share:
 def _why(name: str, results: PlanResults) -> str:
     """Why a target is missed, from the data."""
     single = results.single_step_by_goal
-    if name.startswith("single-step") and single_step_why(results):
-        return single_step_why(results)
-    if name.startswith("calibration") and calibration_why(results, name.endswith("AUROC")):
-        return calibration_why(results, name.endswith("AUROC"))
-    if name.startswith("each left-out") and left_out_why(results):
-        return left_out_why(results)
+    if name.startswith("single-step") and (text := single_step_why(results)):
+        return text
+    if name.startswith("calibration") and (text := calibration_why(results, name.endswith("AUROC"))):
+        return text
+    if name.startswith("each left-out") and (text := left_out_why(results)):
+        return text
     if name.startswith("single-step"):
         gaps = sorted(((single[k]["oracle"].reached.value or 0) - (single[k]["planner"].reached.value or 0), k)
                       for k in GOAL_KINDS if single.get(k))
@@ -341,7 +341,7 @@ WORST_OBJECTS = 3
 def _object_name(goals: list[GoalRecord]) -> str:
     """An object as the report names it: its type and size, from one of its goals."""
     g = goals[0]
-    return g.type.replace("_", " ") + ("" if g.size is None else f" of {100 * g.size:.1f} cm")
+    return g.type.replace("_", " ") + (f" (object {g.object})" if g.size is None else f" of {100 * g.size:.2f} cm")
 
 
 def _by_object(goals: list[GoalRecord]) -> dict[int, list[GoalRecord]]:
@@ -362,14 +362,14 @@ def single_step_why(results: PlanResults | Mapping[str, Any]) -> str | None:
     if not missed or any(g.oracle_hits is None for g in feasible):
         return None
     reached = [g for g in feasible if g.planner]
-    actions = results.oracle.get("actions_per_behavior")
+    actions = results.oracle.get("actions_per_behavior")  # for every behaviour trained
     of = f"of the oracle's {actions * len(results.training)} actions" if actions else "of the oracle's actions"
     narrow = [g for g in missed if g.oracle_hits <= NARROW_HITS]
     kinds = ", ".join(f"{k} {n}" for k, n in sorted(_counts(g.kind for g in narrow).items(), key=lambda e: -e[1]))
     threshold = float(results.settings.get("threshold", 0.5))
-    unsure = sum(g.planner_p < threshold for g in missed)
-    sure = [g for g in missed if g.planner_p >= threshold]
     nothing = sum(g.planner_behavior is None for g in missed)
+    unsure = sum(g.planner_behavior is not None and g.planner_p < threshold for g in missed)
+    sure = [g for g in missed if g.planner_behavior is not None and g.planner_p >= threshold]
     groups = [gs for gs in sorted(_by_object(sure).values(), key=len, reverse=True)[:WORST_OBJECTS] if len(gs) > 1]
     named = ", ".join(f"{_object_name(gs)} {len(gs)}" for gs in groups)
     text = (f"the {len(missed)} feasible goals it missed were reached by a median of "
@@ -377,10 +377,11 @@ def single_step_why(results: PlanResults | Mapping[str, Any]) -> str | None:
     if reached:
         text += f", the {len(reached)} it reached by {np.median([g.oracle_hits for g in reached]):g}"
     text += (f"; {len(narrow)} of the missed by at most {NARROW_HITS} (narrow goals: {kinds})" if narrow else "")
-    text += (f"; it chose {unsure} of the missed at P below its threshold {threshold:g} (it expected to miss"
-             + (f"; for {nothing} none of the candidates it asked about was feasible" if nothing else "")
-             + f") and {len(sure)} at P >= {threshold:g}")
-    return text + (f", {sum(map(len, groups))} of them on {len(groups)} objects ({named})" if groups else "")
+    chose = [f"{unsure} at P below its threshold {threshold:g} (it expected to miss)" if unsure else "",
+             f"{len(sure)} at P >= {threshold:g}" if sure else "",
+             f"nothing for {nothing} (none of the candidates it asked about was feasible)" if nothing else ""]
+    text += "; of the missed it chose " + " and ".join(c for c in chose if c)
+    return text + (f", {sum(map(len, groups))} of those on {len(groups)} objects ({named})" if groups else "")
 
 
 def _counts(values) -> dict[str, int]:
@@ -399,7 +400,7 @@ def calibration_why(results: PlanResults | Mapping[str, Any], auroc: bool = Fals
     acted = [g for g in results.goals if g.planner_behavior]
     if not acted:
         return None
-    curve = results.calibration.curve
+    curve = () if auroc else results.calibration.curve  # the curve's largest gap is the ECE's, not the AUROC's
     off = max(curve, key=lambda c: abs(c.p - c.observed) * c.n) if curve else None
     text = ("" if off is None else f"the largest miscalibration is at P = {off.p:.2f}: observed {off.observed:.2f} "
             f"over {off.n} actions")
@@ -431,7 +432,8 @@ def calibration_why(results: PlanResults | Mapping[str, Any], auroc: bool = Fals
 
     value = "not measured" if metric is None else f"{metric:.3f}"
     named = "; ".join(described(objects[o]) for o in worst)
-    return (f"{text + '. ' if text else ''}The most overconfident objects: {named}; without "
+    objects_text = "object" if len(worst) == 1 else "objects"
+    return (f"{text + '. ' if text else ''}The most overconfident {objects_text}: {named}; without "
             f"{'it' if len(worst) == 1 else 'them'} the {'AUROC' if auroc else 'ECE'} is {value} "
             f"(n={n_rest} chosen actions)")
 
@@ -448,8 +450,9 @@ def left_out_why(results: PlanResults | Mapping[str, Any]) -> str | None:
         if not goals or any(g.planner_left_out is None for g in goals):
             return None
         k, n = sum(g.planner for g in goals), len(goals)
-        parts.append(f"{shape}: {_share(loso[shape]['planner'].feasible, 'feasible')} left out, "
-                     f"{share_text(k / n, n, wilson(k, n), 'feasible', digits=1)} with {shape} in the training "
+        named = shape.replace("_", " ")
+        parts.append(f"{named}: {_share(loso[shape]['planner'].feasible, 'feasible')} left out, "
+                     f"{share_text(k / n, n, wilson(k, n), 'feasible', digits=1)} with {named}s in the training "
                      f"data (best fixed {_share(loso[shape]['best_fixed'].feasible, 'feasible')})")
     return "; ".join(parts)
 

@@ -440,17 +440,26 @@ def _calibration(value: Any, path: _Path) -> Calibration:
                        pooled=None if pooled is None else _calibration(pooled, (*path, "pooled")))
 
 
+def _flag(value: Any, path: _Path) -> bool:
+    """``value`` as a bool: true or false (a string such as "false" is neither)."""
+    if isinstance(value, str) or value not in (True, False):
+        raise InvalidValueError(f"{_where(path)} must be true or false, got {value!r}; {_EXPECTED}.")
+    return bool(value)
+
+
 def _goal(value: Any, path: _Path) -> GoalRecord:
     entry = _entry(value, path, ("kind", "type", "object", "planner", "planner_p", "planner_behavior", "oracle"))
     behavior, left_out = entry["planner_behavior"], entry.get("planner_left_out")
     hits = entry.get("oracle_hits")
     return GoalRecord(kind=_text(entry["kind"], (*path, "kind")), type=_text(entry["type"], (*path, "type")),
-                      object=_count(entry["object"], (*path, "object")), planner=bool(entry["planner"]),
+                      object=_count(entry["object"], (*path, "object")),
+                      planner=_flag(entry["planner"], (*path, "planner")),
                       planner_p=_number(entry["planner_p"], (*path, "planner_p")),
                       planner_behavior=_text(behavior, (*path, "planner_behavior")) if behavior else None,
-                      oracle=bool(entry["oracle"]), size=_number(entry.get("size"), (*path, "size"), True),
+                      oracle=_flag(entry["oracle"], (*path, "oracle")),
+                      size=_number(entry.get("size"), (*path, "size"), True),
                       oracle_hits=None if hits is None else _count(hits, (*path, "oracle_hits")),
-                      planner_left_out=None if left_out is None else bool(left_out))
+                      planner_left_out=None if left_out is None else _flag(left_out, (*path, "planner_left_out")))
 
 
 def _decisions(value: Any, path: _Path) -> DecisionTimes:

@@ -9,6 +9,7 @@ import pandas as pd
 import pytest
 from scipy import sparse
 
+from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_learning.effect_model import ActionEffectModel
 from affordance_learning.goals import Lift, Move, Percept, Place, Roll, goal_from_dict
 from affordance_learning.outcomes import MOTION_COLUMNS
@@ -470,7 +471,7 @@ def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     for policy in ("planner", "direction", "random"):
         assert 0 <= results["multi_step"][policy]["reach_failures"] <= 1
     assert {"ece", "auroc"} <= set(results["calibration"])
-    actions = 5 * len(oracle_params())  # every goal says how many of the oracle's actions reached it
+    actions = len(BEHAVIOR_NAMES) * len(oracle_params())  # every goal: how many of the oracle's actions reached it
     for goal in results["goals"]:
         assert goal["oracle"] == (0 < goal["oracle_hits"] <= actions)
         assert 0.03 <= goal["size"] <= 0.1 and isinstance(goal["planner_left_out"], bool)

@@ -203,7 +203,8 @@ def test_plan_results_are_read_typed() -> None:
 def test_plan_results_count_placements_from_the_goals_when_older() -> None:
     older = _plan()
     del older["placement_error_n"]
-    # goals as results of version 2 wrote them: without the object's size, the oracle's hits, the left-out planner
+    # goals as results written before these were recorded: without the object's size, the oracle's hits, the
+    # left-out planner's outcome
     goal = {"kind": "place", "type": "box", "object": 0, "goal": {"kind": "place", "target_xy": [-0.3, 0.0]},
             "planner": False, "planner_p": 0.1, "planner_behavior": "push", "oracle": False}
     older["goals"] = [goal] * 3 + [{**goal, "planner_behavior": None}]
@@ -219,6 +220,9 @@ def test_plan_results_count_placements_from_the_goals_when_older() -> None:
     (lambda r: r["multi_step"]["planner"]["episodes"][0].pop("target_xy"), r"\['episodes'\]\[0\] lacks 'target_xy'"),
     (lambda r: r["calibration"].update(ece="low"), r"plan results\['calibration'\]\['ece'\] must be a number"),
     (lambda r: r.update(goals=[{"kind": "place"}]), r"plan results\['goals'\]\[0\] lacks 'type', 'object'"),
+    (lambda r: r.update(goals=[{"kind": "place", "type": "box", "object": 0, "planner": "false", "planner_p": 0.1,
+                                "planner_behavior": "push", "oracle": False}]),
+     r"plan results\['goals'\]\[0\]\['planner'\] must be true or false, got 'false'"),
     (lambda r: r.update(format="tap-affordance-results"), "results of format 'tap-affordance-results', not "
                                                           "'tap-affordance-plan-results'"),
 ])

@@ -192,9 +192,14 @@ def test_missed_feasible_goals_are_explained_by_how_many_oracle_actions_reached_
                         + [_goal(oracle=False, oracle_hits=0, planner=False)] * 5)
     row = _missed_target_row(results, SINGLE_TARGET, tmp_path)
     assert ("the 6 feasible goals it missed were reached by a median of 3.5 of the oracle's 65 actions, the 8 it "
-            "reached by 30; 3 of the missed by at most 3 (narrow goals: place 3); it chose 1 of the missed at P "
-            "below its threshold 0.5 (it expected to miss) and 5 at P >= 0.5, 5 of them on 2 objects (box of 6.0 cm "
-            "3, box of 7.1 cm 2)") in row
+            "reached by 30; 3 of the missed by at most 3 (narrow goals: place 3); of the missed it chose 1 at P "
+            "below its threshold 0.5 (it expected to miss) and 5 at P >= 0.5, 5 of those on 2 objects (box of 6.00 "
+            "cm 3, box of 7.10 cm 2)") in row
+    # a goal where nothing it asked about was feasible: no choice, not one at P below the threshold
+    results["goals"][8] = _goal(planner=False, oracle_hits=2, kind="place", planner_behavior=None, planner_p=0.0)
+    assert ("of the missed it chose 1 at P below its threshold 0.5 (it expected to miss) and 4 at P >= 0.5 and "
+            "nothing for 1 (none of the candidates it asked about was feasible)") in _missed_target_row(
+        results, SINGLE_TARGET, tmp_path)
     # results written before the oracle's hits were recorded: the gap to the oracle per goal kind, as before
     results["goals"] = [{k: v for k, v in goal.items() if k != "oracle_hits"} for goal in results["goals"]]
     assert "the gap to the oracle is largest for" in _missed_target_row(results, SINGLE_TARGET, tmp_path)
@@ -208,7 +213,7 @@ def test_a_missed_calibration_names_the_most_overconfident_objects_and_the_ece_w
     boxes = [_goal(object=9, size=0.0707, planner_p=0.95, planner=False, planner_behavior="grasp")] * 9
     results["goals"] = honest + boxes + [_goal(object=9, size=0.0707, planner_p=0.95, planner=False)]
     row = _missed_target_row(results, "calibration ECE", tmp_path)
-    assert ("The most overconfident objects: box of 7.1 cm: 10 actions (grasp 9, push 1) at a mean P 0.95, 0 "
+    assert ("The most overconfident object: box of 7.07 cm: 10 actions (grasp 9, push 1) at a mean P 0.95, 0 "
             "reached; without it the ECE is 0.000 (n=50 chosen actions)") in row
 
 
@@ -217,8 +222,8 @@ def test_a_missed_left_out_shape_is_set_beside_the_same_goals_with_the_shape_in_
     results["goals"] = [_goal(type=s, planner=k < 45, planner_left_out=k < (20 if s == "sphere" else 45))
                         for s in SHAPES for k in range(50)]
     row = _missed_target_row(results, SHAPE_TARGET, tmp_path)
-    assert ("sphere: 40.0 % [28, 54] (n=50 feasible) left out, 90.0 % [79, 96] (n=50 feasible) with sphere in the "
-            "training data (best fixed") in row
+    assert ("sphere: 40.0 % [28, 54] (n=50 feasible) left out, 90.0 % [79, 96] (n=50 feasible) with spheres in "
+            "the training data (best fixed") in row
 
 
 def test_the_plan_report_shows_n_beside_every_rate_and_no_zero_for_nothing(tmp_path: Path) -> None:
