@@ -19,6 +19,12 @@ _REAL_KINDS = "iuf"
 _SHOWN = 120
 
 
+def _shown(value: Any) -> str:
+    """``repr(value)``, cut to :data:`_SHOWN` characters."""
+    shown = repr(value)
+    return shown if len(shown) <= _SHOWN else shown[: _SHOWN - 3] + "..."
+
+
 def float_array(name: str, value: Any, shape: tuple[int, ...] | None = None, *, expected: str | None = None,
                 finite: bool = True, error: type[Exception] = InvalidValueError) -> np.ndarray:
     """``value`` as a float64 array, refused (``error``, a message naming ``name``, the value and ``expected``) unless
@@ -39,9 +45,7 @@ def float_array(name: str, value: Any, shape: tuple[int, ...] | None = None, *, 
             kind = "finite real" if finite else "real"
             what = (f"a {kind} number" if shape == () else f"{kind} numbers" if shape is None
                     else f"{kind} numbers of shape {shape}")
-        shown = repr(value)
-        shown = shown if len(shown) <= _SHOWN else shown[: _SHOWN - 3] + "..."
-        return error(f"{name} must be {what}, got {got}{shown}.")
+        return error(f"{name} must be {what}, got {got}{_shown(value)}.")
 
     if isinstance(value, str | bytes | Mapping | set | frozenset):
         raise refused()
@@ -69,9 +73,7 @@ def set_generator_state(generator: np.random.Generator, state: Any) -> None:
     try:
         generator.bit_generator.state = copy.deepcopy(state)
     except (TypeError, ValueError, KeyError):
-        shown = repr(state)
-        raise InvalidValueError(f"the state is damaged: its random generator's state is "
-                                f"{shown if len(shown) <= _SHOWN else shown[: _SHOWN - 3] + '...'}.") from None
+        raise InvalidValueError(f"the state is damaged: its random generator's state is {_shown(state)}.") from None
 
 
 def restore_with_generator(generator: np.random.Generator, state: Any, restore: Callable[[], None]) -> None:

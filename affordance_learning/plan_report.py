@@ -8,6 +8,7 @@ measured", never 0 %. The results are read through :class:`~affordance_learning.
 from __future__ import annotations
 
 import os
+from collections import Counter
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, NamedTuple
@@ -202,8 +203,13 @@ def target_verdict(name: str, measured: Measured) -> str:
         return NOT_MEASURED
     if measured.n < MIN_N[name]:
         return TOO_FEW
+    return MET if _within_bound(name, measured.value) else MISSED
+
+
+def _within_bound(name: str, value: float) -> bool:
+    """Whether ``value`` lies on the right side of target ``name``'s bound (whatever its n)."""
     direction, bound = TARGETS[name]
-    return MET if (measured.value >= bound if direction == ">=" else measured.value <= bound) else MISSED
+    return value >= bound if direction == ">=" else value <= bound
 
 
 def target_met(name: str, measured: Measured | float | None) -> bool | None:
@@ -365,7 +371,7 @@ def single_step_why(results: PlanResults | Mapping[str, Any]) -> str | None:
     actions = results.oracle.get("actions_per_behavior")  # for every behaviour trained
     of = f"of the oracle's {actions * len(results.training)} actions" if actions else "of the oracle's actions"
     narrow = [g for g in missed if g.oracle_hits <= NARROW_HITS]
-    kinds = ", ".join(f"{k} {n}" for k, n in sorted(_counts(g.kind for g in narrow).items(), key=lambda e: -e[1]))
+    kinds = ", ".join(f"{k} {n}" for k, n in Counter(g.kind for g in narrow).most_common())
     threshold = float(results.settings.get("threshold", 0.5))
     nothing = sum(g.planner_behavior is None for g in missed)
     unsure = sum(g.planner_behavior is not None and g.planner_p < threshold for g in missed)
@@ -382,13 +388,6 @@ def single_step_why(results: PlanResults | Mapping[str, Any]) -> str | None:
              f"nothing for {nothing} (none of the candidates it asked about was feasible)" if nothing else ""]
     text += "; of the missed it chose " + " and ".join(c for c in chose if c)
     return text + (f", {sum(map(len, groups))} of those on {len(groups)} objects ({named})" if groups else "")
-
-
-def _counts(values) -> dict[str, int]:
-    out: dict[str, int] = {}
-    for v in values:
-        out[v] = out.get(v, 0) + 1
-    return out
 
 
 def calibration_why(results: PlanResults | Mapping[str, Any], auroc: bool = False) -> str | None:
@@ -409,24 +408,21 @@ def calibration_why(results: PlanResults | Mapping[str, Any], auroc: bool = Fals
     key = "auroc" if auroc else "ece"
     name = "calibration AUROC" if auroc else "calibration ECE"
     ranked = [o for o in sorted(objects, key=lambda o: -excess[o])[:WORST_OBJECTS] if excess[o] > 1e-9]
-    direction, bound = TARGETS[name]
     if not ranked:
         return text
     best = None  # the fewest of them without which the rest meets the target, else those leaving it best
     for k in range(1, len(ranked) + 1):
         rest = [g for g in acted if g.object not in ranked[:k]]
         metric = calibration([g.planner_p for g in rest], [g.planner for g in rest])[key]
-        better = metric is not None and (best is None or best[1] is None
-                                         or (metric > best[1] if auroc else metric < best[1]))
-        if best is None or better:
+        if best is None or (metric is not None and (best[1] is None or (metric > best[1] if auroc
+                                                                        else metric < best[1]))):
             best = (k, metric, len(rest))
-        if metric is not None and (metric >= bound if direction == ">=" else metric <= bound):
+        if metric is not None and _within_bound(name, metric):
             break
     worst, (_, metric, n_rest) = ranked[: best[0]], best
 
     def described(goals: list[GoalRecord]) -> str:
-        chosen = ", ".join(f"{b} {n}" for b, n in sorted(_counts(g.planner_behavior for g in goals).items(),
-                                                          key=lambda e: -e[1]))
+        chosen = ", ".join(f"{b} {n}" for b, n in Counter(g.planner_behavior for g in goals).most_common())
         return (f"{_object_name(goals)}: {len(goals)} actions ({chosen}) at a mean P "
                 f"{np.mean([g.planner_p for g in goals]):.2f}, {sum(g.planner for g in goals)} reached")
 
