@@ -11,7 +11,7 @@
   and its outputs (``affordance reproduce`` runs them end to end for the tap and the grasp).
 - Using the affordances: :class:`ActionEffectModel` ([features, action] -> outcome, with a predictive
   distribution), the goals (:class:`Roll`, :class:`Lift`, :class:`Move`, :class:`Place`, :class:`Percept`) and
-  :class:`Planner` (``affordance plan`` measures them against baselines, :mod:`.plan_experiment`).
+  :class:`Planner` (``affordance plan`` measures them against baselines, :mod:`.planning.experiment`).
 """
 
 import importlib
@@ -34,18 +34,19 @@ _LAZY = {
     **dict.fromkeys(("ActionEffectPrediction", "DefaultModelError", "DefaultModelMissingError", "load_action_model",
                      "load_default_model", "predict_effect", "train_default_model"),
                     "affordance_learning.default_model"),
-    "ActionEffectModel": "affordance_learning.effect_model",
-    **dict.fromkeys(("Lift", "Move", "Percept", "Place", "Roll", "goal_from_dict"), "affordance_learning.goals"),
+    "ActionEffectModel": "affordance_learning.planning.effect_model",
+    **dict.fromkeys(("Lift", "Move", "Percept", "Place", "Roll", "goal_from_dict"),
+                    "affordance_learning.planning.goals"),
     **dict.fromkeys(("adjusted_rand", "cluster_purity", "svm_cv_accuracy", "uniformity"),
-                    "affordance_learning.metrics"),
-    **dict.fromkeys(("AffordanceModel", "EffectPrediction", "select_features"), "affordance_learning.model"),
-    "Planner": "affordance_learning.planner",
-    **dict.fromkeys(("ReliefF", "ReliefFScorer", "relieff_weights"), "affordance_learning.relieff"),
-    "SOMClustering": "affordance_learning.som",
-    "make_synthetic_frame": "affordance_learning.synthetic",
-    "run_protocol": "affordance_learning.protocol",
-    "write_figures": "affordance_learning.figures",
-    "write_report": "affordance_learning.report",
+                    "affordance_learning.paper.metrics"),
+    **dict.fromkeys(("AffordanceModel", "EffectPrediction", "select_features"), "affordance_learning.paper.model"),
+    "Planner": "affordance_learning.planning.planner",
+    **dict.fromkeys(("ReliefF", "ReliefFScorer", "relieff_weights"), "affordance_learning.paper.relieff"),
+    "SOMClustering": "affordance_learning.paper.som",
+    "make_synthetic_frame": "affordance_learning.paper.synthetic",
+    "run_protocol": "affordance_learning.paper.protocol",
+    "write_figures": "affordance_learning.paper.figures",
+    "write_report": "affordance_learning.paper.report",
 }
 
 
@@ -54,7 +55,7 @@ def __getattr__(name: str) -> object:
         value = getattr(importlib.import_module(_LAZY[name]), name)
         globals()[name] = value  # found directly from now on
         return value
-    if importlib.util.find_spec(f"{__name__}.{name}") is not None:  # a submodule: affordance_learning.model, ...
+    if importlib.util.find_spec(f"{__name__}.{name}") is not None:  # a submodule: affordance_learning.paper.model, ...
         return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module 'affordance_learning' has no attribute {name!r}")
 

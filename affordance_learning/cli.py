@@ -25,17 +25,17 @@ from affordance_env.collect_cli import (
 )
 from affordance_env.exceptions import AffordanceEnvError
 from affordance_env.registry import BEHAVIOR_NAMES, ENV_ID
-from affordance_learning.exceptions import AffordanceLearningError, InvalidValueError
-from affordance_learning.plan_results import PLAN_RESULTS_FORMAT
+from affordance_learning.common.exceptions import AffordanceLearningError, InvalidValueError
+from affordance_learning.planning.results import PLAN_RESULTS_FORMAT
 
 if TYPE_CHECKING:
-    from affordance_learning.results import Results
+    from affordance_learning.paper.results import Results
 
-#: The sizes of ``affordance plan`` (:class:`~affordance_learning.plan_experiment.PlanSettings`' defaults), for its
+#: The sizes of ``affordance plan`` (:class:`~affordance_learning.planning.experiment.PlanSettings`' defaults), for its
 #: help; an option not given keeps PlanSettings' own default.
 PLAN_DEFAULTS = {"episodes": 1500, "objects": 24, "multi_episodes": 64}
 #: What ``affordance plan`` writes into its ``--out``: its goal episodes in this directory, and its results
-#: (of the format :data:`~affordance_learning.plan_results.PLAN_RESULTS_FORMAT`), report and figures beside it.
+#: (of the format :data:`~affordance_learning.planning.results.PLAN_RESULTS_FORMAT`), report and figures beside it.
 PLAN_DATASET = "dataset"
 
 
@@ -88,7 +88,7 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
     """``--dataset`` values, ``BEHAVIOR=PATH`` or (with one behaviour) ``PATH``, as a directory per behaviour."""
-    from affordance_learning.behaviors import BEHAVIORS
+    from affordance_learning.common.behaviors import BEHAVIORS
 
     datasets: dict[str, Path] = {}
     for item in items:
@@ -126,7 +126,7 @@ def _check_writable_directory(directory: Path, what: str) -> None:
 
 
 def _reproduce(args: argparse.Namespace) -> int:
-    from affordance_learning.reproduce import DEFAULT_BEHAVIORS, reproduce
+    from affordance_learning.paper.reproduce import DEFAULT_BEHAVIORS, reproduce
 
     _check_writable_directory(args.out, f"--out {args.out}")
     behaviors = args.behavior or list(DEFAULT_BEHAVIORS)
@@ -141,7 +141,7 @@ def _train_action_models(args: argparse.Namespace) -> int:
     ``--dataset`` or reused from there) until every behaviour has 1000 interactions, then an action-conditioned
     model per behaviour."""
     from affordance_learning.default_model import ACTION_INTERACTIONS, DATA_ENV, train_action_models, user_model_dir
-    from affordance_learning.plan_experiment import PlanSettings, collect_training
+    from affordance_learning.planning.experiment import PlanSettings, collect_training
 
     dataset = args.dataset or Path("default-actions")
     out = args.out or user_model_dir()
@@ -158,7 +158,7 @@ def _train_action_models(args: argparse.Namespace) -> int:
 def _train_default(args: argparse.Namespace) -> int:
     if args.action_conditioned:
         return _train_action_models(args)
-    from affordance_learning.behaviors import check_behavior, check_env_offers
+    from affordance_learning.common.behaviors import check_behavior, check_env_offers
 
     behavior = check_behavior(args.behavior)
     from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
@@ -184,7 +184,7 @@ def _train_default(args: argparse.Namespace) -> int:
 
 
 def _fingerprint(args: argparse.Namespace) -> int:
-    from affordance_learning.reproduce import check_fingerprint, write_reference_fingerprint
+    from affordance_learning.paper.reproduce import check_fingerprint, write_reference_fingerprint
 
     drifted = 0
     for where in args.reproduction:
@@ -200,7 +200,7 @@ def _fingerprint(args: argparse.Namespace) -> int:
 
 
 def _compare(args: argparse.Namespace) -> int:
-    from affordance_learning.agreement import UNSTABLE_SPREAD, compare_results
+    from affordance_learning.paper.agreement import UNSTABLE_SPREAD, compare_results
 
     found = [_results_of(where) for where in (args.reference, args.found)]
     comparisons = compare_results(*found)
@@ -216,7 +216,7 @@ def _compare(args: argparse.Namespace) -> int:
 
 def _results_of(where: Path) -> Results:
     """The learning results in ``where`` (a reproduction's directory, or its ``results.json``)."""
-    from affordance_learning.results import Results
+    from affordance_learning.paper.results import Results
 
     results = _read_json(where / "results.json" if where.is_dir() else where)
     if not isinstance(results, dict) or "config" not in results:
@@ -297,14 +297,14 @@ def _check_plan_out(out: Path, seed: int) -> None:
 
 def _plan(args: argparse.Namespace) -> int:
     _check_plan_out(args.out, args.seed)
-    from affordance_learning.plan_experiment import PlanSettings, record_episode, run_plan
-    from affordance_learning.plan_report import (
+    from affordance_learning.planning.experiment import PlanSettings, record_episode, run_plan
+    from affordance_learning.planning.report import (
         measured_targets,
         target_verdict,
         write_plan_figures,
         write_plan_report,
     )
-    from affordance_learning.plan_results import PlanResults
+    from affordance_learning.planning.results import PlanResults
 
     settings = PlanSettings(**{name: getattr(args, name) for name in PLAN_DEFAULTS
                                if getattr(args, name) is not None})

@@ -22,7 +22,7 @@ cached, keyed by the file's path, size and modification time, so a rebuilt file 
 
 Action-conditioned: ``predict_effect(features, behavior, action=params)`` predicts what one action of the
 behaviour does (:class:`ActionEffectPrediction`), from the behaviour's
-:class:`~affordance_learning.effect_model.ActionEffectModel` fitted on goal episodes with random actions
+:class:`~affordance_learning.planning.effect_model.ActionEffectModel` fitted on goal episodes with random actions
 (:func:`train_action_models`; ``affordance train-default --action-conditioned`` collects the episodes and builds
 every behaviour's at once). They are stored and found as the others (``BEHAVIOR_action_model.joblib``, the user's
 before the package's: :func:`action_model_path`) and checked the same way on loading (:data:`ACTION_FORMAT`).
@@ -42,10 +42,10 @@ import pandas as pd
 from numpy.typing import ArrayLike
 
 from affordance_env.values import float_array
-from affordance_learning.behaviors import check_behavior
-from affordance_learning.exceptions import DefaultModelError, DefaultModelMissingError, InvalidValueError
-from affordance_learning.model import AffordanceModel, EffectPrediction
-from affordance_learning.validation import check_float32_range, first_non_finite
+from affordance_learning.common.behaviors import check_behavior
+from affordance_learning.common.exceptions import DefaultModelError, DefaultModelMissingError, InvalidValueError
+from affordance_learning.common.validation import check_float32_range, first_non_finite
+from affordance_learning.paper.model import AffordanceModel, EffectPrediction
 
 #: Where the package's own default models are, one file per behaviour (read only).
 MODEL_DIR = Path(__file__).resolve().parent / "data"
@@ -57,7 +57,7 @@ DATA_ENV = "TAP_AFFORDANCE_DATA"
 DEFAULT_N_CLUSTERS = 4
 DEFAULT_RELEVANCY = 0.4
 #: Maps the default model trains (from seeds 0 to 9), of which it keeps the one of lowest quantization error
-#: (:class:`~affordance_learning.som.SOMClustering`'s ``n_init``). One map is a stochastic descent: on the 1000
+#: (:class:`~affordance_learning.paper.som.SOMClustering`'s ``n_init``). One map is a stochastic descent: on the 1000
 #: canonical taps, the 1 x 4 maps of seeds 0-11 have quantization errors 3.73-4.74 (standardised effects), and the
 #: lower the error, the cleaner their node of slides. The four lowest (3.73-3.97) hold 520-577 taps that moved
 #: 1.8-2.5 cm along the tap; the three highest (4.29-4.74, seed 0's the highest) merge them with the shortest rolls,
@@ -142,10 +142,11 @@ def train_default_model(
         path: Where to write the model (the directory is created; default: the user's file of the behaviour,
             :func:`user_model_path`, which :func:`predict_effect` then uses); written to a temporary file first
             and moved into place, so a reader never sees half a file.
-        behavior: The behaviour of the interactions, one of :data:`affordance_learning.behaviors.BEHAVIORS`.
+        behavior: The behaviour of the interactions, one of :data:`affordance_learning.common.behaviors.BEHAVIORS`.
         n_clusters: Effect categories (map size), in [2, 10].
         relevancy: Relevancy threshold of the feature selection, in [0, 1].
-        random_state: Seed of the first map (the others follow it: :class:`~affordance_learning.som.SOMClustering`).
+        random_state: Seed of the first map (the others follow it:
+            :class:`~affordance_learning.paper.som.SOMClustering`).
         som_n_init: Maps trained, of which the one of lowest quantization error is kept.
 
     Returns:
@@ -154,7 +155,7 @@ def train_default_model(
     Raises:
         ValueError: An unknown behaviour, a frame of another behaviour or of several, or missing columns.
     """
-    from affordance_learning.schema import frame_behavior
+    from affordance_learning.common.schema import frame_behavior
 
     path = user_model_path(behavior) if path is None else path
     frame_behavior(df, check_behavior(behavior))
@@ -241,7 +242,7 @@ def load_default_model(path: str | Path | None = None, *, behavior: str = "tap")
     Args:
         path: The stored model (default: the user's model of the behaviour, else the package's:
             :func:`model_path`).
-        behavior: The behaviour the model must be of, one of :data:`affordance_learning.behaviors.BEHAVIORS`.
+        behavior: The behaviour the model must be of, one of :data:`affordance_learning.common.behaviors.BEHAVIORS`.
 
     Raises:
         ValueError: An unknown behaviour.
@@ -338,14 +339,14 @@ ACTION_REBUILD_COMMAND = "affordance train-default --action-conditioned"
 @dataclass(frozen=True)
 class ActionEffectPrediction:
     """What a behaviour's action-conditioned default model predicts for objects and an action: the mean of its
-    predictive distribution (:class:`~affordance_learning.effect_model.ActionEffectModel`).
+    predictive distribution (:class:`~affordance_learning.planning.effect_model.ActionEffectModel`).
 
     Attributes:
         effect: The perceptual effect, final minus initial features (n, 49), each in its feature's unit: the
             training neighbours' as they were.
         displacement: How far the object's centre moves on the table (n, 2) [m], root frame (+x toward the robot):
             the neighbours' moved to this action along the local slopes
-            (:meth:`~affordance_learning.effect_model.ActionEffectModel.predictive_outcomes`).
+            (:meth:`~affordance_learning.planning.effect_model.ActionEffectModel.predictive_outcomes`).
         rolled: P(the object rolls further than the roll threshold), (n,).
         off_table: P(it leaves the table), (n,).
         lifted: P(a grasp lifts and holds it), (n,) (0 for the other behaviours).
@@ -390,8 +391,8 @@ def train_action_models(frame: pd.DataFrame, out: str | Path | None = None, *,
     Raises:
         ValueError: A behaviour without interactions in the frame, or a frame without the goal dataset's columns.
     """
-    from affordance_learning.effect_model import behavior_model
-    from affordance_learning.outcomes import model_inputs, outcome_table
+    from affordance_learning.planning.effect_model import behavior_model
+    from affordance_learning.planning.outcomes import model_inputs, outcome_table
 
     out = user_model_dir() if out is None else Path(out)
     held = [str(b) for b in dict.fromkeys(frame["behavior"].astype(str))] if "behavior" in frame else []
@@ -429,7 +430,7 @@ def _action_problem(path: Path | str, problem: str) -> str:
 @functools.lru_cache(maxsize=8)
 def _load_action(path: str, size: int, mtime_ns: int, behavior: str):
     """Load and check a stored action-conditioned model of ``behavior``; ``size`` and ``mtime_ns`` key the cache."""
-    from affordance_learning.effect_model import ActionEffectModel
+    from affordance_learning.planning.effect_model import ActionEffectModel
 
     try:
         bundle: Any = joblib.load(path)
@@ -459,7 +460,7 @@ def _load_action(path: str, size: int, mtime_ns: int, behavior: str):
 
 def load_action_model(behavior: str = "tap", path: str | Path | None = None):
     """The action-conditioned default model of ``behavior`` (an
-    :class:`~affordance_learning.effect_model.ActionEffectModel`), checked against the installed library versions
+    :class:`~.planning.effect_model.ActionEffectModel`), checked against the installed library versions
     (cached). Raises DefaultModelMissingError (with the command that builds it) or DefaultModelError as
     :func:`load_default_model`."""
     behavior = check_behavior(behavior)

@@ -6,8 +6,9 @@ weighted share of outcomes that reach the goal (roll, lift, move 5 cm in 4 direc
 interaction, 2 places 5-15 cm from where the object was, 3 cm tolerance, as ``affordance plan`` draws them).
 Compared on the last quarter of each behaviour's interactions (by episode), trained on the rest:
 
-- ``forest``: :class:`affordance_learning.effect_model.ActionEffectModel` as ``affordance plan`` fits it
-  (:func:`~affordance_learning.effect_model.behavior_model`: a random forest as a quantile regression forest; each
+- ``forest``: :class:`affordance_learning.planning.effect_model.ActionEffectModel` as ``affordance plan`` fits it
+  (:func:`~affordance_learning.planning.effect_model.behavior_model`:
+   a random forest as a quantile regression forest; each
   neighbour's displacement moved to the query's action along the local slopes; the grasp's flags weighing 5 times
   a displacement in the splits, the others' twice);
 - ``forest_flags_2``: the same with every behaviour's flags weighing twice a displacement;
@@ -33,10 +34,10 @@ from sklearn.neighbors import NearestNeighbors
 from sklearn.preprocessing import StandardScaler
 
 from affordance_env import load_dataset
-from affordance_learning.effect_model import FLAG_WEIGHT, ActionEffectModel, behavior_model
-from affordance_learning.goals import Lift, Move, Place, Roll
-from affordance_learning.outcomes import model_inputs, outcome_table
-from affordance_learning.plan_experiment import BEHAVIORS, calibration
+from affordance_learning.planning.effect_model import FLAG_WEIGHT, ActionEffectModel, behavior_model
+from affordance_learning.planning.experiment import BEHAVIORS, calibration
+from affordance_learning.planning.goals import Lift, Move, Place, Roll
+from affordance_learning.planning.outcomes import model_inputs, outcome_table
 
 GOALS = [Roll(), Lift(), *(Move(d, 0.05) for d in ((1, 0), (-1, 0), (0, 1), (0, -1)))]
 #: Place goals per held-out interaction, their distance from where the object was [m] and tolerance [m].

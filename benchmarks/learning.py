@@ -2,7 +2,7 @@
 
 Run ``python benchmarks/learning.py [--rows 1000] [--trials 20] [--jobs 2]`` from the repository root (with
 the package installed or on ``PYTHONPATH``). No simulator: the frame comes from
-:func:`affordance_learning.synthetic.make_synthetic_frame`. Prints, measured in the same run:
+:func:`affordance_learning.paper.synthetic.make_synthetic_frame`. Prints, measured in the same run:
 
 - skrebate's ``ReliefF(n_neighbors=10)`` fit on the frame's initial features (rows x 49) against 4 effect
   clusters, and :func:`relieff_weights` on the same data, their ratio and largest difference;
@@ -19,8 +19,8 @@ import numpy as np
 from sklearn.preprocessing import StandardScaler
 
 from affordance_learning import SOMClustering, relieff_weights, run_protocol
-from affordance_learning.schema import feature_names
-from affordance_learning.synthetic import make_synthetic_frame
+from affordance_learning.common.schema import feature_names
+from affordance_learning.paper.synthetic import make_synthetic_frame
 
 GOAL_S = 60.0
 

@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from affordance_env.tap_env import TapAffordanceEnv  # noqa: E402
-from affordance_learning.behaviors import outcome_words  # noqa: E402
+from affordance_learning.common.behaviors import outcome_words  # noqa: E402
 
 
 def main() -> None:

@@ -17,10 +17,10 @@ import numpy as np
 import affordance_env  # noqa: F401  (registers the environments)
 from affordance_env.workspace import in_workspace
 from affordance_learning import load_action_model
-from affordance_learning.behaviors import BEHAVIORS
-from affordance_learning.goals import Move, describe
-from affordance_learning.plan_experiment import fit_models, load_training, training_frames
-from affordance_learning.planner import Planner
+from affordance_learning.common.behaviors import BEHAVIORS
+from affordance_learning.planning.experiment import fit_models, load_training, training_frames
+from affordance_learning.planning.goals import Move, describe
+from affordance_learning.planning.planner import Planner
 
 
 def main() -> None:

@@ -17,8 +17,8 @@ from affordance_learning.default_model import (
     predict_effect,
     train_action_models,
 )
-from affordance_learning.effect_model import BEHAVIOR_FLAG_WEIGHTS, FLAG_WEIGHT
-from affordance_learning.plan_experiment import fit_models
+from affordance_learning.planning.effect_model import BEHAVIOR_FLAG_WEIGHTS, FLAG_WEIGHT
+from affordance_learning.planning.experiment import fit_models
 
 N = len(FEATURE_NAMES)
 

@@ -17,10 +17,10 @@ from affordance_env.physics import TapPhysics
 from affordance_env.scene import build_model, table_extent
 from affordance_env.tap_env import TapAffordanceEnv
 from affordance_learning import predict_effect
-from affordance_learning.behaviors import BEHAVIORS
-from affordance_learning.effect_model import ActionEffectModel
-from affordance_learning.goals import Place, Roll
-from affordance_learning.planner import Planner
+from affordance_learning.common.behaviors import BEHAVIORS
+from affordance_learning.planning.effect_model import ActionEffectModel
+from affordance_learning.planning.goals import Place, Roll
+from affordance_learning.planning.planner import Planner
 
 N = len(FEATURE_NAMES)
 
@@ -243,7 +243,7 @@ def test_a_camera_too_large_to_allocate_and_a_reward_fn_that_is_no_function_are_
 def test_a_fingerprint_file_that_is_not_a_fingerprint_is_refused_before_any_collection(tmp_path):
     import json
 
-    from affordance_learning.reproduce import check_fingerprint
+    from affordance_learning.paper.reproduce import check_fingerprint
 
     (tmp_path / "fingerprint.json").write_text(json.dumps([1, 2]))
     with pytest.raises(ValueError, match="fingerprint.json is not a fingerprint"):

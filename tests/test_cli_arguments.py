@@ -85,7 +85,7 @@ def no_work(monkeypatch):
     import gymnasium
 
     import affordance_env.dataset as dataset
-    import affordance_learning.plan_experiment as plan_experiment
+    import affordance_learning.planning.experiment as plan_experiment
     from affordance_env.dataset import minari_export
 
     def started(*args, **kwargs):
@@ -107,7 +107,7 @@ def _refused(argv, capsys, *fragments):
 
 
 def test_plan_takes_the_sizes_given_and_plan_settings_defaults_otherwise(no_work, tmp_path):
-    from affordance_learning.plan_experiment import PlanSettings
+    from affordance_learning.planning.experiment import PlanSettings
 
     assert PLAN_DEFAULTS == {name: getattr(PlanSettings(), name) for name in PLAN_DEFAULTS}  # the help says these
     with pytest.raises(WorkStarted) as started:
@@ -180,7 +180,7 @@ def test_plan_takes_a_new_or_empty_out_or_an_earlier_plans(no_work, tmp_path):
 def test_plan_results_format_is_the_one_run_plan_writes():
     import inspect
 
-    import affordance_learning.plan_experiment as plan_experiment
+    import affordance_learning.planning.experiment as plan_experiment
     from affordance_learning.cli import PLAN_DATASET, PLAN_RESULTS_FORMAT
 
     source = inspect.getsource(plan_experiment.run_plan)
@@ -265,7 +265,7 @@ def test_a_command_line_mistake_imports_neither_the_simulator_nor_what_the_comma
     code = f"""
 import importlib.abc, os, sys
 HEAVY = {{"mujoco", "pinocchio", "minari", "sklearn", "scipy", "matplotlib", "affordance_env.tap_env",
-         "affordance_learning.plan_experiment"}}
+         "affordance_learning.planning.experiment"}}
 class Guard(importlib.abc.MetaPathFinder):
     def find_spec(self, name, path=None, target=None):
         if name in HEAVY:

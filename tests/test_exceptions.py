@@ -6,7 +6,7 @@ from pathlib import Path
 import pytest
 
 import affordance_env.exceptions as env_errors
-import affordance_learning.exceptions as learning_errors
+import affordance_learning.common.exceptions as learning_errors
 from affordance_learning import cli
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -72,6 +72,6 @@ def _with_func(parser, func):
 def test_the_lazy_package_still_reaches_its_submodules():
     import affordance_learning
 
-    assert affordance_learning.model.AffordanceModel is affordance_learning.AffordanceModel
+    assert affordance_learning.paper.model.AffordanceModel is affordance_learning.AffordanceModel
     with pytest.raises(AttributeError, match="no attribute 'nothing'"):
         affordance_learning.nothing  # noqa: B018

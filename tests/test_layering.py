@@ -77,3 +77,26 @@ def test_adding_a_behaviour_is_one_module_and_one_registry_line():
             assert behavior.name == name and registry.REGISTERED[name].module == info.name
     for name, entry in registry.REGISTERED.items():
         assert name in importlib.import_module(f"affordance_env.behaviors.{entry.module}").BEHAVIORS
+
+
+def _learning_imports(room: str) -> dict[str, list[str]]:
+    import affordance_learning
+
+    package = Path(affordance_learning.__file__).parent / room
+    return {str(path.relative_to(package.parent)): sorted(m for m in _imported_modules(path)
+                                                          if m.startswith("affordance_learning"))
+            for path in package.rglob("*.py")}
+
+
+def test_learning_rooms_are_layered_common_below_paper_below_planning():
+    # common/ serves both experiments and knows neither; the paper's experiment knows nothing of the planner; the
+    # planner may use the paper (its effect categories are a baseline). The command line and the default models
+    # stand on top.
+    allowed = {"common": ("affordance_learning.common",),
+               "paper": ("affordance_learning.common", "affordance_learning.paper"),
+               "planning": ("affordance_learning.common", "affordance_learning.paper", "affordance_learning.planning")}
+    for room, ok in allowed.items():
+        imports = _learning_imports(room)
+        assert imports, f"no modules found in affordance_learning/{room}"
+        offenders = {path: [m for m in names if not m.startswith(ok)] for path, names in imports.items()}
+        assert not {k: v for k, v in offenders.items() if v}, offenders

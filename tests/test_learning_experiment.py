@@ -11,9 +11,16 @@ import pandas as pd
 import pytest
 
 from affordance_learning import run_protocol, write_figures, write_report
-from affordance_learning.report import AGREES, DISAGREES, NOT_COMPUTABLE, VERDICTS, evaluate_claims, write_overview
-from affordance_learning.schema import feature_groups, feature_names
-from affordance_learning.synthetic import make_synthetic_frame
+from affordance_learning.common.schema import feature_groups, feature_names
+from affordance_learning.paper.report import (
+    AGREES,
+    DISAGREES,
+    NOT_COMPUTABLE,
+    VERDICTS,
+    evaluate_claims,
+    write_overview,
+)
+from affordance_learning.paper.synthetic import make_synthetic_frame
 
 KS = (2, 3, 4)
 RS = (0.0, 0.4)
@@ -421,7 +428,7 @@ def test_the_overview_sets_the_behaviours_side_by_side(results: dict, tmp_path: 
 
 
 def test_reports_define_uniformity_and_read_older_results_in_percent(results: dict, tmp_path: Path) -> None:
-    from affordance_learning.report import render_overview, render_report
+    from affordance_learning.paper.report import render_overview, render_report
 
     text = render_report(results)
     assert "U = sum over clusters c of |S_c - F_c| / T" in text and "fractions in [0, 1]" in text
@@ -440,8 +447,8 @@ def test_reports_define_uniformity_and_read_older_results_in_percent(results: di
 
 
 def test_no_critical_size_where_success_does_not_depend_on_size(results: dict, tmp_path: Path) -> None:
-    from affordance_learning.metrics import size_success
-    from affordance_learning.report import render_overview, render_report
+    from affordance_learning.paper.metrics import size_success
+    from affordance_learning.paper.report import render_overview, render_report
 
     rng = np.random.default_rng(3)
     sizes = rng.uniform(0.04, 0.10, 1000)  # the tap's rolled share drifts from 47 % to 56 % across the sizes
@@ -455,7 +462,7 @@ def test_no_critical_size_where_success_does_not_depend_on_size(results: dict, t
 
 
 def test_prototypes_mark_categories_whose_objects_left_the_view(results: dict, tmp_path: Path, monkeypatch) -> None:
-    import affordance_learning.figures as figures
+    import affordance_learning.paper.figures as figures
 
     drawn = {}
     monkeypatch.setattr(figures, "_save", lambda fig, path: drawn.setdefault(path.name, fig) and path)

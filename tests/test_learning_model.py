@@ -30,8 +30,8 @@ from affordance_learning import (
     uniformity,
 )
 from affordance_learning import default_model as default_model_module
-from affordance_learning.metrics import size_success
-from affordance_learning.synthetic import make_synthetic_frame
+from affordance_learning.paper.metrics import size_success
+from affordance_learning.paper.synthetic import make_synthetic_frame
 
 # --------------------------------------------------------------------------------------------- fixtures
 

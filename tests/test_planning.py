@@ -10,10 +10,10 @@ import pytest
 from scipy import sparse
 
 from affordance_env.registry import BEHAVIOR_NAMES
-from affordance_learning.effect_model import ActionEffectModel
-from affordance_learning.goals import Lift, Move, Percept, Place, Roll, goal_from_dict
-from affordance_learning.outcomes import MOTION_COLUMNS
-from affordance_learning.planner import REFUSAL_RADIUS, SCENE_TABLE, Planner, candidate_params
+from affordance_learning.planning.effect_model import ActionEffectModel
+from affordance_learning.planning.goals import Lift, Move, Percept, Place, Roll, goal_from_dict
+from affordance_learning.planning.outcomes import MOTION_COLUMNS
+from affordance_learning.planning.planner import REFUSAL_RADIUS, SCENE_TABLE, Planner, candidate_params
 
 
 def synthetic(n: int = 600, seed: int = 0, push: float = 0.12) -> tuple[np.ndarray, pd.DataFrame]:
@@ -128,7 +128,7 @@ def test_toward_searches_over_two_interactions_where_the_nearest_first_step_is_a
 def test_toward_by_default_looks_ahead_within_the_workspaces():
     import inspect
 
-    from affordance_learning.planner import in_workspace
+    from affordance_learning.planning.planner import in_workspace
 
     parameters = inspect.signature(Planner.toward).parameters
     assert parameters["steps_left"].default is None and parameters["reachable"].default is in_workspace
@@ -299,7 +299,7 @@ def test_an_outcome_that_ends_beyond_the_table_edge_counts_as_off_the_table():
 def test_place_goals_lie_on_the_table_where_the_goal_env_puts_its_goals():
     from affordance_env.goal_env import GOAL_TABLE_MARGIN
     from affordance_env.workspace import in_any_workspace
-    from affordance_learning.plan_experiment import PLACE_DISTANCE, draw_goal
+    from affordance_learning.planning.experiment import PLACE_DISTANCE, draw_goal
 
     rng = np.random.default_rng(0)
     low, high = np.array(SCENE_TABLE[0]) + GOAL_TABLE_MARGIN, np.array(SCENE_TABLE[1]) - GOAL_TABLE_MARGIN
@@ -314,7 +314,7 @@ def test_place_goals_lie_on_the_table_where_the_goal_env_puts_its_goals():
 
 
 def test_step_reach_and_within_reach_bound_what_a_few_interactions_can_do():
-    from affordance_learning.plan_experiment import step_reach, within_reach
+    from affordance_learning.planning.experiment import step_reach, within_reach
 
     n = 100
     moves = np.linspace(0.0, 0.05, n)  # boxes pushed away (-x) by up to 5 cm, never towards the robot
@@ -340,7 +340,7 @@ def test_candidates_and_errors():
 
 
 def test_the_oracle_tries_a_fixed_set_of_at_least_64_actions_per_behaviour():
-    from affordance_learning.plan_experiment import oracle_params
+    from affordance_learning.planning.experiment import oracle_params
 
     params = oracle_params()
     assert params.shape[0] >= 64 + 1 and params.shape[1] == 3 and np.all(np.abs(params) <= 1)
@@ -352,7 +352,7 @@ def test_the_oracle_tries_a_fixed_set_of_at_least_64_actions_per_behaviour():
 
 
 def test_calibration_is_measured_on_the_chosen_actions_with_pooled_beside_it():
-    from affordance_learning.plan_experiment import calibrations
+    from affordance_learning.planning.experiment import calibrations
 
     # The planner picks actions it believes at 0.9 and half of them reach the goal; every other action tried is at
     # P near 0 and never reaches it: pooled, the 0.4-point miscalibration is drowned in the many right zeros.
@@ -366,7 +366,7 @@ def test_calibration_is_measured_on_the_chosen_actions_with_pooled_beside_it():
 
 
 def test_success_is_reported_on_feasible_goals_and_on_those_the_oracle_or_the_planner_reached():
-    from affordance_learning.plan_experiment import seconds_summary, summarize
+    from affordance_learning.planning.experiment import seconds_summary, summarize
 
     records = ([{"oracle": True, "planner": True}] * 6 + [{"oracle": True, "planner": False}] * 2
                + [{"oracle": False, "planner": True}] * 2 + [{"oracle": False, "planner": False}] * 10)
@@ -379,7 +379,7 @@ def test_success_is_reported_on_feasible_goals_and_on_those_the_oracle_or_the_pl
 
 
 def test_calibration_and_wilson_intervals():
-    from affordance_learning.plan_experiment import calibration, wilson
+    from affordance_learning.planning.experiment import calibration, wilson
 
     rng = np.random.default_rng(0)
     p = rng.uniform(0, 1, 4000)
@@ -395,7 +395,7 @@ def test_calibration_and_wilson_intervals():
 
 
 def test_goals_are_judged_on_what_the_simulator_measured():
-    from affordance_learning.plan_experiment import draw_goal, reached
+    from affordance_learning.planning.experiment import draw_goal, reached
 
     info = {"failure": None, "rolled": True, "outcome": "rest", "behavior": "tap", "success": True,
             "effect": np.zeros(49), "object": {"initial_pose": np.array([-0.3, 0.0, 0.0, 1, 0, 0, 0]),
@@ -420,7 +420,7 @@ def _sleep_then_pid(seconds: float, scale: float = 1.0) -> tuple[float, int]:
 
 @pytest.mark.slow
 def test_the_evaluation_hands_each_item_to_the_first_free_process_and_keeps_the_order():
-    from affordance_learning.plan_experiment import _parallel
+    from affordance_learning.planning.experiment import _parallel
 
     items = [1.5] + [0.01] * 9  # the first item is slow: the other process does the rest meanwhile
     results = _parallel(_sleep_then_pid, items, 2, scale=1.0)
@@ -437,7 +437,7 @@ def test_the_evaluation_takes_new_processes_not_those_joblib_kept_from_the_colle
 
     from joblib import Parallel, delayed
 
-    from affordance_learning.plan_experiment import _parallel
+    from affordance_learning.planning.experiment import _parallel
 
     kept = set(Parallel(n_jobs=2, batch_size=1)(delayed(os.getpid)() for _ in range(4)))
     fresh = {pid for _, pid in _parallel(_sleep_then_pid, [0.2, 0.2, 0.2], 2, scale=1.0)}
@@ -446,8 +446,8 @@ def test_the_evaluation_takes_new_processes_not_those_joblib_kept_from_the_colle
 
 @pytest.mark.slow
 def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
-    from affordance_learning.plan_experiment import PlanSettings, oracle_params, run_plan
-    from affordance_learning.plan_report import TARGETS, write_plan_figures, write_plan_report
+    from affordance_learning.planning.experiment import PlanSettings, oracle_params, run_plan
+    from affordance_learning.planning.report import TARGETS, write_plan_figures, write_plan_report
 
     settings = PlanSettings(episodes=40, max_episodes=40, objects=2, multi_episodes=2, candidates=8,
                             som_clusters=2)
@@ -486,8 +486,8 @@ def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
 def test_a_multi_step_action_that_left_the_object_where_it_was_is_noted_as_failed():
     """A 10 cm box, which the hand cannot hold, grasped again and again: every grasp leaves it where it was, and
     the episode notes each as failed, so that a planner does not choose it again from there."""
-    from affordance_learning import plan_experiment
-    from affordance_learning.planner import Choice
+    from affordance_learning.planning import experiment as plan_experiment
+    from affordance_learning.planning.planner import Choice
 
     class Grasping:  # a planner that grasps whatever the situation, recording what it is told
         def __init__(self) -> None:
@@ -520,7 +520,7 @@ def test_an_episode_toward_the_robot_takes_an_object_the_table_leaves_room_for_s
     """An object 22 cm from the robot leaves no room for a target 10 cm or more toward it 5 cm inside the table's
     near edge: the episode draws another object, and its target lies toward the robot."""
     from affordance_env.goal_env import GOAL_DISTANCE, GOAL_TABLE_MARGIN
-    from affordance_learning import plan_experiment
+    from affordance_learning.planning import experiment as plan_experiment
 
     env = plan_experiment._env((40, 30))
     reset = env.reset

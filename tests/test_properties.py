@@ -10,7 +10,7 @@ from hypothesis.extra.numpy import arrays
 
 from affordance_env.dataset import FORMAT, SCHEMA_VERSION, DatasetError, load_dataset
 from affordance_learning import AffordanceModel
-from affordance_learning.relieff import relieff_weights
+from affordance_learning.paper.relieff import relieff_weights
 
 finite = st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False)
 

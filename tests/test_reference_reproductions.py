@@ -11,8 +11,8 @@ from affordance_env import load_dataset
 from affordance_env.dataset import collect
 from affordance_env.dataset.fingerprint import fingerprint, fingerprint_differences
 from affordance_learning.cli import main
-from affordance_learning.report import render_overview, render_report
-from affordance_learning.reproduce import FINGERPRINT, check_fingerprint
+from affordance_learning.paper.report import render_overview, render_report
+from affordance_learning.paper.reproduce import FINGERPRINT, check_fingerprint
 
 REPRODUCTIONS = sorted(p.parent for p in (Path(__file__).resolve().parent.parent / "docs" / "reproduction")
                        .glob("*/results.json"))

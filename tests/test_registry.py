@@ -8,9 +8,9 @@ from affordance_env.behaviors import BEHAVIORS as ENV_BEHAVIORS
 from affordance_env.dataset.format import ENV_IDS
 from affordance_env.goal_env import ARM_OF
 from affordance_env.goal_env import BEHAVIORS as GOAL_BEHAVIORS
-from affordance_learning.behaviors import BEHAVIORS as LEARNING_BEHAVIORS
-from affordance_learning.behaviors import OUTCOME_WORDS, check_behavior
-from affordance_learning.plan_experiment import BEHAVIORS as PLAN_BEHAVIORS
+from affordance_learning.common.behaviors import BEHAVIORS as LEARNING_BEHAVIORS
+from affordance_learning.common.behaviors import OUTCOME_WORDS, check_behavior
+from affordance_learning.planning.experiment import BEHAVIORS as PLAN_BEHAVIORS
 
 
 def test_every_part_offers_the_registrys_behaviours():

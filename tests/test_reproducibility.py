@@ -162,7 +162,7 @@ def _results(uniformity_k3: float = 0.77, success: float = 0.5, std: float = 0.0
 
 
 def test_two_reproductions_agree_within_the_trials_own_spread():
-    from affordance_learning.agreement import FLOOR, Z, compare_results
+    from affordance_learning.paper.agreement import FLOOR, Z, compare_results
 
     same = compare_results(_results(), _results(uniformity_k3=0.80))  # 3 points at a spread of 5 points
     assert all(c.ok for c in same) and len(same) == 1 + 2 + 2
@@ -180,7 +180,7 @@ def test_two_reproductions_agree_within_the_trials_own_spread():
 
 
 def test_a_number_whose_trials_disagree_is_shown_but_not_held_to_a_tolerance():
-    from affordance_learning.agreement import UNSTABLE_SPREAD, compare_results
+    from affordance_learning.paper.agreement import UNSTABLE_SPREAD, compare_results
 
     unstable = compare_results(_results(std=UNSTABLE_SPREAD + 0.05), _results(uniformity_k3=0.40))
     k3 = next(c for c in unstable if c.name == "uniformity at k = 3")
@@ -192,7 +192,7 @@ def test_a_number_whose_trials_disagree_is_shown_but_not_held_to_a_tolerance():
 
 
 def test_only_reproductions_of_the_same_experiment_are_compared():
-    from affordance_learning.agreement import compare_results
+    from affordance_learning.paper.agreement import compare_results
 
     other = _results()
     other["config"]["seed"] = 1

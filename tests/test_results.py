@@ -11,11 +11,11 @@ from pathlib import Path
 
 import pytest
 
-from affordance_learning.claims import CLAIM_SETS, METHOD_CLAIMS, ClaimSpec, evaluate_claims
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.plan_results import NOTHING, PlanResults
-from affordance_learning.report import render_report
-from affordance_learning.results import RESULTS_FORMAT, Results, Stat, k_key, r_key
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.paper.claims import CLAIM_SETS, METHOD_CLAIMS, ClaimSpec, evaluate_claims
+from affordance_learning.paper.report import render_report
+from affordance_learning.paper.results import RESULTS_FORMAT, Results, Stat, k_key, r_key
+from affordance_learning.planning.results import NOTHING, PlanResults
 
 ROOT = Path(__file__).resolve().parent.parent
 TAP = ROOT / "docs" / "reproduction" / "tap" / "results.json"

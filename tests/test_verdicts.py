@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from affordance_learning.claims import (
+from affordance_learning.paper.claims import (
     AGREES,
     DISAGREES,
     MIN_INTERACTIONS,
@@ -20,9 +20,10 @@ from affordance_learning.claims import (
     TOO_FEW,
     evaluate_claims,
 )
-from affordance_learning.metrics import wilson_interval
-from affordance_learning.plan_experiment import MULTI_POLICIES, POLICIES, SHAPES, share_text, summarize
-from affordance_learning.plan_report import (
+from affordance_learning.paper.metrics import wilson_interval
+from affordance_learning.paper.report import render_report
+from affordance_learning.planning.experiment import MULTI_POLICIES, POLICIES, SHAPES, share_text, summarize
+from affordance_learning.planning.report import (
     MET,
     MIN_CALIBRATION_ACTIONS,
     MIN_EPISODES,
@@ -36,9 +37,8 @@ from affordance_learning.plan_report import (
     target_verdict,
     write_plan_report,
 )
-from affordance_learning.plan_report import TOO_FEW as TARGET_TOO_FEW
-from affordance_learning.plan_results import PlanResults
-from affordance_learning.report import render_report
+from affordance_learning.planning.report import TOO_FEW as TARGET_TOO_FEW
+from affordance_learning.planning.results import PlanResults
 
 STRADDLE = "1 x 3 map: a category straddles the critical size"
 SHAPE_TARGET = "each left-out shape, success on its feasible goals"

@@ -2,7 +2,7 @@
 
 :data:`TARGETS` holds each target once; the check and the report's text both read it. A target is judged "met" or
 "missed" only on enough data (:data:`MIN_N`); below that it is "too few (n=...)", and a share of nothing is "not
-measured", never 0 %. The results are read through :class:`~affordance_learning.plan_results.PlanResults`.
+measured", never 0 %. The results are read through :class:`~affordance_learning.planning.results.PlanResults`.
 """
 
 from __future__ import annotations
@@ -15,8 +15,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.plan_experiment import (
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.planning.experiment import (
     GOAL_KINDS,
     MULTI_POLICIES,
     POLICIES,
@@ -26,8 +26,8 @@ from affordance_learning.plan_experiment import (
     share_text,
     wilson,
 )
-from affordance_learning.plan_results import NOTHING, GoalRecord, PlanResults, Share
-from affordance_learning.planner import MAX_CHECKS
+from affordance_learning.planning.planner import MAX_CHECKS
+from affordance_learning.planning.results import NOTHING, GoalRecord, PlanResults, Share
 
 #: The targets of the planner, each a (direction, value): ">=" or "<=".
 TARGETS: dict[str, tuple[str, float]] = {

@@ -32,8 +32,8 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.results import Cluster, PerK, PerRK, Results, as_results
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.paper.results import Cluster, PerK, PerRK, Results, as_results
 
 _REQUIRED = ("uniformity", "svm_accuracy", "shape_fraction", "size_fraction", "n_selected", "case_studies")
 _TYPE_COLOURS = {
@@ -297,8 +297,8 @@ def write_figures(results: Results | Mapping[str, Any], out_dir: str | Path,
     """Write the figures of a results dict into ``out_dir`` (created if needed); returns their paths.
 
     Args:
-        results: :class:`~affordance_learning.results.Results`, or the dict returned by
-            :func:`affordance_learning.protocol.run_protocol` (or read back from its JSON).
+        results: :class:`~affordance_learning.paper.results.Results`, or the dict returned by
+            :func:`affordance_learning.paper.protocol.run_protocol` (or read back from its JSON).
         out_dir: Directory for the PNG files.
         progress: Draw a progress bar over the figures; None: a bar on a terminal, else a line every 10 s.
 

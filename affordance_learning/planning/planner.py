@@ -2,7 +2,7 @@
 
 :class:`Planner` scores candidate actions, every behaviour with ``n_candidates`` parameter vectors (the canonical
 action and a scrambled Sobol sequence over [-1, 1]^3), by P(goal) under each behaviour's
-:class:`~affordance_learning.effect_model.ActionEffectModel`, and takes the most likely one that the arm can
+:class:`~affordance_learning.planning.effect_model.ActionEffectModel`, and takes the most likely one that the arm can
 reach: ``feasible`` (the kinematics, tens of milliseconds a call) is asked from the most likely down, at most
 ``max_checks`` times per decision, so that a decision costs a few calls, not one per candidate. Candidates of equal
 P (every one near 0 for a goal out of reach) are ranked by how far their predicted outcomes go towards the goal,
@@ -26,11 +26,11 @@ from scipy.stats import qmc
 
 from affordance_env.scene import table_extent
 from affordance_env.values import float_array
-from affordance_learning.behaviors import BEHAVIORS
-from affordance_learning.effect_model import ActionEffectModel, PredictiveOutcomes
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.goals import Goal, Move, Place, check_goal, check_start
-from affordance_learning.validation import check_float32_range
+from affordance_learning.common.behaviors import BEHAVIORS
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.common.validation import check_float32_range
+from affordance_learning.planning.effect_model import ActionEffectModel, PredictiveOutcomes
+from affordance_learning.planning.goals import Goal, Move, Place, check_goal, check_start
 
 #: The scene's table top, ((x_low, y_low), (x_high, y_high)) [m] in the robot's root frame: the planner's default
 #: ``table``.
@@ -146,8 +146,8 @@ class Planner:
     """Chooses the behaviour and parameters that maximise P(goal).
 
     Args:
-        models: A fitted :class:`~affordance_learning.effect_model.ActionEffectModel` per behaviour name (one of
-            :data:`affordance_learning.behaviors.BEHAVIORS`), each of the same inputs: the object's features (the
+        models: A fitted :class:`~.effect_model.ActionEffectModel` per behaviour name (one of
+            :data:`affordance_learning.common.behaviors.BEHAVIORS`), each of the same inputs: the object's features (the
             49 of ``affordance_env.FEATURE_NAMES``) and the 3 action parameters.
         n_candidates: Parameter vectors scored per behaviour.
         threshold: Abstain below this P(goal).
@@ -160,8 +160,8 @@ class Planner:
             (a place beyond the edge was never executed, so no training outcome says what it does). None: no table.
 
     Every method checks its inputs before any work: ``features`` must have as many values as the models take
-    (ValueError), the goal must be a goal of :mod:`affordance_learning.goals` (TypeError), a
-    :class:`~affordance_learning.goals.Place` needs ``start_xy``; with a ``table``, a place's target (and
+    (ValueError), the goal must be a goal of :mod:`affordance_learning.planning.goals` (TypeError), a
+    :class:`~affordance_learning.planning.goals.Place` needs ``start_xy``; with a ``table``, a place's target (and
     :meth:`toward`'s) must lie on the table top, and ``start_xy`` within :data:`SEEN_MARGIN` of it (ValueError).
     """
 
@@ -273,7 +273,7 @@ class Planner:
     def on_table(self, outcomes: PredictiveOutcomes, start) -> PredictiveOutcomes:
         """``outcomes`` as the planner reads them: every entry that leaves the object's centre beyond the table top's
         edge (:attr:`table`) counted off the table
-        (:meth:`~affordance_learning.effect_model.PredictiveOutcomes.off_beyond`); as they are without ``start``
+        (:meth:`~.effect_model.PredictiveOutcomes.off_beyond`); as they are without ``start``
         (where the object is: (2,), or (m, 2) one per query) or without a table."""
         return outcomes if start is None or self.table is None else outcomes.off_beyond(start, *self.table)
 
@@ -294,7 +294,7 @@ class Planner:
                ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """Per behaviour, every candidate's P(goal) and expected progress towards it (:meth:`_progress`, 0 where
         the goal has no distance), from the models' predictive outcomes (each neighbour's displacement at the
-        candidate's action: :meth:`~affordance_learning.effect_model.ActionEffectModel.predictive_outcomes`, read
+        candidate's action: :meth:`~.effect_model.ActionEffectModel.predictive_outcomes`, read
         with the table: :meth:`on_table`). ``candidates``: the actions per behaviour (default: :attr:`params` for
         every behaviour). ``start_xy`` (where the object is) is needed for a :class:`Place`, and for any goal, when
         given, says which outcomes leave the object beyond the table's edge."""
@@ -496,7 +496,8 @@ class Planner:
                 raise InvalidValueError(
                     f"the model of {name!r} has {len(self.models[name].effect_columns_)} effect columns "
                                  f"for {len(features)} features: looking ahead needs models fitted on outcome tables "
-                                 "with the perceptual effect (affordance_learning.outcomes.outcome_table), or none.")
+                                 "with the perceptual effect (affordance_learning.planning.outcomes.outcome_table), "
+                                  "or none.")
 
         def effect(name: str, j: int) -> np.ndarray | float:  # a model without the perceptual effect: unchanged
             columns = self.models[name].effect_columns_

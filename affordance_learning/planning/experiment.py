@@ -4,19 +4,19 @@
    objects spread over the workspaces (:func:`affordance_env.dataset.collect`, resumable), extending the dataset
    in rounds until every behaviour has ``max_per_behavior`` interactions (or ``max_episodes`` were collected), and
    keep the first ``max_per_behavior`` of each behaviour for training.
-2. Fit an :class:`~affordance_learning.effect_model.ActionEffectModel` per behaviour, the same without each shape
-   (step 4), and the paper's model (:class:`~affordance_learning.model.AffordanceModel`, its effect categories)
+2. Fit an :class:`~.effect_model.ActionEffectModel` per behaviour, the same without each shape
+   (step 4), and the paper's model (:class:`~affordance_learning.paper.model.AffordanceModel`, its effect categories)
    per behaviour for the ``som_categories`` baseline.
 3. Single step, on held-out objects (reset seeds disjoint from the training episodes, ``objects`` of them, the
    shapes in turn). On each object every behaviour's :func:`oracle_params` (the canonical action and a 4 x 4 x 4
    grid, 65 per behaviour, the same for every object) is run from the same snapshot (``get_state`` /
-   ``set_state``), once; then :data:`GOALS_PER_OBJECT` goals (:mod:`affordance_learning.goals`: roll, lift, move
+   ``set_state``), once; then :data:`GOALS_PER_OBJECT` goals (:mod:`.goals`: roll, lift, move
    5 cm in each of 8 directions, and places within 3 cm of points 5-15 cm away, on the table as the goal env's
    targets are: :func:`place_target`) are each judged against those outcomes. Policies, all from that snapshot
    (an action run once is not run again: the env repeats an interaction bit for bit from a snapshot):
 
-   - ``planner``: :meth:`~affordance_learning.planner.Planner.choose`, with ``feasible`` ruling out reach
-     failures, remembering the actions that failed on this object (:meth:`~affordance_learning.planner.Planner.
+   - ``planner``: :meth:`~affordance_learning.planning.planner.Planner.choose`, with ``feasible`` ruling out reach
+     failures, remembering the actions that failed on this object (:meth:`~affordance_learning.planning.planner.Planner.
      note_failure`); the time of each decision is measured, ``feasible``'s calls included;
    - ``random``: a uniform behaviour and a uniform action of the oracle's set;
    - ``best_fixed``: per goal kind, the behaviour whose canonical action reached that kind most often (chosen
@@ -30,7 +30,7 @@
 4. Leaving each shape out: on the goals of step 3 whose object is of that shape, the planner of the models fitted
    without it, from the same snapshot (the oracle's verdict says which goals are feasible).
 5. Multi-step: episodes of the goal env (its targets, its tolerance, at most ``GOAL_MAX_EPISODE_STEPS``
-   interactions), re-planning after each interaction with :meth:`~affordance_learning.planner.Planner.toward`'s
+   interactions), re-planning after each interaction with :meth:`~affordance_learning.planning.planner.Planner.toward`'s
    defaults (a search over two interactions, the behaviours' workspaces saying where a second one can act),
    against random actions and a direction heuristic. Where no candidate is feasible the planner stops
    (``gave_up``) rather than run an interaction it knows would fail; an action that failed to reach is not chosen
@@ -65,10 +65,10 @@ import pandas as pd
 from affordance_env.goal_env import GOAL_TABLE_MARGIN, draw_target
 from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
 from affordance_env.scene import table_extent
-from affordance_learning.effect_model import ActionEffectModel, behavior_model
-from affordance_learning.goals import Goal, Lift, Move, Place, Roll
-from affordance_learning.outcomes import model_inputs, outcome_table
-from affordance_learning.planner import FAILURE_RADIUS, Planner
+from affordance_learning.planning.effect_model import ActionEffectModel, behavior_model
+from affordance_learning.planning.goals import Goal, Lift, Move, Place, Roll
+from affordance_learning.planning.outcomes import model_inputs, outcome_table
+from affordance_learning.planning.planner import FAILURE_RADIUS, Planner
 
 BEHAVIORS = BEHAVIOR_NAMES
 GOAL_KINDS = ("roll", "lift", "move", "place")
@@ -137,7 +137,7 @@ class PlanSettings:
 
 # --- outcomes measured by the simulator ------------------------------------------------------------------------
 def measured_outcome(info: Mapping[str, Any]) -> dict[str, np.ndarray]:
-    """The outcome (:mod:`affordance_learning.outcomes`) of one interaction from its step ``info``: one row."""
+    """The outcome (:mod:`affordance_learning.planning.outcomes`) of one interaction from its step ``info``: one row."""
     obj = info["object"]
     start, end = np.asarray(obj["initial_pose"]), np.asarray(obj["final_pose"])
     return {"dx": np.array([end[0] - start[0]]), "dy": np.array([end[1] - start[1]]),
@@ -203,7 +203,7 @@ def training_frames(frame: pd.DataFrame, max_per_behavior: int, exclude_type: st
 
 def fit_models(frames: Mapping[str, pd.DataFrame], random_state: int, n_jobs: int | None = None
                ) -> dict[str, ActionEffectModel]:
-    """An effect model per behaviour (:func:`~affordance_learning.effect_model.behavior_model`)."""
+    """An effect model per behaviour (:func:`~affordance_learning.planning.effect_model.behavior_model`)."""
     return {b: behavior_model(b, random_state=random_state, n_jobs=n_jobs).fit(model_inputs(f), outcome_table(f))
             for b, f in frames.items()}
 
@@ -220,7 +220,7 @@ class SomBaseline:
     @classmethod
     def fit(cls, frames: Mapping[str, pd.DataFrame], n_clusters: int, random_state: int) -> SomBaseline:
         from affordance_env.dataset import learning_data
-        from affordance_learning.model import AffordanceModel
+        from affordance_learning.paper.model import AffordanceModel
 
         models, outcomes, labels = {}, {}, {}
         for b, f in frames.items():
@@ -294,7 +294,7 @@ class Outcomes:
 def _decide(planner: Planner, features, goal: Goal, start, feasible, outcomes: Outcomes
             ) -> tuple[Any, bool, dict[str, Any] | None, float]:
     """The planner's choice for ``goal``, whether its action reached it, what it did, and the decision's time
-    [s]; an action that failed to reach is remembered (:meth:`~affordance_learning.planner.Planner.note_failure`).
+    [s]; an action that failed to reach is remembered (:meth:`~.planner.Planner.note_failure`).
     """
     t = time.perf_counter()
     choice = planner.choose(features, goal, start, feasible=feasible)
@@ -523,8 +523,9 @@ def within_reach(start_xy, target_xy, reach: Mapping[str, float], tolerance: flo
 
 # --- statistics ------------------------------------------------------------------------------------------------
 def wilson(successes: int, n: int) -> tuple[float, float]:
-    """Wilson 95 % interval of a share (:func:`~affordance_learning.metrics.wilson_interval`); (0, 1) for 0 of 0."""
-    from affordance_learning.metrics import wilson_interval
+    """Wilson 95 % interval of a share (:func:`~affordance_learning.paper.metrics.wilson_interval`);
+    (0, 1) for 0 of 0."""
+    from affordance_learning.paper.metrics import wilson_interval
 
     return wilson_interval(int(successes), int(n))
 

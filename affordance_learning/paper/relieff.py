@@ -52,8 +52,8 @@ from scipy.spatial.distance import pdist, squareform
 from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.validation import first_non_finite
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.common.validation import first_non_finite
 
 #: Distance skrebate gives an instance to itself, so that it sorts after every other instance.
 SELF_DISTANCE = float(sys.maxsize)

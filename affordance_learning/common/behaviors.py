@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from affordance_env.registry import BEHAVIOR_NAMES, check_behavior_name
-from affordance_learning.exceptions import InvalidValueError
+from affordance_learning.common.exceptions import InvalidValueError
 
 #: Per behaviour, how its success and its failure read: ``(success, failure)``.
 OUTCOME_WORDS: dict[str, tuple[str, str]] = {

@@ -2,10 +2,10 @@
 predictive distribution.
 
 :class:`ActionEffectModel` is a random forest used as a quantile regression forest (Meinshausen 2006, JMLR 7): its
-trees are grown on the motion part of the outcome (:data:`~affordance_learning.outcomes.MOTION_COLUMNS`,
+trees are grown on the motion part of the outcome (:data:`~affordance_learning.planning.outcomes.MOTION_COLUMNS`,
 standardised), and a query's predictive distribution is the training outcomes weighted by how often they share a
 leaf with it, averaged over the trees. The distribution is over whole outcomes (motion and perceptual effect
-together), so the probability of any goal (:mod:`affordance_learning.goals`) is the weighted share of training
+together), so the probability of any goal (:mod:`affordance_learning.planning.goals`) is the weighted share of training
 outcomes that reach it, and samples are training outcomes drawn by those weights: a distribution that keeps the
 outcomes' real spread and their joint structure (a ball that rolls far also leaves the view), which a point
 prediction would lose.
@@ -31,8 +31,8 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.ensemble import ExtraTreesRegressor, RandomForestRegressor
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.goals import Goal
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.planning.goals import Goal
 
 #: The displacement columns that :meth:`ActionEffectModel.predictive_outcomes` moves to the query's action, and the
 #: flags whose combinations are the kinds of outcome that each get their own slope.
@@ -89,7 +89,7 @@ class PredictiveOutcomes:
     Each stored entry of ``weights`` (CSR, (queries, training outcomes), every training outcome at most once per
     query, rows summing to 1) is one training outcome of one query; ``outcomes[name]`` gives a column of the
     outcome table (``dx``, ``rolled``, ``effect_<feature>``, ...) at every entry, in the entries' order, with the
-    displacement (``dx``, ``dy``) moved to the query's action. A goal (:mod:`affordance_learning.goals`) reads it
+    displacement (``dx``, ``dy``) moved to the query's action. A goal (:mod:`.goals`) reads it
     as it reads an outcome table: ``probability(goal, start_xy)`` is each query's weighted share of entries that
     reach it.
 
@@ -177,8 +177,8 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         random_state: Seed of the forest.
         n_jobs: Parallel jobs of the forest (joblib).
 
-    ``fit(X, y)``: ``X`` (n, d) inputs (:func:`~affordance_learning.outcomes.model_inputs`: 49 features and 3
-    parameters), ``y`` (n, m) outcomes (:func:`~affordance_learning.outcomes.outcome_table`; a DataFrame keeps its
+    ``fit(X, y)``: ``X`` (n, d) inputs (:func:`~affordance_learning.planning.outcomes.model_inputs`: 49 features and 3
+    parameters), ``y`` (n, m) outcomes (:func:`~.outcomes.outcome_table`; a DataFrame keeps its
     column names in ``outcome_names_``). ``predict(X)``: the mean outcome. :meth:`predictive_outcomes`,
     :meth:`goal_probability` and :meth:`sample` give the distribution; :meth:`predictive_weights` the forest's
     weights of the training outcomes as they were.
@@ -361,7 +361,7 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
     def goal_probability(self, X, goal: Goal, start_xy=None) -> np.ndarray:
         """P(goal) for each query, (m,): the weighted share of its outcomes (:meth:`predictive_outcomes`) that
         reach ``goal`` from ``start_xy`` ((2,) or (m, 2) [m], where the object is; needed by
-        :class:`~affordance_learning.goals.Place`)."""
+        :class:`~affordance_learning.planning.goals.Place`)."""
         return self.predictive_outcomes(X).probability(goal, start_xy)
 
     @staticmethod

@@ -1,4 +1,4 @@
-"""The results of :func:`~affordance_learning.protocol.run_protocol`: their format and units, the reading of older
+"""The results of :func:`~affordance_learning.paper.protocol.run_protocol`: their format and units, the reading of older
 ones, and :class:`Results`, the typed, read-only view every report, figure and check reads them through.
 
 Units (:data:`UNITS`, also written into every results dict as ``config["units"]``): every share is a fraction
@@ -22,9 +22,9 @@ from dataclasses import dataclass, field, fields
 from types import MappingProxyType
 from typing import Any
 
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.json_reading import Path as _Path
-from affordance_learning.json_reading import Reader, is_number
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.common.json_reading import Path as _Path
+from affordance_learning.common.json_reading import Reader, is_number
 
 #: Version of the results dict; raise it when the meaning or the unit of a key changes.
 RESULTS_FORMAT = 2
@@ -176,7 +176,7 @@ class SizeSide:
 
 @dataclass(frozen=True)
 class SizeSuccess:
-    """How success depends on object size (:func:`affordance_learning.metrics.size_success`).
+    """How success depends on object size (:func:`affordance_learning.paper.metrics.size_success`).
 
     Attributes:
         bins: The share of successes per size bin.
@@ -216,7 +216,7 @@ class SizeSuccess:
 
 @dataclass(frozen=True)
 class TypeEffects:
-    """What the effects of one object type contain (:func:`affordance_learning.diagnostics.effect_summary`): its
+    """What the effects of one object type contain (:func:`affordance_learning.paper.diagnostics.effect_summary`): its
     interactions; the shares (fractions) of successes, of objects at rest, seen in the final snapshot and off the
     table; the medians of the travel [m], of the 3-D motion seen [m], of the change of the pixel count [pixels] and
     of the normal histograms (sum of |effect| over the shape features). None where the dataset could not say."""
@@ -302,7 +302,7 @@ class Config:
 # --- the results ----------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Results:
-    """The results of :func:`~affordance_learning.protocol.run_protocol` (or of its ``results.json``), typed and
+    """The results of :func:`~affordance_learning.paper.protocol.run_protocol` (or of its ``results.json``), typed and
     read-only, in the current format: build it with :meth:`from_dict`.
 
     Every section is None when the results lack it (results may be partial: the claims on what they hold are
@@ -353,7 +353,7 @@ class Results:
         """Read a results dict (of any format this package reads, :func:`current_results`) and check it.
 
         Args:
-            results: The dict of :func:`~affordance_learning.protocol.run_protocol`, or its ``results.json`` read
+            results: The dict of :func:`~affordance_learning.paper.protocol.run_protocol`, or its ``results.json`` read
                 back, or part of it.
             required: Sections the caller cannot do without (``"uniformity"``, ``"case_studies"``, ...).
 
@@ -429,7 +429,7 @@ class Results:
         return (self.case_studies or {}).get(int(k), ())
 
     def to_dict(self) -> dict[str, Any]:
-        """The results dict of the current format, as :func:`~affordance_learning.protocol.run_protocol` writes
+        """The results dict of the current format, as :func:`~affordance_learning.paper.protocol.run_protocol` writes
         it (the sections held, with k and r keyed by :func:`k_key` and :func:`r_key`)."""
         out: dict[str, Any] = {"results_format": self.results_format}
         for name in _PER_K:

@@ -1,6 +1,6 @@
 """Reading a results dict (as ``json.load`` gives it) with errors that say where a value is wrong.
 
-:mod:`affordance_learning.results` and :mod:`affordance_learning.plan_results` read their dicts through a
+:mod:`affordance_learning.paper.results` and :mod:`affordance_learning.planning.results` read their dicts through a
 :class:`Reader`: each check returns the value in the type asked for, or raises InvalidValueError naming its place
 (``results['uniformity']['3'] lacks 'std'``) and what the reader expected.
 """
@@ -12,7 +12,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from affordance_learning.exceptions import InvalidValueError
+from affordance_learning.common.exceptions import InvalidValueError
 
 #: Where a value lies in the dict: its keys from the top, ("uniformity", "3", "mean").
 Path = tuple[Any, ...]

@@ -10,8 +10,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.schema import OBJECT_TYPES
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.common.schema import OBJECT_TYPES
 
 #: Behaviours :func:`make_synthetic_frame` can imitate, with their object size ranges [m].
 SYNTHETIC_SIZE_RANGES = {"tap": (0.04, 0.10), "grasp": (0.03, 0.09)}

@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 import pandas as pd
 
-from affordance_learning.exceptions import InvalidValueError
+from affordance_learning.common.exceptions import InvalidValueError
 
 #: The object types of the paper, in the order figures and case studies list them.
 OBJECT_TYPES = ("sphere", "horizontal_cylinder", "box", "vertical_cylinder")

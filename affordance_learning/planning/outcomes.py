@@ -22,8 +22,8 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.schema import feature_names
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.common.schema import feature_names
 
 #: The motion columns of an outcome table, in order; the effect columns follow.
 MOTION_COLUMNS = ("dx", "dy", "rolled", "off_table", "lifted")

@@ -14,7 +14,7 @@ from numpy.typing import ArrayLike
 from sklearn.base import BaseEstimator, ClusterMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from affordance_learning.exceptions import InvalidValueError
+from affordance_learning.common.exceptions import InvalidValueError
 
 #: Largest seed minisom's ``numpy.random.RandomState`` accepts.
 _MAX_SEED = 2**32 - 1

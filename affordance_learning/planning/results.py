@@ -1,4 +1,4 @@
-"""The results of ``affordance plan`` (:func:`~affordance_learning.plan_experiment.run_plan`, its ``results.json``):
+"""The results of ``affordance plan`` (:func:`~affordance_learning.planning.experiment.run_plan`, its ``results.json``):
 :class:`PlanResults`, the typed, read-only view its report, figures and targets read them through.
 
 Units: every share is a fraction in [0, 1] (with its Wilson 95 % interval where the results hold one), distances
@@ -12,9 +12,9 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.json_reading import Path as _Path
-from affordance_learning.json_reading import Reader, is_number
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.common.json_reading import Path as _Path
+from affordance_learning.common.json_reading import Reader, is_number
 
 #: The ``format`` a plan's ``results.json`` names.
 PLAN_RESULTS_FORMAT = "tap-affordance-plan-results"
@@ -46,7 +46,7 @@ NOTHING = Share(None)
 
 @dataclass(frozen=True)
 class PolicyOutcome:
-    """How often one policy reached its goals (:func:`~affordance_learning.plan_experiment.summarize`).
+    """How often one policy reached its goals (:func:`~affordance_learning.planning.experiment.summarize`).
 
     Attributes:
         reached: Its share of all the goals.
@@ -70,7 +70,7 @@ class Episode:
         target_xy: Where it was to be brought (x, y) [m].
         success: Whether it got there.
         within_reach: Whether the episode's interactions could take it there at all
-            (:func:`~affordance_learning.plan_experiment.within_reach`).
+            (:func:`~affordance_learning.planning.experiment.within_reach`).
         gave_up: Whether the planner stopped because none of the candidates it asked ``feasible`` about (at most
             its ``max_checks``) was reachable.
         failures: The messages of its interactions that failed to reach.
@@ -222,7 +222,7 @@ class PlanResults:
 
     Attributes:
         seed: The seed of the data and of the evaluation.
-        settings: The run's settings (:class:`~affordance_learning.plan_experiment.PlanSettings`), as written.
+        settings: The run's settings (:class:`~affordance_learning.planning.experiment.PlanSettings`), as written.
         training: The training interactions per behaviour.
         timings_s: The time of each stage and the ``total`` [s].
         single_step: Each policy's outcome over the held-out single-step goals.
@@ -270,7 +270,7 @@ class PlanResults:
     @classmethod
     def from_dict(cls, results: PlanResults | Mapping[str, Any]) -> PlanResults:
         """Read the results of ``affordance plan`` (the dict of
-        :func:`~affordance_learning.plan_experiment.run_plan`, or its ``results.json`` read back) and check them.
+        :func:`~affordance_learning.planning.experiment.run_plan`, or its ``results.json`` read back) and check them.
 
         Raises:
             InvalidValueError: ``results`` are not a mapping, name another format, lack a section (naming every

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from affordance_learning.schema import OBJECT_TYPES, feature_groups, feature_names, label_column
+from affordance_learning.common.schema import OBJECT_TYPES, feature_groups, feature_names, label_column
 
 
 def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:

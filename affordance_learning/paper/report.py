@@ -1,7 +1,7 @@
 """REPORT.md: our numbers beside the paper's statements, with a verdict per claim computed from the numbers.
 
-The claims, their rules and verdicts are :mod:`affordance_learning.claims`; this module sets them out with
-the tables of the numbers they are computed from, read through :class:`~affordance_learning.results.Results`.
+The claims, their rules and verdicts are :mod:`affordance_learning.paper.claims`; this module sets them out with
+the tables of the numbers they are computed from, read through :class:`~affordance_learning.paper.results.Results`.
 """
 
 from __future__ import annotations
@@ -12,7 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from affordance_learning.claims import (  # noqa: F401  (AGREES ... Claim: re-exported, the report's vocabulary)
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.paper.claims import (  # noqa: F401  (AGREES ... Claim: re-exported, the report's vocabulary)
     AGREES,
     DISAGREES,
     MIN_INTERACTIONS,
@@ -24,8 +25,7 @@ from affordance_learning.claims import (  # noqa: F401  (AGREES ... Claim: re-ex
     claims_scope,
     evaluate_claims,
 )
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.results import (
+from affordance_learning.paper.results import (
     UNIFORMITY_DEFINITION,
     UNITS,
     PerK,
@@ -249,8 +249,8 @@ def write_report(results: Results | Mapping[str, Any], out_dir: str | Path) -> P
     """Write ``REPORT.md`` into ``out_dir`` (created if needed), linking the PNG figures found there.
 
     Args:
-        results: :class:`~affordance_learning.results.Results`, or the dict returned by
-            :func:`affordance_learning.protocol.run_protocol` (or its JSON).
+        results: :class:`~affordance_learning.paper.results.Results`, or the dict returned by
+            :func:`affordance_learning.paper.protocol.run_protocol` (or its JSON).
         out_dir: Output directory.
 
     Returns:
@@ -347,7 +347,7 @@ def write_overview(runs: Mapping[str, Results | Mapping[str, Any]], out_dir: str
     with their verdicts, and links to its report and figures in ``out_dir/<behavior>/``.
 
     Args:
-        runs: The results dict of each behaviour (:func:`affordance_learning.protocol.run_protocol`), by
+        runs: The results dict of each behaviour (:func:`affordance_learning.paper.protocol.run_protocol`), by
             behaviour, in the order to show them.
         out_dir: Output directory, holding one directory per behaviour.
 

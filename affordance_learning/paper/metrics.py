@@ -16,7 +16,7 @@ from sklearn.pipeline import Pipeline, make_pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVC
 
-from affordance_learning.exceptions import InvalidValueError
+from affordance_learning.common.exceptions import InvalidValueError
 
 
 def _paired(clusters: ArrayLike, labels: ArrayLike, name: str) -> tuple[np.ndarray, np.ndarray]:

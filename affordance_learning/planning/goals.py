@@ -1,6 +1,6 @@
 """Goals: what a robot wants an interaction to do to an object, as small JSON-serialisable objects.
 
-Each goal says, for outcomes (:mod:`affordance_learning.outcomes`), whether they reach it: ``goal.reached(outcomes,
+Each goal says, for outcomes (:mod:`.outcomes`), whether they reach it: ``goal.reached(outcomes,
 start_xy)`` takes an outcome table (or a dict of its columns as arrays, one row per sample) and where the object
 was [m], and returns a boolean per row. A planner estimates P(goal) as the share of an effect model's predictive
 samples that reach it; an evaluation asks the same of the outcome the simulator measured.
@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from affordance_env.values import float_array
-from affordance_learning.exceptions import InvalidValueError
+from affordance_learning.common.exceptions import InvalidValueError
 
 
 def _column(outcomes: Any, name: str) -> np.ndarray:
@@ -34,7 +34,7 @@ def _column(outcomes: Any, name: str) -> np.ndarray:
         return np.asarray(outcomes[name])
     except (KeyError, IndexError):
         raise InvalidValueError(
-            f"the outcomes lack {name!r} (an outcome table of affordance_learning.outcomes)") from None
+            f"the outcomes lack {name!r} (an outcome table of affordance_learning.planning.outcomes)") from None
 
 
 def _finite(name: str, value: Any, shape: tuple[int, ...] | None = ()) -> np.ndarray:
@@ -195,7 +195,7 @@ def check_goal(goal: Any) -> Goal:
     if not isinstance(goal, tuple(GOAL_KINDS.values())):
         names = ", ".join(cls.__name__ for cls in GOAL_KINDS.values())
         hint = " (goal_from_dict makes one from a dict)" if isinstance(goal, Mapping) else ""
-        raise TypeError(f"goal must be one of {names} (affordance_learning.goals){hint}, got {goal!r} "
+        raise TypeError(f"goal must be one of {names} (affordance_learning.planning.goals){hint}, got {goal!r} "
                         f"({type(goal).__name__}).")
     return goal
 

@@ -26,8 +26,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.results import Config, PerK, PerRK, Results, as_results
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.paper.results import Config, PerK, PerRK, Results, as_results
 
 #: Standard errors a number may move by (two-sided, about 0.3 % by chance for a normal difference).
 Z = 3.0
@@ -75,7 +75,7 @@ def _tolerance(p: float, n_a: int, n_b: int, std_a: float = 0.0, std_b: float = 
 
 def compare_results(reference: Results | Mapping[str, Any], found: Results | Mapping[str, Any]) -> list[Comparison]:
     """Every headline number of ``found`` beside ``reference`` (two ``results.json`` of ``affordance reproduce``
-    for one behaviour, or their :class:`~affordance_learning.results.Results`), with its tolerance. Raises
+    for one behaviour, or their :class:`~affordance_learning.paper.results.Results`), with its tolerance. Raises
     InvalidValueError when they are not the same experiment, or lack what is compared (naming it)."""
     reference, found = as_results(reference), as_results(found)
     uniformity, accuracy, n_a, share_a = _compared_parts("reference", reference)

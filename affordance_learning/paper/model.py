@@ -35,10 +35,10 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.utils import Tags
 from sklearn.utils.validation import check_is_fitted, validate_data
 
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.metrics import make_svm
-from affordance_learning.relieff import MULTICLASS_THRESHOLD, relieff_weights
-from affordance_learning.som import SOMClustering, som_seed
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.paper.metrics import make_svm
+from affordance_learning.paper.relieff import MULTICLASS_THRESHOLD, relieff_weights
+from affordance_learning.paper.som import SOMClustering, som_seed
 
 
 @dataclass(frozen=True)

@@ -16,7 +16,7 @@ The paper reports two behaviours, and the claims are chosen by the behaviour of 
 - any other behaviour: only the statements on the method.
 
 Each claim is specified once, as a :class:`ClaimSpec` (topic, the paper's statement, the rule, the function that
-applies it and the one that says what it is judged on), and judged on :class:`~affordance_learning.results.Results`.
+applies it and the one that says what it is judged on), and judged on :class:`~.results.Results`.
 """
 
 from __future__ import annotations
@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from affordance_learning.results import Cluster, PerK, PerRK, Results, as_results
+from affordance_learning.paper.results import Cluster, PerK, PerRK, Results, as_results
 
 AGREES = "agrees"
 DISAGREES = "disagrees"
@@ -722,8 +722,8 @@ def evaluate_claims(results: Results | Mapping[str, Any], behavior: str | None =
     or do not say how much data they hold.
 
     Args:
-        results: :class:`~affordance_learning.results.Results`, or the dict of
-            :func:`affordance_learning.protocol.run_protocol` (or its JSON), or part of it.
+        results: :class:`~affordance_learning.paper.results.Results`, or the dict of
+            :func:`affordance_learning.paper.protocol.run_protocol` (or its JSON), or part of it.
         behavior: Whose claims to check; by default the results' own (:func:`results_behavior`).
 
     Raises:

@@ -22,7 +22,7 @@ and SVM for each behavior".
 3. ReliefF weighs the standardised initial features of the training rows against their categories, once per
    (t, k): the weights do not depend on the relevancy threshold. The test rows take no part in it.
 4. For every relevancy threshold r the model keeps the features whose weight exceeds r x the largest weight
-   (:func:`affordance_learning.model.select_features`); recorded are their number and the shares of them that
+   (:func:`affordance_learning.paper.model.select_features`); recorded are their number and the shares of them that
    are shape and size features; the SVM (standardisation + RBF ``SVC``) is trained on the training rows and its
    accuracy measured on the test rows, next to the accuracy of always answering the training rows' most
    common category (``svm_baseline``).
@@ -31,10 +31,10 @@ Trials run in parallel with joblib; a trial's seeds come from ``(random_state, t
 over fewer k gives the same numbers for those k), and the results are gathered in trial order, so they do
 not depend on ``n_jobs``. Means and standard deviations (population, ddof = 0) are over trials.
 
-Besides, once over all rows: how success depends on object size (:func:`affordance_learning.metrics.size_success`,
-the grasp's critical size) and what the effects contain (:func:`affordance_learning.diagnostics.effect_summary`).
+Besides, once over all rows: how success depends on object size (:func:`affordance_learning.paper.metrics.size_success`,
+the grasp's critical size) and what the effects contain (:func:`affordance_learning.paper.diagnostics.effect_summary`).
 
-:func:`affordance_learning.synthetic.make_synthetic_frame` builds a frame in the same schema without the
+:func:`affordance_learning.paper.synthetic.make_synthetic_frame` builds a frame in the same schema without the
 simulator.
 """
 
@@ -49,16 +49,16 @@ from joblib import Parallel, delayed
 from sklearn.model_selection import train_test_split
 from sklearn.preprocessing import StandardScaler
 
-from affordance_learning.behaviors import ROLLED_IS_SUCCESS, outcome_words
-from affordance_learning.diagnostics import effect_summary
-from affordance_learning.exceptions import InvalidValueError
-from affordance_learning.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
-from affordance_learning.model import _check_int, select_features
-from affordance_learning.relieff import MULTICLASS_THRESHOLD, ReliefFScorer
-from affordance_learning.results import RESULTS_FORMAT, UNITS, k_key, r_key
-from affordance_learning.schema import OBJECT_TYPES, feature_groups, feature_names, frame_behavior, label_column
-from affordance_learning.som import SOMClustering
-from affordance_learning.validation import first_non_finite
+from affordance_learning.common.behaviors import ROLLED_IS_SUCCESS, outcome_words
+from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.common.schema import OBJECT_TYPES, feature_groups, feature_names, frame_behavior, label_column
+from affordance_learning.common.validation import first_non_finite
+from affordance_learning.paper.diagnostics import effect_summary
+from affordance_learning.paper.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
+from affordance_learning.paper.model import _check_int, select_features
+from affordance_learning.paper.relieff import MULTICLASS_THRESHOLD, ReliefFScorer
+from affordance_learning.paper.results import RESULTS_FORMAT, UNITS, k_key, r_key
+from affordance_learning.paper.som import SOMClustering
 
 DEFAULT_KS = tuple(range(2, 11))
 DEFAULT_RELEVANCIES = (0.0, 0.2, 0.4, 0.6, 0.8)
@@ -310,21 +310,21 @@ def run_protocol(
 
     Returns:
         ``{"uniformity": {"<k>": {"mean", "std"}}`` [0, 1] (against the success/fail labels; a fraction like
-        every share here, :data:`affordance_learning.results.UNITS`),
+        every share here, :data:`affordance_learning.paper.results.UNITS`),
         ``"svm_accuracy": {"<r>": {"<k>": {"mean", "std"}}}`` [0, 1], ``"shape_fraction"`` and
         ``"size_fraction"`` (same keys; shares of shape and size features among the selected ones) [0, 1],
         ``"n_selected"`` (same keys), ``"case_studies": {"<k>": [{"cluster", "success", "fail", "types":
         {type: count}, "sizes": [m, ...], "left_view": count}]}``, ``"prototypes": {"<k>": [[effect per
         feature], ...]}``,
         ``"feature_names"``, ``"effects"`` (:func:`effect_summary`), ``"size_success"``
-        (:func:`affordance_learning.metrics.size_success`), ``"purity"``, ``"adjusted_rand"`` (against the
+        (:func:`affordance_learning.paper.metrics.size_success`), ``"purity"``, ``"adjusted_rand"`` (against the
         object type), ``"n_categories"`` (non-empty clusters), ``"svm_baseline"`` (majority-category
         accuracy), all ``{"<k>": {"mean", "std"}}``, ``"feature_weights": {"<k>": {name: mean ReliefF
         weight}}``, and ``"config"``, which names the ``behavior``, the ``label`` column and how a success and
         a failure read (``success_label``, ``fail_label``). r is written as ``str(float(r))`` ("0.0", "0.2",
-        ..., :func:`~affordance_learning.results.r_key`), k as ``str(k)`` (:func:`~affordance_learning.results.k_key`).
+        ..., :func:`~.results.r_key`), k as ``str(k)`` (:func:`~.results.k_key`).
         The schema is the same for every behaviour. A mean over no finite value is None.
-        :meth:`affordance_learning.results.Results.from_dict` reads it.
+        :meth:`affordance_learning.paper.results.Results.from_dict` reads it.
     """
     ks, relevancies = _check_protocol_args(
         ks, relevancies, n_trials, random_state, test_size, n_neighbors, som_iterations

@@ -6,7 +6,7 @@ and grasping. For each behaviour asked (by default :data:`DEFAULT_BEHAVIORS`), i
 1. Collect (or reuse) ``episodes`` canonical interactions with :func:`affordance_env.dataset.collect` into
    ``out/<behavior>/dataset`` (or the directory given for that behaviour); the dataset is resumable, so an
    interrupted run continues where it stopped, and a finished one is reused.
-2. Run the learning protocol (:func:`affordance_learning.protocol.run_protocol`) over k = 2..10 clusters and
+2. Run the learning protocol (:func:`affordance_learning.paper.protocol.run_protocol`) over k = 2..10 clusters and
    relevancy r in {0, 0.2, 0.4, 0.6, 0.8}, ``trials`` times.
 3. Write ``results.json``, the figures and ``REPORT.md``.
 
@@ -15,7 +15,7 @@ Beside ``results.json``, ``fingerprint.json`` pins down the first 30 interaction
 current code, so that a shipped reproduction cannot silently stop being what the code gives, and
 :func:`write_reference_fingerprint` (``affordance fingerprint DIR``) rewrites it.
 
-Then ``out/REPORT.md`` sets the behaviours side by side (:func:`affordance_learning.report.write_overview`):
+Then ``out/REPORT.md`` sets the behaviours side by side (:func:`affordance_learning.paper.report.write_overview`):
 those just run, and any other whose results an earlier run left in ``out/<behavior>/``. Every behaviour is
 checked against the environment before anything is collected, so a behaviour it does not offer stops the run
 at once with a clear error.
@@ -31,11 +31,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from affordance_learning.exceptions import InvalidValueError
+from affordance_learning.common.exceptions import InvalidValueError
 
 if TYPE_CHECKING:
     from affordance_env.dataset.fingerprint import FingerprintCheck
-    from affordance_learning.results import Results
+    from affordance_learning.paper.results import Results
 
 #: The behaviours the paper reports on, run by default.
 DEFAULT_BEHAVIORS = ("tap", "grasp")
@@ -92,8 +92,8 @@ def reproduce(
         The results dict of each behaviour run, by behaviour.
     """
     import affordance_env.behaviors as env_behaviors
-    from affordance_learning.behaviors import BEHAVIORS, check_env_offers
-    from affordance_learning.report import write_overview
+    from affordance_learning.common.behaviors import BEHAVIORS, check_env_offers
+    from affordance_learning.paper.report import write_overview
 
     behaviors = list(behaviors)
     runnable = [b for b in behaviors if isinstance(b, str) and b in env_behaviors.BEHAVIORS] or ["tap"]
@@ -132,9 +132,9 @@ def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: 
     """Collect, learn and report one behaviour into ``out/<behavior>``; returns its results."""
     from affordance_env.dataset import collect, failure_summary, load_dataset
     from affordance_env.dataset.fingerprint import fingerprint
-    from affordance_learning.figures import write_figures
-    from affordance_learning.protocol import run_protocol
-    from affordance_learning.report import write_report
+    from affordance_learning.paper.figures import write_figures
+    from affordance_learning.paper.protocol import run_protocol
+    from affordance_learning.paper.report import write_report
 
     where = out / behavior
     where.mkdir(parents=True, exist_ok=True)
@@ -236,7 +236,7 @@ def check_fingerprint(where: str | Path, workers: int = 1) -> FingerprintCheck:
 def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, Results]:
     """Results an earlier run left in ``out/<behavior>/results.json`` for behaviours not run now; only those of
     the current schema (whose config names the behaviour of their directory)."""
-    from affordance_learning.results import Results
+    from affordance_learning.paper.results import Results
 
     found = {}
     for path in sorted(out.glob("*/results.json")):
@@ -254,9 +254,9 @@ def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, Results]:
 
 def summary(results: Results | Mapping[str, Any], report: Path) -> str:
     """The headline numbers of one behaviour's reproduction, and where its report is, in a few lines."""
-    from affordance_learning.claims import AGREES, claims_scope, evaluate_claims
-    from affordance_learning.report import HEADLINE_R, headline_accuracy
-    from affordance_learning.results import as_results
+    from affordance_learning.paper.claims import AGREES, claims_scope, evaluate_claims
+    from affordance_learning.paper.report import HEADLINE_R, headline_accuracy
+    from affordance_learning.paper.results import as_results
 
     results = as_results(results, required=("uniformity", "svm_accuracy"))
     behavior = results.behavior

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from affordance_learning.exceptions import InvalidValueError
+from affordance_learning.common.exceptions import InvalidValueError
 
 #: The largest float32: the models (their trees, scikit-learn's scalers) read their inputs as float32, so a finite
 #: float64 beyond it becomes infinite there.
