@@ -297,14 +297,11 @@ def _check_plan_out(out: Path, seed: int) -> None:
 
 def _plan(args: argparse.Namespace) -> int:
     _check_plan_out(args.out, args.seed)
+    from affordance_learning.common.verdicts import tally_text
     from affordance_learning.planning.experiment import PlanSettings, record_episode, run_plan
-    from affordance_learning.planning.report import (
-        measured_targets,
-        target_verdict,
-        write_plan_figures,
-        write_plan_report,
-    )
+    from affordance_learning.planning.report import write_plan_figures, write_plan_report
     from affordance_learning.planning.results import PlanResults
+    from affordance_learning.planning.targets import evaluate_targets
 
     settings = PlanSettings(**{name: getattr(args, name) for name in PLAN_DEFAULTS
                                if getattr(args, name) is not None})
@@ -313,9 +310,8 @@ def _plan(args: argparse.Namespace) -> int:
     plan = PlanResults.from_dict(results)
     write_plan_figures(plan, args.out, frames)
     report = write_plan_report(plan, args.out)
-    verdicts = [target_verdict(name, value) for name, value in measured_targets(plan).items()]
-    counts = ", ".join(f"{verdicts.count(v)} {v}" for v in dict.fromkeys(verdicts))
-    print(f"{len(verdicts)} targets: {counts} (a verdict only on enough data); {report} gives each with its n and "
+    verdicts = list(evaluate_targets(plan).values())
+    print(f"{tally_text(verdicts, 'targets')} (a verdict only on enough data); {report} gives each with its n and "
           f"why a missed one is missed; {args.out / 'results.json'} holds every number "
           f"({plan.total_time_s / 60:.1f} min)")
     return 0

@@ -12,14 +12,8 @@ import pytest
 
 from affordance_learning import run_protocol, write_figures, write_report
 from affordance_learning.common.schema import feature_groups, feature_names
-from affordance_learning.paper.report import (
-    AGREES,
-    DISAGREES,
-    NOT_COMPUTABLE,
-    VERDICTS,
-    evaluate_claims,
-    write_overview,
-)
+from affordance_learning.common.verdicts import MET, MISSED, NOT_MEASURED, WORDS
+from affordance_learning.paper.report import evaluate_claims, write_overview
 from affordance_learning.paper.synthetic import make_synthetic_frame
 
 KS = (2, 3, 4)
@@ -231,7 +225,7 @@ def test_figures_and_report_are_written(results: dict, tmp_path: Path) -> None:
     assert "uniformity.png" in text and "| Uniformity on average |" in text
     assert "# Reproduction of Akgun et al. 2009, tap:" in text and "| cluster | rolled | did not roll |" in text
     assert "## Success by object size" in text and "![size_success](size_success.png)" in text
-    assert sum(text.count(f"**{v}**") for v in VERDICTS) == 14
+    assert sum(text.count(f"**{v}**") for v in WORDS) == 14
     again = write_report(json.loads(json.dumps(results)), tmp_path / "again").read_text()
     assert again.split("## Configuration")[0] == text.split("## Figures")[0]  # same numbers from the JSON
 
@@ -280,13 +274,13 @@ def _paper_like(results: dict) -> dict:
 
 def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
     good = _paper_like(results)
-    verdicts = {c.topic: c.verdict for c in evaluate_claims(good)}
-    assert set(verdicts.values()) == {AGREES}, verdicts
+    verdicts = {c.topic: c.word for c in evaluate_claims(good)}
+    assert set(verdicts.values()) == {MET}, verdicts
     bad = copy.deepcopy(good)
     bad["uniformity"] = {k: {"mean": 0.60 - 0.01 * i, "std": 0.01} for i, k in enumerate(good["uniformity"])}
     bad["svm_accuracy"]["0.4"] = {k: {"mean": 0.5, "std": 0.0} for k in good["svm_accuracy"]["0.4"]}
     bad["case_studies"]["2"][0]["types"]["sphere"], bad["case_studies"]["2"][1]["types"]["sphere"] = 0, 250
-    verdicts = {c.topic: c.verdict for c in evaluate_claims(bad)}
+    verdicts = {c.topic: c.word for c in evaluate_claims(bad)}
     for topic in (
         "Uniformity on average",
         "Uniformity rises with k",
@@ -295,7 +289,7 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
         "r = 0.4 best",
         "r = 0, 0.2, 0.4 alike",
     ):
-        assert verdicts[topic] == DISAGREES, topic
+        assert verdicts[topic] == MISSED, topic
     # the other eight claims, each driven the other way
     worse = copy.deepcopy(good)
     rs = sorted(good["shape_fraction"], key=float)
@@ -307,7 +301,7 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
     worse["svm_accuracy"] = {r: {str(k): {"mean": a, "std": 0.0} for k, a in rising.items()} for r in rs}
     worse["case_studies"]["2"][0]["sizes"], worse["case_studies"]["2"][1]["sizes"] = [0.04, 0.05], [0.09, 0.1]
     worse["case_studies"]["4"][2]["success"], worse["case_studies"]["4"][2]["fail"] = 200, 5
-    verdicts = {c.topic: c.verdict for c in evaluate_claims(worse)}
+    verdicts = {c.topic: c.word for c in evaluate_claims(worse)}
     for topic in (
         "Shape features dominate",
         "Shape share and r",
@@ -318,10 +312,10 @@ def test_report_verdicts_are_computed_from_the_numbers(results: dict) -> None:
         "SVM accuracy falls with k",
         "Bump at k = 4",
     ):
-        assert verdicts[topic] == DISAGREES, topic
+        assert verdicts[topic] == MISSED, topic
     partial = {"results_format": 2, "uniformity": good["uniformity"], "config": {"n_trials": 20, "n_rows": 1000}}
-    verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
-    assert verdicts["Uniformity on average"] == AGREES and verdicts["Bump at k = 4"] == NOT_COMPUTABLE
+    verdicts = {c.topic: c.word for c in evaluate_claims(partial)}
+    assert verdicts["Uniformity on average"] == MET and verdicts["Bump at k = 4"] == NOT_MEASURED
 
 
 def _grasp_like(results: dict) -> dict:
@@ -353,49 +347,49 @@ GRASP_TOPICS = ("Uniformity on average", "Fall at k = 3", "Critical size",
 
 def test_grasp_claims_are_computed_from_the_numbers(results: dict) -> None:
     good = _grasp_like(results)
-    verdicts = {c.topic: c.verdict for c in evaluate_claims(good)}
+    verdicts = {c.topic: c.word for c in evaluate_claims(good)}
     assert list(verdicts) == [
         "Uniformity on average", "Uniformity rises with k", "Uniformity peak", "Fall at k = 3", "Critical size",
         "1 x 3 map: a category straddles the critical size", "Size features dominate",
         "Fewer features as r rises", "Number constant in k", "SVM accuracy falls with k"]
-    assert set(verdicts.values()) == {AGREES}, verdicts
+    assert set(verdicts.values()) == {MET}, verdicts
     bad = copy.deepcopy(good)
     bad["uniformity"] = {k: {"mean": (84.0 + int(k)) / 100, "std": 0.01} for k in good["uniformity"]}  # >80 %
     bad["size_fraction"] = {r: {k: {"mean": 0.3, "std": 0.0} for k in per_k}
                             for r, per_k in good["size_fraction"].items()}
     bad["size_success"]["below"]["success"], bad["size_success"]["above"]["success"] = 0.6, 0.4  # too soft
     bad["case_studies"]["3"][1]["success"], bad["case_studies"]["3"][1]["fail"] = 95, 5  # nearly all held
-    verdicts = {c.topic: c.verdict for c in evaluate_claims(bad)}
+    verdicts = {c.topic: c.word for c in evaluate_claims(bad)}
     for topic in GRASP_TOPICS:
-        assert verdicts[topic] == DISAGREES, topic
+        assert verdicts[topic] == MISSED, topic
     # the average must be above 70 %, and not above the tap's 80 %
     low = copy.deepcopy(good)
     low["uniformity"] = {k: {"mean": v["mean"] - 0.10, "std": 0.01} for k, v in good["uniformity"].items()}
-    assert {c.topic: c.verdict for c in evaluate_claims(low)}["Uniformity on average"] == DISAGREES
+    assert {c.topic: c.word for c in evaluate_claims(low)}["Uniformity on average"] == MISSED
     # the straddling cluster must hold objects on both sides of the critical size, not just both outcomes
     one_side = copy.deepcopy(good)
     one_side["case_studies"]["3"][1]["sizes"] = [0.061, 0.065, 0.068, 0.07]
-    assert {c.topic: c.verdict for c in evaluate_claims(one_side)}[GRASP_TOPICS[3]] == DISAGREES
+    assert {c.topic: c.word for c in evaluate_claims(one_side)}[GRASP_TOPICS[3]] == MISSED
     # ... and be a category, not a handful of objects (here 5 of 905 interactions)
     handful = copy.deepcopy(good)
     handful["case_studies"]["3"][1].update(success=3, fail=2)
-    assert {c.topic: c.verdict for c in evaluate_claims(handful)}[GRASP_TOPICS[3]] == DISAGREES
+    assert {c.topic: c.word for c in evaluate_claims(handful)}[GRASP_TOPICS[3]] == MISSED
     # success rising with size is not the grasp's critical size
     rising = copy.deepcopy(good)
     rising["size_success"]["logistic"]["slope"] = 300.0
-    assert {c.topic: c.verdict for c in evaluate_claims(rising)}["Critical size"] == DISAGREES
+    assert {c.topic: c.word for c in evaluate_claims(rising)}["Critical size"] == MISSED
     # no crossing within the sizes seen: the critical size disagrees, the straddling cannot be computed
     none = copy.deepcopy(good)
     none["size_success"].update(critical_size=None, below=None, above=None)
-    verdicts = {c.topic: c.verdict for c in evaluate_claims(none)}
-    assert verdicts["Critical size"] == DISAGREES and verdicts[GRASP_TOPICS[3]] == NOT_COMPUTABLE
+    verdicts = {c.topic: c.word for c in evaluate_claims(none)}
+    assert verdicts["Critical size"] == MISSED and verdicts[GRASP_TOPICS[3]] == NOT_MEASURED
     single = copy.deepcopy(none)
     single["size_success"]["logistic"] = None
-    assert {c.topic: c.verdict for c in evaluate_claims(single)}["Critical size"] == DISAGREES
+    assert {c.topic: c.word for c in evaluate_claims(single)}["Critical size"] == MISSED
     partial = {"results_format": 2, "uniformity": good["uniformity"],
                "config": {"behavior": "grasp", "n_trials": 20, "n_rows": 1000}}
-    verdicts = {c.topic: c.verdict for c in evaluate_claims(partial)}
-    assert verdicts["Fall at k = 3"] == AGREES and verdicts["Critical size"] == NOT_COMPUTABLE
+    verdicts = {c.topic: c.word for c in evaluate_claims(partial)}
+    assert verdicts["Fall at k = 3"] == MET and verdicts["Critical size"] == NOT_MEASURED
 
 
 def test_each_behaviour_gets_its_own_claims(results: dict, tmp_path: Path) -> None:
@@ -409,7 +403,7 @@ def test_each_behaviour_gets_its_own_claims(results: dict, tmp_path: Path) -> No
         "Uniformity rises with k", "Fewer features as r rises", "Number constant in k", "SVM accuracy falls with k"]
     text = write_report(push, tmp_path).read_text()
     assert "# Reproduction of Akgun et al. 2009, push:" in text and "tapping and grasping only" in text
-    assert sum(text.count(f"**{v}**") for v in VERDICTS) == 4
+    assert sum(text.count(f"**{v}**") for v in WORDS) == 4
 
 
 def test_the_overview_sets_the_behaviours_side_by_side(results: dict, tmp_path: Path) -> None:
@@ -422,7 +416,7 @@ def test_the_overview_sets_the_behaviours_side_by_side(results: dict, tmp_path: 
     assert "6.0 cm (90 % below, 10 % above)" in text  # the grasp's critical size in the headline table
     assert "[uniformity](grasp/uniformity.png)" in text and "## tap" in text and "## grasp" in text
     assert "| Fall at k = 3 |" in text and "| 1 x 2 map: object types |" in text
-    assert sum(text.count(f"**{v}**") for v in VERDICTS) == 14 + 10
+    assert sum(text.count(f"**{v}**") for v in WORDS) == 14 + 10
     with pytest.raises(ValueError, match="runs must map each behaviour"):
         write_overview({}, tmp_path)
 

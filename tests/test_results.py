@@ -1,5 +1,5 @@
 """The typed, read-only view of the learning results (:class:`Results`) and of the plan's (:class:`PlanResults`),
-and the claims specified as :class:`ClaimSpec`: read from the shipped reproductions, checked, upgraded from format
+and the claims specified as :class:`Spec`: read from the shipped reproductions, checked, upgraded from format
 1, and the same reports whether given a dict or the view."""
 
 from __future__ import annotations
@@ -12,7 +12,8 @@ from pathlib import Path
 import pytest
 
 from affordance_learning.common.exceptions import InvalidValueError
-from affordance_learning.paper.claims import CLAIM_SETS, METHOD_CLAIMS, ClaimSpec, evaluate_claims
+from affordance_learning.common.verdicts import Spec, judge
+from affordance_learning.paper.claims import CLAIM_SETS, METHOD_CLAIMS, evaluate_claims
 from affordance_learning.paper.report import render_report
 from affordance_learning.paper.results import RESULTS_FORMAT, Results, Stat, k_key, r_key
 from affordance_learning.planning.results import NOTHING, PlanResults
@@ -145,15 +146,15 @@ def test_format_1_is_read_as_the_current_format(raw: dict) -> None:
 
 
 # --- the claims --------------------------------------------------------------------------------------------------
-def test_claims_are_specified_once_each_as_a_claim_spec(raw: dict) -> None:
+def test_claims_are_specified_once_each_as_a_spec(raw: dict) -> None:
     specs = [spec for claims in (*CLAIM_SETS.values(), METHOD_CLAIMS) for spec in claims]
-    assert specs and all(isinstance(spec, ClaimSpec) for spec in specs)
-    assert all(spec.topic and spec.paper and spec.rule and callable(spec.judge) and callable(spec.basis)
+    assert specs and all(isinstance(spec, Spec) for spec in specs)
+    assert all(spec.topic and spec.statement and spec.rule and callable(spec.judge) and callable(spec.basis)
                for spec in specs)
     with pytest.raises(dataclasses.FrozenInstanceError):
         specs[0].rule = "anything goes"  # type: ignore[misc]
     results = Results.from_dict(raw)
-    assert evaluate_claims(results) == evaluate_claims(raw) == [spec.judged(results) for spec in CLAIM_SETS["tap"]]
+    assert evaluate_claims(results) == evaluate_claims(raw) == [judge(spec, results) for spec in CLAIM_SETS["tap"]]
     assert render_report(results) == render_report(raw)
 
 

@@ -10,34 +10,26 @@ from pathlib import Path
 import pytest
 
 from affordance_learning.paper.claims import (
-    AGREES,
-    DISAGREES,
     MIN_INTERACTIONS,
     MIN_TRIALS,
-    NOT_COMPUTABLE,
     STRADDLE_MAX_SIZE,
     STRADDLE_MIN_SIZE,
-    TOO_FEW,
     evaluate_claims,
 )
 from affordance_learning.paper.metrics import wilson_interval
 from affordance_learning.paper.report import render_report
 from affordance_learning.planning.experiment import MULTI_POLICIES, POLICIES, SHAPES, share_text, summarize
-from affordance_learning.planning.report import (
-    MET,
+from affordance_learning.common.verdicts import MET, MISSED, NOT_MEASURED, TOO_FEW
+from affordance_learning.planning.report import write_plan_report
+from affordance_learning.planning.targets import (
     MIN_CALIBRATION_ACTIONS,
     MIN_EPISODES,
     MIN_FEASIBLE_GOALS,
     MIN_FEASIBLE_PER_SHAPE,
     MIN_PLACEMENTS,
-    MISSED,
-    NOT_MEASURED,
+    evaluate_targets,
     measured_targets,
-    target_met,
-    target_verdict,
-    write_plan_report,
 )
-from affordance_learning.planning.report import TOO_FEW as TARGET_TOO_FEW
 from affordance_learning.planning.results import PlanResults
 
 STRADDLE = "1 x 3 map: a category straddles the critical size"
@@ -121,48 +113,47 @@ def _plan_results(shape_goals: dict[str, tuple[int, int, int]] | None = None, si
 
 def test_a_left_out_shape_judged_on_one_goal_is_too_few_not_met() -> None:
     results = _plan_results({**{s: (60, 50, 45) for s in SHAPES}, "box": (3, 1, 1)})  # box: 1 of 1 feasible
-    measured = measured_targets(results)[SHAPE_TARGET]
-    assert target_verdict(SHAPE_TARGET, measured) == TARGET_TOO_FEW and target_met(SHAPE_TARGET, measured) is None
-    assert measured.n == 1 and "box" in measured.unit
+    measured, verdict = measured_targets(results)[SHAPE_TARGET], evaluate_targets(results)[SHAPE_TARGET]
+    assert verdict.word == TOO_FEW and verdict.met is None
+    assert measured.n == 1 and "box" in measured.unit and verdict.n == 1
     # with enough feasible goals of every shape the same shares are met
     enough = _plan_results({**{s: (60, 50, 45) for s in SHAPES}, "box": (40, MIN_FEASIBLE_PER_SHAPE, 30)})
-    assert target_verdict(SHAPE_TARGET, measured_targets(enough)[SHAPE_TARGET]) == MET
+    assert evaluate_targets(enough)[SHAPE_TARGET].word == MET
 
 
 def test_a_left_out_shape_missed_on_enough_goals_misses_whatever_the_others() -> None:
     results = _plan_results({"sphere": (60, 50, 20), "box": (3, 0, 0), "horizontal_cylinder": (60, 50, 45),
                              "vertical_cylinder": (60, 50, 45)})
     measured = measured_targets(results)[SHAPE_TARGET]
-    assert target_verdict(SHAPE_TARGET, measured) == MISSED and measured.value == pytest.approx(0.4)
+    assert evaluate_targets(results)[SHAPE_TARGET].word == MISSED and measured.value == pytest.approx(0.4)
     assert measured.n == 50 and "sphere" in measured.unit
 
 
 def test_single_step_and_multi_step_need_their_minimum_n() -> None:
     few = _plan_results(single=(200, MIN_FEASIBLE_GOALS - 1, MIN_FEASIBLE_GOALS - 1),
                         episodes=(MIN_EPISODES - 1, MIN_EPISODES - 1))
-    targets = measured_targets(few)
-    assert target_verdict(SINGLE_TARGET, targets[SINGLE_TARGET]) == TARGET_TOO_FEW  # 100 % of 199
-    assert target_verdict(MULTI_TARGET, targets[MULTI_TARGET]) == TARGET_TOO_FEW  # 100 % of 59
-    enough = measured_targets(_plan_results(single=(300, MIN_FEASIBLE_GOALS, 150),
+    targets = evaluate_targets(few)
+    assert targets[SINGLE_TARGET].word == TOO_FEW  # 100 % of 199
+    assert targets[MULTI_TARGET].word == TOO_FEW  # 100 % of 59
+    enough = evaluate_targets(_plan_results(single=(300, MIN_FEASIBLE_GOALS, 150),
                                             episodes=(MIN_EPISODES, MIN_EPISODES)))
-    assert target_verdict(SINGLE_TARGET, enough[SINGLE_TARGET]) == MISSED  # 75 % of 200
-    assert target_verdict(MULTI_TARGET, enough[MULTI_TARGET]) == MET
-    # nothing measured is no verdict, and a bare value without its n gets none either
-    none = measured_targets(_plan_results(episodes=(0, 0)))
-    assert target_verdict(MULTI_TARGET, none[MULTI_TARGET]) == NOT_MEASURED
-    assert target_met(SINGLE_TARGET, 0.99) is None
+    assert enough[SINGLE_TARGET].word == MISSED  # 75 % of 200
+    assert enough[MULTI_TARGET].word == MET
+    # nothing measured is no verdict
+    none = evaluate_targets(_plan_results(episodes=(0, 0)))
+    assert none[MULTI_TARGET].word == NOT_MEASURED and none[MULTI_TARGET].met is None
 
 
 def test_placement_and_calibration_need_their_minimum_n() -> None:
     placement, ece = "median placement error [m]", "calibration ECE"
     results = _plan_results()
     results["placement_error_n"], results["calibration"]["n"] = MIN_PLACEMENTS - 1, MIN_CALIBRATION_ACTIONS - 1
-    targets = measured_targets(results)
-    assert target_verdict(placement, targets[placement]) == TARGET_TOO_FEW
-    assert target_verdict(ece, targets[ece]) == TARGET_TOO_FEW
+    targets = evaluate_targets(results)
+    assert targets[placement].word == TOO_FEW
+    assert targets[ece].word == TOO_FEW
     results["placement_error_n"], results["calibration"]["n"] = MIN_PLACEMENTS, MIN_CALIBRATION_ACTIONS
-    targets = measured_targets(results)
-    assert target_verdict(placement, targets[placement]) == target_verdict(ece, targets[ece]) == MET
+    targets = evaluate_targets(results)
+    assert targets[placement].word == targets[ece].word == MET
     # results written before placement_error_n: the place goals the planner acted on, counted from the goals
     del results["placement_error_n"]
     results["goals"] = [_goal(kind="place", planner_behavior="push")] * 12 + [_goal(kind="place",
@@ -231,7 +222,8 @@ def test_the_plan_report_shows_n_beside_every_rate_and_no_zero_for_nothing(tmp_p
     text = write_plan_report(results, tmp_path).read_text()
     box = next(line for line in text.splitlines() if line.startswith("| box |"))
     assert box == "| box | not measured (n=0) | not measured (n=0) | 0.0 % [0, 49] (n=4) |"  # 0 of 0, but 0 of 4
-    assert f"**{TARGET_TOO_FEW} (n=0 feasible goals of box; {MIN_FEASIBLE_PER_SHAPE} needed)**" in text
+    assert (f"**{TOO_FEW} (n=0 feasible goals of box; at least {MIN_FEASIBLE_PER_SHAPE} feasible goals of box "
+            "needed)**") in text
     assert "| lift | not measured (n=0) |" in text  # a goal kind without goals
     rows = [line for line in text.splitlines() if line.startswith("| ")]
     assert len(rows) > 20
@@ -262,65 +254,65 @@ SMALL, BOTH, LARGE = [0.03, 0.04, 0.05], [0.05, 0.055, 0.062, 0.068], [0.07, 0.0
 
 
 def _verdict(results: dict, topic: str) -> str:
-    return next(c.verdict for c in evaluate_claims(results) if c.topic == topic)
+    return next(c.word for c in evaluate_claims(results) if c.topic == topic)
 
 
 def test_a_straddling_category_must_be_a_minority() -> None:
     # the paper's picture: a success and a fail category, and a minority between them, with some of each
     good = _grasp_results([(400, 20, SMALL), (120, 80, BOTH), (20, 460, LARGE)])
-    assert _verdict(good, STRADDLE) == AGREES
+    assert _verdict(good, STRADDLE) == MET
     # what the shipped grasp shows: the category with objects and outcomes on both sides holds 97 % of everything
     bulk = _grasp_results([(553, 414, [0.04, 0.07, 0.1]), (0, 29, [0.071, 0.093]), (0, 4, [0.083, 0.085])])
-    assert _verdict(bulk, STRADDLE) == DISAGREES
+    assert _verdict(bulk, STRADDLE) == MISSED
     claim = next(c for c in evaluate_claims(bulk) if c.topic == STRADDLE)
     assert "holds 97 % of the interactions" in claim.ours and f"{100 * STRADDLE_MAX_SIZE:.0f} %" in claim.rule
     # a majority, with two fair categories beside it, is still the bulk of the map
     majority = _grasp_results([(200, 20, SMALL), (330, 270, BOTH), (20, 160, LARGE)])
-    assert _verdict(majority, STRADDLE) == DISAGREES
+    assert _verdict(majority, STRADDLE) == MISSED
 
 
 def test_the_categories_a_straddling_one_steals_from_hold_enough_of_both_outcomes() -> None:
     # a category of 5 % beside the straddling one: not one of the two it steals from
     handful = _grasp_results([(630, 20, SMALL), (180, 120, BOTH), (5, 45, LARGE)])
-    assert 50 / 1000 < STRADDLE_MIN_SIZE and _verdict(handful, STRADDLE) == DISAGREES
+    assert 50 / 1000 < STRADDLE_MIN_SIZE and _verdict(handful, STRADDLE) == MISSED
     # two success categories beside it: there is no fail category to steal from
     no_fail = _grasp_results([(400, 20, SMALL), (120, 80, BOTH), (300, 80, LARGE)])
-    assert _verdict(no_fail, STRADDLE) == DISAGREES
+    assert _verdict(no_fail, STRADDLE) == MISSED
 
 
 def test_claims_judged_on_too_few_data_say_so_with_their_n() -> None:
     straddle = [(400, 20, SMALL), (120, 80, BOTH), (20, 460, LARGE)]
     few_trials = _grasp_results(straddle, trials=MIN_TRIALS - 1)
     claims = {c.topic: c for c in evaluate_claims(few_trials)}
-    assert claims["Fall at k = 3"].verdict == TOO_FEW and claims["Fall at k = 3"].n == MIN_TRIALS - 1
-    assert claims["Fall at k = 3"].verdict_text.startswith(f"too few (n={MIN_TRIALS - 1} trials of 1000 interactions")
-    assert claims[STRADDLE].verdict == AGREES  # a map of the first trial does not depend on the trials
-    assert _verdict(_grasp_results(straddle, trials=MIN_TRIALS), "Fall at k = 3") == AGREES
+    assert claims["Fall at k = 3"].word == TOO_FEW and claims["Fall at k = 3"].n == MIN_TRIALS - 1
+    assert claims["Fall at k = 3"].text.startswith(f"too few data (n={MIN_TRIALS - 1} trials of 1000 interactions")
+    assert claims[STRADDLE].word == MET  # a map of the first trial does not depend on the trials
+    assert _verdict(_grasp_results(straddle, trials=MIN_TRIALS), "Fall at k = 3") == MET
     few_rows = _grasp_results(straddle, rows=MIN_INTERACTIONS - 1)
     assert _verdict(few_rows, "Fall at k = 3") == TOO_FEW and _verdict(few_rows, "Critical size") == TOO_FEW
     small_map = _grasp_results([(80, 4, SMALL), (24, 16, BOTH), (4, 70, LARGE)])  # 198 interactions
     claim = next(c for c in evaluate_claims(small_map) if c.topic == STRADDLE)
-    assert claim.verdict == TOO_FEW and claim.n == 198 and "198 interactions in the 1 x 3 map" in claim.verdict_text
+    assert claim.word == TOO_FEW and claim.n == 198 and "198 interactions in the 1 x 3 map" in claim.text
     # results that do not say how many trials they hold get no verdict
     unknown = copy.deepcopy(few_trials)
     del unknown["config"]["n_trials"]
     fall = next(c for c in evaluate_claims(unknown) if c.topic == "Fall at k = 3")
-    assert fall.verdict == NOT_COMPUTABLE and fall.verdict_text == "not computable (n unknown)"
+    assert fall.word == NOT_MEASURED and fall.text == "not measured (n unknown)"
 
 
 def test_every_claim_carries_its_n_in_the_report() -> None:
     results = _grasp_results([(400, 20, SMALL), (120, 80, BOTH), (20, 460, LARGE)])
     claims = evaluate_claims(results)
     for c in claims:
-        assert re.search(r"\(n=\d+ ", c.verdict_text) or c.verdict == NOT_COMPUTABLE, c
+        assert re.search(r"\(n=\d+ ", c.text) or c.word == NOT_MEASURED, c
     text = render_report(results)
     rows = [line for line in text.splitlines() if any(line.startswith(f"| {c.topic} |") for c in claims)]
     assert len(rows) == len(claims)
     for row, c in zip(rows, claims, strict=True):
-        assert row.endswith(f"**{c.verdict}** ({c.n_text}) |")
-    assert "had too few data for a verdict" in text and f"at least {MIN_TRIALS} trials of {MIN_INTERACTIONS}" in text
+        assert row.endswith(f"**{c.word}** ({c.n_text}) |")
+    assert "had too few data" in text and f"at least {MIN_TRIALS} trials of {MIN_INTERACTIONS}" in text
     few = render_report({**results, "config": {**results["config"], "n_trials": 3}})
-    assert "**too few** (n=3 trials of 1000 interactions; at least" in few
+    assert "**too few data** (n=3 trials of 1000 interactions; at least" in few
 
 
 def test_a_missed_target_toward_the_robot_says_where_the_draw_could_not_reach(tmp_path: Path) -> None:

@@ -13,18 +13,8 @@ from typing import Any
 import numpy as np
 
 from affordance_learning.common.exceptions import InvalidValueError
-from affordance_learning.paper.claims import (  # noqa: F401  (AGREES ... Claim: re-exported, the report's vocabulary)
-    AGREES,
-    DISAGREES,
-    MIN_INTERACTIONS,
-    MIN_TRIALS,
-    NOT_COMPUTABLE,
-    TOO_FEW,
-    VERDICTS,
-    Claim,
-    claims_scope,
-    evaluate_claims,
-)
+from affordance_learning.common.verdicts import MET, TOO_FEW, Verdict, tally_text
+from affordance_learning.paper.claims import MIN_INTERACTIONS, MIN_TRIALS, claims_scope, evaluate_claims
 from affordance_learning.paper.results import (
     UNIFORMITY_DEFINITION,
     UNITS,
@@ -92,20 +82,23 @@ def _case_tables(results: Results) -> list[str]:
     return lines
 
 
-def _tally(claims: Sequence[Claim]) -> str:
+def _tally(claims: Sequence[Verdict]) -> str:
     """How many claims got each verdict, and the least data a verdict is given on."""
-    tally = {v: sum(c.verdict == v for c in claims) for v in VERDICTS}
-    return (f"**{tally[AGREES]} of {len(claims)} claims agree**, {tally[DISAGREES]} disagree, {tally[TOO_FEW]} had too "
-            f"few data for a verdict, {tally[NOT_COMPUTABLE]} could not be computed. A verdict is given on at least "
+    return (f"**{tally_text(claims, 'claims')}.** A verdict is given on at least "
             f"{MIN_TRIALS} trials of {MIN_INTERACTIONS} interactions (a claim on means over trials) or "
             f"{MIN_INTERACTIONS} interactions (a claim on one map of the first trial, or on sizes); each shows its "
             "n.")
 
 
-def _claim_rows(claims: Sequence[Claim]) -> list[str]:
-    """The claims' table: each with the paper's statement, the rule, our numbers and the verdict with its n."""
+def _claim_rows(claims: Sequence[Verdict]) -> list[str]:
+    """The claims' table: each with the paper's statement, the rule, our numbers and the verdict with its n; then,
+    for each missed claim, why from the data."""
     rows = ["| claim | the paper | rule | ours | verdict |", "|---|---|---|---|---|"]
-    rows += [f"| {c.topic} | {c.paper} | {c.rule} | {c.ours} | **{c.verdict}** ({c.n_text}) |" for c in claims]
+    rows += [f"| {c.topic} | {c.statement} | {c.rule} | {c.ours} | **{c.word}** ({c.n_text}) |" for c in claims]
+    missed = [c for c in claims if c.why]
+    if missed:
+        rows += ["", "Why the missed claims are missed, from the data:", ""]
+        rows += [f"- **{c.topic}**: {c.why}." for c in missed]
     return rows
 
 
@@ -322,14 +315,14 @@ def render_overview(runs: Mapping[str, Results | Mapping[str, Any]],
         "size (a test on the logistic fit of success on size, in each report).",
         "",
         "| behaviour | interactions | successes | uniformity, mean over k | highest uniformity | "
-        f"SVM accuracy at r = {HEADLINE_R} | critical size (success crosses 50 %) | claims that agree |",
+        f"SVM accuracy at r = {HEADLINE_R} | critical size (success crosses 50 %) | claims met |",
         "|---|---|---|---|---|---|---|---|",
     ]
     claims = {b: evaluate_claims(results) for b, results in read.items()}
     for behavior, results in read.items():
         h = _headline(results)
-        agree = sum(c.verdict == AGREES for c in claims[behavior])
-        few = sum(c.verdict == TOO_FEW for c in claims[behavior])
+        agree = sum(c.word == MET for c in claims[behavior])
+        few = sum(c.word == TOO_FEW for c in claims[behavior])
         lines.append(f"| [{behavior}]({behavior}/REPORT.md) | {h['interactions']} | {h['success']} | "
                      f"{h['uniformity']} | {h['peak']} | {h['accuracy']} | {h['critical']} | "
                      f"{agree} of {len(claims[behavior])}" + (f" ({few} on too few data)" if few else "") + " |")

@@ -254,7 +254,8 @@ def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, Results]:
 
 def summary(results: Results | Mapping[str, Any], report: Path) -> str:
     """The headline numbers of one behaviour's reproduction, and where its report is, in a few lines."""
-    from affordance_learning.paper.claims import AGREES, claims_scope, evaluate_claims
+    from affordance_learning.common.verdicts import tally_text
+    from affordance_learning.paper.claims import claims_scope, evaluate_claims
     from affordance_learning.paper.report import HEADLINE_R, headline_accuracy
     from affordance_learning.paper.results import as_results
 
@@ -282,6 +283,6 @@ def summary(results: Results | Mapping[str, Any], report: Path) -> str:
                      "above")
     lines.append(f"  SVM accuracy at r = {HEADLINE_R}: {100 * acc[min(acc)]:.1f} % (k = {min(acc)}) to "
                  f"{100 * acc[max(acc)]:.1f} % (k = {max(acc)})")
-    lines.append(f"  the paper's claims: {sum(c.verdict == AGREES for c in claims)} of {len(claims)} agree "
-                 f"(each verdict and its rule in the report). {claims_scope(behavior)}")
+    lines.append(f"  the paper's claims: {tally_text(claims, 'claims')} (each verdict, its rule and, where missed, "
+                 f"why in the report). {claims_scope(behavior)}")
     return "\n".join(lines)
