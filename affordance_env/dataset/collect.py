@@ -22,7 +22,6 @@ import dataclasses
 import json
 import os
 import signal
-import threading
 import warnings
 from collections.abc import Iterator, Mapping
 from pathlib import Path
@@ -62,6 +61,7 @@ from affordance_env.exceptions import InvalidValueError, MissingDependencyError
 from affordance_env.options import EnvOptions
 from affordance_env.progress import progress_bar, show_progress  # noqa: F401  (show_progress: re-exported)
 from affordance_env.registry import BEHAVIOR_NAMES
+from affordance_env.workers import worker_env
 
 ACTIONS = ("canonical", "random")
 SCHEDULERS = ("joblib", "dask")
@@ -114,25 +114,6 @@ def goal_step_actions(seed: int, episode: int, step: int, action: str) -> Iterat
 
 
 # --- a worker: interactions -> one chunk file --------------------------------------------------------------
-#: Per worker thread, {options: env}: building an env takes about a second, so a worker keeps its own.
-_worker = threading.local()
-
-
-def _worker_env(options_json: str, env_id: str = ENV_IDS[0]):
-    envs = _worker.__dict__.setdefault("envs", {})
-    key = (env_id, options_json)
-    if key not in envs:
-        if env_id == GOAL_ENV_ID:
-            from affordance_env.goal_env import TapAffordanceGoalEnv
-
-            envs[key] = TapAffordanceGoalEnv(**json.loads(options_json))
-        else:
-            from affordance_env.tap_env import TapAffordanceEnv
-
-            envs[key] = TapAffordanceEnv(**json.loads(options_json))
-    return envs[key]
-
-
 def _goal_episode_rows(env, settings: dict, episode: int) -> tuple[list[dict], str | None, str | None]:
     """The rows of goal episode ``episode`` (one per interaction, until the episode ends), the reason of its failed
     interaction (the last one run, left out), or None, and why the episode was cut short (truncated), or None.
@@ -183,7 +164,7 @@ def _collect_chunk(out: str, index: int, start: int, stop: int, header: dict) ->
     truncated: dict[str, str] = {}  # goal episodes cut short, and why
     for episode in range(start, stop):
         # an env that cannot be built stops the run: not a failed interaction
-        env = _worker_env(options_json, settings.get("env_id", ENV_IDS[0]))
+        env = worker_env(settings.get("env_id", ENV_IDS[0]), options_json)
         if goal:
             rows, failure, truncation = _goal_episode_rows(env, settings, episode)
             if failure is not None:
@@ -331,7 +312,7 @@ def collect(
     options = _full_options(dict(env_options or {}), env_id)
     options_json = json.dumps(options, sort_keys=True)
     if scheduler == "joblib" and workers == 1:
-        _worker_env(options_json, env_id)  # this process collects: build its env now, before any work
+        worker_env(env_id, options_json)  # this process collects: build its env now, before any work
     header = dataset_header(seed, action, chunk_size, options, save_images, env_id)
     if env_id == GOAL_ENV_ID:
         header["settings"]["goal_episodes"] = GOAL_EPISODE_RULE
