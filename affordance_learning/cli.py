@@ -23,9 +23,8 @@ from affordance_env.collect_cli import (
     non_negative_int,
     positive_int,
 )
-from affordance_env.exceptions import AffordanceEnvError
 from affordance_env.registry import BEHAVIOR_NAMES, ENV_ID
-from affordance_learning.common.exceptions import AffordanceLearningError, InvalidValueError
+from affordance_learning.common.exceptions import AffordanceError, InvalidValueError
 from affordance_learning.planning.results import PLAN_RESULTS_FORMAT
 
 if TYPE_CHECKING:
@@ -472,7 +471,7 @@ def main(argv: list[str] | None = None) -> int:
             print("affordance: interrupted; what was finished is kept (the same command resumes a collection "
                   "from its last finished chunk)", file=sys.stderr)
             return INTERRUPTED
-        except (AffordanceEnvError, AffordanceLearningError, OSError) as exc:  # FileNotFoundError: an OSError
+        except (AffordanceError, OSError) as exc:  # FileNotFoundError: an OSError
             print(f"affordance: error: {_one_line(exc)}", file=sys.stderr)
             return 2
 
