@@ -4,12 +4,12 @@ critical size are held and larger ones are not."""
 
 from __future__ import annotations
 
-import numbers
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from affordance_env.values import is_integer
 from affordance_learning.common.exceptions import InvalidValueError
 from affordance_learning.common.schema import OBJECT_TYPES
 
@@ -43,7 +43,7 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
         random_state: Seed.
         behavior: ``"tap"`` or ``"grasp"`` (the ``behavior`` column).
     """
-    if isinstance(n_rows, bool) or not isinstance(n_rows, numbers.Integral) or n_rows < 8:
+    if not is_integer(n_rows) or n_rows < 8:
         raise InvalidValueError(f"n_rows must be an integer >= 8, got {n_rows!r}.")
     if behavior not in SYNTHETIC_SIZE_RANGES:
         raise InvalidValueError(f"behavior must be one of {tuple(SYNTHETIC_SIZE_RANGES)}, got {behavior!r}.")
