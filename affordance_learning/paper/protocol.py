@@ -52,7 +52,7 @@ from sklearn.preprocessing import StandardScaler
 from affordance_env.values import is_integer
 from affordance_learning.common.behaviors import ROLLED_IS_SUCCESS, outcome_words
 from affordance_learning.common.exceptions import InvalidValueError
-from affordance_learning.common.schema import OBJECT_TYPES, feature_groups, feature_names, frame_behavior, label_column
+from affordance_learning.common.schema import TYPE_ORDER, feature_groups, feature_names, frame_behavior, label_column
 from affordance_learning.common.validation import first_non_finite
 from affordance_learning.paper.diagnostics import effect_summary
 from affordance_learning.paper.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
@@ -355,8 +355,8 @@ def run_protocol(
         if stratify
         else f"random, not stratified (type counts {type_counts.to_dict()} too small to stratify)"
     )
-    type_order = [t for t in OBJECT_TYPES if t in type_counts.index] + sorted(
-        t for t in type_counts.index if t not in OBJECT_TYPES
+    type_order = [t for t in TYPE_ORDER if t in type_counts.index] + sorted(
+        t for t in type_counts.index if t not in TYPE_ORDER
     )
     jobs = (
         delayed(_run_trial)(

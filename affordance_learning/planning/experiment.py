@@ -63,6 +63,7 @@ import numpy as np
 import pandas as pd
 
 from affordance_env.goal_env import GOAL_TABLE_MARGIN, draw_target
+from affordance_env.objects import OBJECT_TYPES
 from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
 from affordance_env.scene import table_extent
 from affordance_learning.planning.effect_model import ActionEffectModel, behavior_model
@@ -72,7 +73,6 @@ from affordance_learning.planning.planner import FAILURE_RADIUS, Planner
 
 BEHAVIORS = BEHAVIOR_NAMES
 GOAL_KINDS = ("roll", "lift", "move", "place")
-SHAPES = ("sphere", "box", "horizontal_cylinder", "vertical_cylinder")
 POLICIES = ("planner", "random", "best_fixed", "canonical_choice", "som_categories", "oracle")
 MULTI_POLICIES = ("planner", "direction", "random")
 #: Goals: Move's distance [m], Place's distance from the object [m] and tolerance [m].
@@ -504,7 +504,7 @@ def step_reach(frame: pd.DataFrame, quantile: float = 0.9) -> dict[str, dict[str
     kept = (frame["outcome"].astype(str) != "off_table").to_numpy()
     types = frame["type"].astype(str).to_numpy()
     out = {}
-    for shape in SHAPES:
+    for shape in OBJECT_TYPES:
         rows = kept & (types == shape)
         if rows.any():
             parts = dict(zip(DIRECTIONS, (dx[rows], -dx[rows], dy[rows], -dy[rows]), strict=True))
@@ -617,7 +617,7 @@ def _items(seed: int, part: int, n: int) -> list[dict]:
     for i in range(n):
         ss = np.random.SeedSequence([seed, EVAL_STREAM, part, i])
         env_seed, rng_seed = (int(v) for v in ss.generate_state(2))
-        items.append({"seed": env_seed, "rng": rng_seed, "index": i, "shape": SHAPES[i % len(SHAPES)]})
+        items.append({"seed": env_seed, "rng": rng_seed, "index": i, "shape": OBJECT_TYPES[i % len(OBJECT_TYPES)]})
     return items
 
 
@@ -753,7 +753,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         shape: Planner(fit_models(training_frames(frame, settings.max_per_behavior, exclude_type=shape), seed,
                                   n_jobs=workers),
                        n_candidates=settings.candidates, threshold=settings.threshold, random_state=seed)
-        for shape in SHAPES}
+        for shape in OBJECT_TYPES}
     timings["fit"] = time.perf_counter() - t
     say(f"[2/5] fitted the effect models, each shape's without it, and the paper's categories "
         f"({timings['fit']:.1f} s)")
@@ -779,12 +779,12 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         + f"; {single['oracle']['n_feasible']} goals feasible")
 
     loso: dict[str, Any] = {}
-    for shape in SHAPES:
+    for shape in OBJECT_TYPES:
         shape_records = [{**r, "planner": r.get("planner_left_out", False)} for r in records if r["type"] == shape]
         loso[shape] = summarize(shape_records, ("planner", "best_fixed", "random", "oracle"))
     say("[4/5] leaving each shape out (judged in step 3): "
         + ", ".join(f"{s} " + share_text(loso[s]["planner"]["success_feasible"], loso[s]["planner"]["n_feasible"],
-                                         loso[s]["planner"]["success_feasible_ci"], "feasible") for s in SHAPES))
+                                         loso[s]["planner"]["success_feasible_ci"], "feasible") for s in OBJECT_TYPES))
 
     multi: dict[str, Any] = {}
     for i, policy in enumerate(MULTI_POLICIES):
@@ -811,7 +811,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
 
     multi["planner"]["by_type"] = {
         shape: {"n": len(eps), "success": sum(e["success"] for e in eps) / len(eps)}
-        for shape in SHAPES if (eps := [e for e in planner_episodes if e["type"] == shape])}
+        for shape in OBJECT_TYPES if (eps := [e for e in planner_episodes if e["type"] == shape])}
     reach, tolerance = step_reach(frame), planner_episodes[0]["tolerance"]  # the goal env's
     multi["step_reach_p90_m"], multi["tolerance_m"], multi["max_interactions"] = (reach, tolerance,
                                                                                   GOAL_MAX_EPISODE_STEPS)
@@ -839,7 +839,8 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         "workers": workers, "cpu_count": os.cpu_count(),
         "oracle": {"actions_per_behavior": len(oracle_params()), "levels": list(ORACLE_LEVELS),
                    "objects": n_objects, "goals_per_object": dict(GOALS_PER_OBJECT),
-                   "objects_per_shape": {s: len({r["object"] for r in records if r["type"] == s}) for s in SHAPES}},
+                   "objects_per_shape": {s: len({r["object"] for r in records if r["type"] == s})
+                                         for s in OBJECT_TYPES}},
         "single_step": single,
         "single_step_by_goal": {kind: summarize([r for r in records if r["kind"] == kind], POLICIES)
                                 for kind in GOAL_KINDS},

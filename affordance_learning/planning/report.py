@@ -21,7 +21,6 @@ from affordance_learning.planning.experiment import (
     MULTI_POLICIES,
     POLICIES,
     PULLING,
-    SHAPES,
     calibration,
     share_text,
     wilson,
@@ -659,4 +658,4 @@ def _interval(share: Share) -> tuple[float, float]:
 
 
 __all__ = ["TARGETS", "MIN_N", "Measured", "measured_targets", "target_verdict", "target_met", "verdict_text",
-           "write_plan_report", "write_plan_figures", "SHAPES", "MULTI_POLICIES"]
+           "write_plan_report", "write_plan_figures", "MULTI_POLICIES"]
