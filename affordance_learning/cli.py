@@ -87,12 +87,10 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
     """``--dataset`` values, ``BEHAVIOR=PATH`` or (with one behaviour) ``PATH``, as a directory per behaviour."""
-    from affordance_learning.common.behaviors import BEHAVIORS
-
     datasets: dict[str, Path] = {}
     for item in items:
         name, _, path = item.partition("=")
-        if not path or name not in {*behaviors, *BEHAVIORS}:  # a bare path (which may hold "=" itself)
+        if not path or name not in {*behaviors, *BEHAVIOR_NAMES}:  # a bare path (which may hold "=" itself)
             if len(behaviors) != 1:
                 raise InvalidValueError(
                     f"--dataset {item}: say whose dataset it is, as BEHAVIOR=PATH with BEHAVIOR one "

@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import qmc
 
+from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_env.scene import table_extent
 from affordance_env.values import float_array, is_integer
-from affordance_learning.common.behaviors import BEHAVIORS
 from affordance_learning.common.exceptions import InvalidValueError
 from affordance_learning.common.validation import check_float32_range
 from affordance_learning.planning.effect_model import ActionEffectModel, PredictiveOutcomes
@@ -147,8 +147,8 @@ class Planner:
 
     Args:
         models: A fitted :class:`~.effect_model.ActionEffectModel` per behaviour name (one of
-            :data:`affordance_learning.common.behaviors.BEHAVIORS`), each of the same inputs: the object's features (the
-            49 of ``affordance_env.FEATURE_NAMES``) and the 3 action parameters.
+            :data:`affordance_env.registry.BEHAVIOR_NAMES`, in any order), each of the same inputs: the object's
+            features (the 49 of ``affordance_env.FEATURE_NAMES``) and the 3 action parameters.
         n_candidates: Parameter vectors scored per behaviour.
         threshold: Abstain below this P(goal).
         random_state: Seed of the candidates.
@@ -174,17 +174,20 @@ class Planner:
             raise InvalidValueError(f"threshold must be a probability in [0, 1], got {threshold!r}.")
         if not is_integer(max_checks) or max_checks < 1:
             raise InvalidValueError(f"max_checks must be an integer >= 1, got {max_checks!r}.")
-        unknown = [name for name in models if name not in BEHAVIORS]
+        unknown = [name for name in models if name not in BEHAVIOR_NAMES]
         if unknown:
             raise InvalidValueError(f"Unknown behavior(s) {', '.join(map(repr, unknown))} in models. Valid behaviors: "
-                             f"{', '.join(BEHAVIORS)}.")
+                             f"{', '.join(BEHAVIOR_NAMES)}.")
         for name, model in models.items():
             if not isinstance(model, ActionEffectModel) or not hasattr(model, "forest_"):
                 raise TypeError(f"models[{name!r}] must be a fitted ActionEffectModel, got {type(model).__name__}.")
         inputs = {name: model.n_features_in_ for name, model in models.items()}
         if len(set(inputs.values())) > 1:
             raise InvalidValueError(f"the models must take the same inputs, got {inputs} input columns per behaviour.")
-        self.models = dict(models)
+        #: The models by behaviour, in the registry's order (:data:`affordance_env.registry.BEHAVIOR_NAMES`)
+        #: whatever the order of ``models``: the order of :meth:`scores`, and candidates that rank equal go to the
+        #: earlier behaviour.
+        self.models = {name: models[name] for name in BEHAVIOR_NAMES if name in models}
         self.threshold = float(threshold)
         self.max_checks = int(max_checks)
         if not is_integer(random_state) or random_state < 0:
