@@ -16,16 +16,12 @@ from affordance_env.exceptions import InvalidValueError
 from affordance_env.features import FEATURE_NAMES
 from affordance_env.options import EnvOptions
 from affordance_env.placement import RESET_OPTIONS, draw_placement
-from affordance_env.registry import BEHAVIOR_ARMS, BEHAVIOR_NAMES
+from affordance_env.registry import BEHAVIOR_NAMES, check_behavior_name
 from affordance_env.results import InteractionResult, Snapshot
 from affordance_env.values import float_array, restore_with_generator
 from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
 from affordance_env.world import World, WorldState
 
-#: The behaviours, in the order of the action's ``behavior`` index (:mod:`affordance_env.registry`).
-BEHAVIORS: tuple[str, ...] = BEHAVIOR_NAMES
-#: The arm that does each behaviour.
-ARM_OF: Mapping[str, str] = BEHAVIOR_ARMS
 #: Keys of ``reset(options=...)``.
 GOAL_RESET_OPTIONS = ("goal", *RESET_OPTIONS)
 #: Goals are drawn this far from the object [m] ...
@@ -228,13 +224,13 @@ class TapAffordanceGoalEnv(gym.Env):
         #: workspace of a behaviour drawn uniformly (:func:`~affordance_env.workspace.sample_in_workspace`).
         self.position_range = options.position_range
         #: The world, with both arms: every behaviour acts in it.
-        self.world = World(BEHAVIORS, two_arms=True, camera_width=options.camera_width,
+        self.world = World(BEHAVIOR_NAMES, two_arms=True, camera_width=options.camera_width,
                            camera_height=options.camera_height, camera_fovy=options.camera_fovy,
                            range_noise=options.range_noise, roll_threshold=options.roll_threshold,
                            settle_timeout=options.settle_timeout, typical_size=float(np.mean(options.size_range)))
         self._render_size = (render_width, render_height)
         #: The behaviours, named by the action's ``behavior`` index.
-        self.behaviors = BEHAVIORS
+        self.behaviors = BEHAVIOR_NAMES
         self.goal_tolerance = float(goal_tolerance)
         self.reward_type = reward_type
         self.render_mode = render_mode
@@ -249,7 +245,7 @@ class TapAffordanceGoalEnv(gym.Env):
             "achieved_goal": spaces.Box(table.low, table.high, (2,), np.float64),
             "desired_goal": spaces.Box(table.low, table.high, (2,), np.float64),
         })
-        self.action_space = spaces.Dict({"behavior": spaces.Discrete(len(BEHAVIORS)),
+        self.action_space = spaces.Dict({"behavior": spaces.Discrete(len(BEHAVIOR_NAMES)),
                                          "params": spaces.Box(-1.0, 1.0, (ACTION_DIM,), np.float32)})
         self._goal = np.zeros(2)
         self._obs: dict[str, Any] | None = None
@@ -327,19 +323,17 @@ class TapAffordanceGoalEnv(gym.Env):
 
     def _check_action(self, action: Any) -> tuple[str, np.ndarray]:
         if not isinstance(action, Mapping) or set(action) != {"behavior", "params"}:
-            raise InvalidValueError(f"action must be a dict with keys 'behavior' (an index into {list(BEHAVIORS)} or a "
-                             f"name) and 'params' (3 values in [-1, 1]), got {action!r}.")
+            raise InvalidValueError(f"action must be a dict with keys 'behavior' (an index into {list(BEHAVIOR_NAMES)} "
+                                    f"or a name) and 'params' (3 values in [-1, 1]), got {action!r}.")
         behavior = action["behavior"]
         if isinstance(behavior, str):
-            name = behavior
-            if name not in BEHAVIORS:
-                raise InvalidValueError(f"Unknown behavior {name!r}. Valid behaviors: {', '.join(BEHAVIORS)}.")
+            name = check_behavior_name(behavior)
         else:
             index = _behavior_index(behavior)
-            if not 0 <= index < len(BEHAVIORS):
-                raise InvalidValueError(f"action 'behavior' must be an index in 0..{len(BEHAVIORS) - 1} "
-                                 f"({', '.join(BEHAVIORS)}), got {behavior!r}.")
-            name = BEHAVIORS[index]
+            if not 0 <= index < len(BEHAVIOR_NAMES):
+                raise InvalidValueError(f"action 'behavior' must be an index in 0..{len(BEHAVIOR_NAMES) - 1} "
+                                 f"({', '.join(BEHAVIOR_NAMES)}), got {behavior!r}.")
+            name = BEHAVIOR_NAMES[index]
         return name, check_action(action["params"])
 
     def feasible(self, behavior: int | str, params: Any, state: GoalEnvState | None = None) -> bool:
@@ -418,13 +412,14 @@ class FlatActionWrapper(gym.ActionWrapper):
 
     def __init__(self, env: gym.Env) -> None:
         super().__init__(env)
-        self.action_space = spaces.Box(-1.0, 1.0, (len(BEHAVIORS) + ACTION_DIM,), np.float32)
+        self.action_space = spaces.Box(-1.0, 1.0, (len(BEHAVIOR_NAMES) + ACTION_DIM,), np.float32)
 
     def action(self, action: Any) -> dict[str, Any]:
         a = float_array("action", action, self.action_space.shape,
-                        expected=f"{self.action_space.shape[0]} finite values ({len(BEHAVIORS)} behaviour scores, 3 "
-                                 "parameters in [-1, 1])")
-        return {"behavior": int(np.argmax(a[: len(BEHAVIORS)])), "params": a[len(BEHAVIORS):].astype(np.float32)}
+                        expected=f"{self.action_space.shape[0]} finite values ({len(BEHAVIOR_NAMES)} behaviour scores, "
+                                 "3 parameters in [-1, 1])")
+        n = len(BEHAVIOR_NAMES)
+        return {"behavior": int(np.argmax(a[:n])), "params": a[n:].astype(np.float32)}
 
 
-__all__ = ["TapAffordanceGoalEnv", "GoalEnvState", "FlatActionWrapper", "BEHAVIORS", "goal_distance", "WORKSPACES"]
+__all__ = ["TapAffordanceGoalEnv", "GoalEnvState", "FlatActionWrapper", "goal_distance", "WORKSPACES"]

@@ -15,6 +15,9 @@ from affordance_env.linalg import norm
 
 #: Object types, as named in the paper.
 OBJECT_TYPES: tuple[str, ...] = ("sphere", "box", "horizontal_cylinder", "vertical_cylinder")
+#: The types that roll when tapped (a sphere, a cylinder lying across the stroke); the others rest. The paper's
+#: tap affordance, which the learning reads as ground truth.
+ROLLING_TYPES: tuple[str, ...] = ("sphere", "horizontal_cylinder")
 #: Which primitive geom of the scene's ``object`` body each type uses.
 PRIMITIVE_OF_TYPE: dict[str, str] = {
     "sphere": "sphere",

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from affordance_env.exceptions import InvalidValueError
+from affordance_env.values import is_integer
 
 #: The widest and tallest image [pixels]: 4096, six times a Kinect's 640 x 480 on either side; the camera keeps a few
 #: arrays of 8 to 24 bytes per pixel (rays, distances, points), 1.2 GB at 4096 x 4096.
@@ -31,8 +32,7 @@ class Intrinsics:
     @classmethod
     def from_fovy(cls, width: int, height: int, fovy_deg: float) -> Intrinsics:
         """Square pixels with vertical field of view ``fovy_deg`` [deg], principal point at the image centre."""
-        if (not (isinstance(width, int | np.integer) and isinstance(height, int | np.integer))
-                or isinstance(width, bool) or isinstance(height, bool)
+        if (not (is_integer(width) and is_integer(height))
                 or min(width, height) < 2 or max(width, height) > MAX_RESOLUTION):
             raise InvalidValueError(f"camera resolution must be integers in 2..{MAX_RESOLUTION}, got width={width!r}, "
                                     f"height={height!r}.")

@@ -8,6 +8,7 @@ import gymnasium as gym
 
 from affordance_env.exceptions import InvalidValueError
 from affordance_env.registry import ENV_ID, GOAL_ENV_ID
+from affordance_env.values import is_integer
 
 #: Interactions per episode of the goal env, after which it is truncated.
 GOAL_MAX_EPISODE_STEPS = 5
@@ -31,7 +32,7 @@ def make_tap_vector_env(num_envs: int = 1, **kwargs: Any) -> gym.vector.VectorEn
     metadata), so that every vector step is an interaction. With Gymnasium's default, the next step, every
     second step of a one-interaction episode would be a reset with reward 0. ``vectorization_mode="async"``
     with ``vector_kwargs={"autoreset_mode": gym.vector.AutoresetMode.SAME_STEP}`` gives worker processes."""
-    if isinstance(num_envs, bool) or not isinstance(num_envs, int) or num_envs < 1:
+    if not is_integer(num_envs) or num_envs < 1:
         raise InvalidValueError(f"num_envs must be an integer >= 1, got {num_envs!r}.")
     kwargs.pop("max_episode_steps", None)  # one interaction per episode: the env terminates it
     return gym.vector.SyncVectorEnv([lambda: make_tap_env(**kwargs) for _ in range(num_envs)],
@@ -52,7 +53,7 @@ def make_goal_vector_env(num_envs: int = 1, max_episode_steps: int = GOAL_MAX_EP
     truncated after ``max_episode_steps`` interactions and reset in the same vector step that ends its episode
     (``AutoresetMode.SAME_STEP``, declared in the env's metadata; the episode's last observation and info are in
     ``infos["final_obs"]`` and ``infos["final_info"]``), so that every vector step is an interaction."""
-    if isinstance(num_envs, bool) or not isinstance(num_envs, int) or num_envs < 1:
+    if not is_integer(num_envs) or num_envs < 1:
         raise InvalidValueError(f"num_envs must be an integer >= 1, got {num_envs!r}.")
 
     def make() -> gym.Env:

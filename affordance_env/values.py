@@ -25,6 +25,11 @@ def _shown(value: Any) -> str:
     return shown if len(shown) <= _SHOWN else shown[: _SHOWN - 3] + "..."
 
 
+def is_integer(value: Any) -> bool:
+    """Whether ``value`` is an integer, Python's or numpy's; not a boolean, which Python counts as one."""
+    return isinstance(value, int | np.integer) and not isinstance(value, bool)
+
+
 def float_array(name: str, value: Any, shape: tuple[int, ...] | None = None, *, expected: str | None = None,
                 finite: bool = True, error: type[Exception] = InvalidValueError) -> np.ndarray:
     """``value`` as a float64 array, refused (``error``, a message naming ``name``, the value and ``expected``) unless
@@ -37,7 +42,7 @@ def float_array(name: str, value: Any, shape: tuple[int, ...] | None = None, *, 
         shape: The shape it must have; None: any.
         expected: What it must be, in words (default: from ``shape`` and ``finite``).
         finite: Whether NaN and infinities are refused.
-        error: The exception raised (a package's own ``InvalidValueError``).
+        error: The exception raised.
     """
     def refused(got: str = "") -> Exception:  # the message is made only when it is raised
         what = expected

@@ -23,9 +23,8 @@ from affordance_env.collect_cli import (
     non_negative_int,
     positive_int,
 )
-from affordance_env.exceptions import AffordanceEnvError
 from affordance_env.registry import BEHAVIOR_NAMES, ENV_ID
-from affordance_learning.common.exceptions import AffordanceLearningError, InvalidValueError
+from affordance_learning.common.exceptions import AffordanceError, InvalidValueError
 from affordance_learning.planning.results import PLAN_RESULTS_FORMAT
 
 if TYPE_CHECKING:
@@ -88,12 +87,10 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
     """``--dataset`` values, ``BEHAVIOR=PATH`` or (with one behaviour) ``PATH``, as a directory per behaviour."""
-    from affordance_learning.common.behaviors import BEHAVIORS
-
     datasets: dict[str, Path] = {}
     for item in items:
         name, _, path = item.partition("=")
-        if not path or name not in {*behaviors, *BEHAVIORS}:  # a bare path (which may hold "=" itself)
+        if not path or name not in {*behaviors, *BEHAVIOR_NAMES}:  # a bare path (which may hold "=" itself)
             if len(behaviors) != 1:
                 raise InvalidValueError(
                     f"--dataset {item}: say whose dataset it is, as BEHAVIOR=PATH with BEHAVIOR one "
@@ -468,7 +465,7 @@ def main(argv: list[str] | None = None) -> int:
             print("affordance: interrupted; what was finished is kept (the same command resumes a collection "
                   "from its last finished chunk)", file=sys.stderr)
             return INTERRUPTED
-        except (AffordanceEnvError, AffordanceLearningError, OSError) as exc:  # FileNotFoundError: an OSError
+        except (AffordanceError, OSError) as exc:  # FileNotFoundError: an OSError
             print(f"affordance: error: {_one_line(exc)}", file=sys.stderr)
             return 2
 

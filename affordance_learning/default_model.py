@@ -142,7 +142,7 @@ def train_default_model(
         path: Where to write the model (the directory is created; default: the user's file of the behaviour,
             :func:`user_model_path`, which :func:`predict_effect` then uses); written to a temporary file first
             and moved into place, so a reader never sees half a file.
-        behavior: The behaviour of the interactions, one of :data:`affordance_learning.common.behaviors.BEHAVIORS`.
+        behavior: The behaviour of the interactions, one of :data:`affordance_env.registry.BEHAVIOR_NAMES`.
         n_clusters: Effect categories (map size), in [2, 10].
         relevancy: Relevancy threshold of the feature selection, in [0, 1].
         random_state: Seed of the first map (the others follow it:
@@ -242,7 +242,7 @@ def load_default_model(path: str | Path | None = None, *, behavior: str = "tap")
     Args:
         path: The stored model (default: the user's model of the behaviour, else the package's:
             :func:`model_path`).
-        behavior: The behaviour the model must be of, one of :data:`affordance_learning.common.behaviors.BEHAVIORS`.
+        behavior: The behaviour the model must be of, one of :data:`affordance_env.registry.BEHAVIOR_NAMES`.
 
     Raises:
         ValueError: An unknown behaviour.

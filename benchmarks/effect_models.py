@@ -34,8 +34,9 @@ from sklearn.neighbors import NearestNeighbors
 from sklearn.preprocessing import StandardScaler
 
 from affordance_env import load_dataset
+from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_learning.planning.effect_model import FLAG_WEIGHT, ActionEffectModel, behavior_model
-from affordance_learning.planning.experiment import BEHAVIORS, calibration
+from affordance_learning.planning.experiment import calibration
 from affordance_learning.planning.goals import Lift, Move, Place, Roll
 from affordance_learning.planning.outcomes import model_inputs, outcome_table
 
@@ -75,7 +76,7 @@ def main() -> None:
                 "knn": lambda b: KnnEffectModel()}
     scores = {name: {"p": [], "y": [], "place_p": [], "place_y": [], "fit": 0.0} for name in learners}
     rng = np.random.default_rng(0)
-    for behavior in BEHAVIORS:
+    for behavior in BEHAVIOR_NAMES:
         rows = frame[frame["behavior"] == behavior]
         split = int(0.75 * len(rows))
         train, test = rows.iloc[:split], rows.iloc[split:]
@@ -107,7 +108,7 @@ def main() -> None:
                   f"{calibration(p, y)['ece']:7.3f} {roc_auc_score(y, p):7.3f} {s['fit']:8.1f}")
         if name == "forest":
             n_all, n_place = len(np.concatenate(s["p"])), len(p)
-    print(f"({n_all} held-out (interaction, goal) pairs over {len(BEHAVIORS)} behaviours, {len(GOALS)} goals and "
+    print(f"({n_all} held-out (interaction, goal) pairs over {len(BEHAVIOR_NAMES)} behaviours, {len(GOALS)} goals and "
           f"{PLACES} places per interaction, {n_place} of them places)")
 
 

@@ -16,8 +16,9 @@ import time
 
 import numpy as np
 
-from affordance_env.goal_env import BEHAVIORS, TapAffordanceGoalEnv
+from affordance_env.goal_env import TapAffordanceGoalEnv
 from affordance_env.objects import OBJECT_TYPES
+from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_env.tap_env import TapAffordanceEnv
 
 
@@ -32,7 +33,7 @@ def main() -> None:
                for _ in range(args.episodes)]
     goal = TapAffordanceGoalEnv()
     print(f"{'behaviour':10s} {'v1 [ms]':>9s} {'goal [ms]':>10s} {'ratio':>6s}")
-    for name in BEHAVIORS:
+    for name in BEHAVIOR_NAMES:
         v1 = TapAffordanceEnv(behavior=name)
         best = {"v1": np.inf, "goal": np.inf}
         for _ in range(args.repeats):

@@ -15,9 +15,9 @@ import gymnasium as gym
 import numpy as np
 
 import affordance_env  # noqa: F401  (registers the environments)
+from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_env.workspace import in_workspace
 from affordance_learning import load_action_model
-from affordance_learning.common.behaviors import BEHAVIORS
 from affordance_learning.planning.experiment import fit_models, load_training, training_frames
 from affordance_learning.planning.goals import Move, describe
 from affordance_learning.planning.planner import Planner
@@ -30,7 +30,7 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=3)
     args = parser.parse_args()
     if args.dataset is None:
-        models = {behavior: load_action_model(behavior) for behavior in BEHAVIORS}
+        models = {behavior: load_action_model(behavior) for behavior in BEHAVIOR_NAMES}
     else:
         try:
             models = fit_models(training_frames(load_training(args.dataset), 1000), random_state=0)

@@ -14,10 +14,10 @@ from gymnasium.utils.passive_env_checker import data_shares_objects
 import affordance_env  # noqa: F401 (registers the envs)
 from affordance_env.features import FEATURE_NAMES
 from affordance_env.physics import TapPhysics
+from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_env.scene import build_model, table_extent
 from affordance_env.tap_env import TapAffordanceEnv
 from affordance_learning import predict_effect
-from affordance_learning.common.behaviors import BEHAVIORS
 from affordance_learning.planning.effect_model import ActionEffectModel
 from affordance_learning.planning.goals import Place, Roll
 from affordance_learning.planning.planner import Planner
@@ -45,7 +45,7 @@ def planner(model) -> Planner:
 def test_a_model_of_an_unknown_behaviour_is_refused_naming_the_known_ones(model):
     with pytest.raises(ValueError, match="'kick'") as error:
         Planner({"kick": model})
-    assert all(name in str(error.value) for name in BEHAVIORS)
+    assert all(name in str(error.value) for name in BEHAVIOR_NAMES)
     with pytest.raises(TypeError, match="fitted ActionEffectModel, got str"):
         Planner({"push": "model.joblib"})
 

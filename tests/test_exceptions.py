@@ -26,6 +26,16 @@ def test_every_error_derives_from_its_package_base_and_the_builtin_callers_expec
     assert DefaultModelMissingError is learning_errors.DefaultModelMissingError
 
 
+def test_one_invalid_value_error_under_one_base_for_both_packages():
+    assert learning_errors.InvalidValueError is env_errors.InvalidValueError
+    assert learning_errors.AffordanceLearningError is env_errors.AffordanceLearningError
+    for base in (env_errors.AffordanceEnvError, learning_errors.AffordanceLearningError):
+        assert issubclass(base, env_errors.AffordanceError)
+    assert issubclass(learning_errors.DefaultModelError, env_errors.AffordanceError)
+    assert not issubclass(learning_errors.DefaultModelError, env_errors.AffordanceEnvError)
+    assert not issubclass(env_errors.MissingDependencyError, learning_errors.AffordanceLearningError)
+
+
 def test_the_packages_raise_no_untyped_value_error():
     untyped = [f"{path.relative_to(ROOT)}:{node.lineno}"
                for package in ("affordance_env", "affordance_learning")

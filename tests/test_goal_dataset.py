@@ -8,7 +8,7 @@ import pytest
 from affordance_env import load_dataset
 from affordance_env.dataset import collect, read_manifest
 from affordance_env.dataset.format import GOAL_COLUMNS, chunk_metadata, collect_command
-from affordance_env.goal_env import BEHAVIORS
+from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_env.workspace import in_any_workspace
 
 SMALL = {"camera_width": 32, "camera_height": 24}
@@ -31,7 +31,7 @@ def test_goal_episodes_are_rows_of_interactions_with_episode_step_and_goal(goal_
     command = collect_command(goal_dir, manifest)  # what an error message tells a user to run
     assert "--env TapAffordanceGoal-v2" in command and "--position-range workspace" in command
     assert {"step", *GOAL_COLUMNS} <= set(frame.columns)
-    assert set(frame["behavior"]) <= set(BEHAVIORS) and frame["behavior"].nunique() >= 3
+    assert set(frame["behavior"]) <= set(BEHAVIOR_NAMES) and frame["behavior"].nunique() >= 3
     truncated = {k: v for chunk in sorted(goal_dir.glob("chunk-*.parquet"))
                  for k, v in chunk_metadata(chunk)[0]["chunk"]["truncated"].items()}
     assert all(reason.startswith(("infeasible:", "lost:")) for reason in truncated.values())

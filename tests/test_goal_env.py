@@ -7,9 +7,10 @@ from gymnasium.utils.env_checker import check_env
 
 import affordance_env  # noqa: F401 (registers the envs)
 from affordance_env.features import FEATURE_NAMES
-from affordance_env.goal_env import BEHAVIORS, FlatActionWrapper, TapAffordanceGoalEnv, goal_distance
+from affordance_env.goal_env import FlatActionWrapper, TapAffordanceGoalEnv, goal_distance
 from affordance_env.objects import as_resting, object_geometry
 from affordance_env.outcome import ObjectMonitor
+from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_env.tap_env import TapAffordanceEnv
 from affordance_env.workspace import in_any_workspace, in_workspace, sample_in_workspace
 
@@ -36,7 +37,7 @@ def test_the_object_stays_where_the_interaction_left_it_for_every_behaviour(env)
                                            "goal": (-0.45, -0.2)})
     np.testing.assert_allclose(obs["desired_goal"], (-0.45, -0.2))
     pose = info["object"]["pose"]
-    for k, behavior in enumerate(BEHAVIORS):
+    for k, behavior in enumerate(BEHAVIOR_NAMES):
         reachable = env.feasible(k, np.zeros(3))
         obs, reward, terminated, truncated, info = env.step({"behavior": k, "params": np.zeros(3, np.float32)})
         assert info["behavior"] == behavior and (info["failure"] is None) == reachable, info["failure"]
@@ -124,13 +125,13 @@ def test_feasible_from_a_snapshot_answers_for_it_and_leaves_the_env_as_it_was(en
     env.step({"behavior": "push", "params": np.zeros(3)})  # the box is now elsewhere
     now = env.get_state()
     params = np.array([0.0, 0.0, 0.0])
-    answers = {b: env.feasible(b, params, state=start) for b in BEHAVIORS}
+    answers = {b: env.feasible(b, params, state=start) for b in BEHAVIOR_NAMES}
     after = env.get_state()
     for field in ("qpos", "qvel", "ctrl", "act"):  # nothing moved
         np.testing.assert_array_equal(getattr(after.world.physics[1], field), getattr(now.world.physics[1], field))
     assert after.world.arm == now.world.arm and after.obs is now.obs
     env.set_state(start)
-    assert answers == {b: env.feasible(b, params) for b in BEHAVIORS}
+    assert answers == {b: env.feasible(b, params) for b in BEHAVIOR_NAMES}
 
 
 def test_the_object_pose_has_the_same_key_after_reset_and_after_step(env):
@@ -234,7 +235,7 @@ def test_feasible_answers_as_the_whole_ik_budget_would_in_fewer_iterations(env, 
         return ik(self, p, q, hand)
 
     rng = np.random.default_rng(4)
-    actions = [(b, rng.uniform(-1, 1, 3)) for b in BEHAVIORS for _ in range(8)]
+    actions = [(b, rng.uniform(-1, 1, 3)) for b in BEHAVIOR_NAMES for _ in range(8)]
     answers, spent = {}, {}
     for check in (True, False):
         if not check:
@@ -320,7 +321,7 @@ def test_any_resting_pose_can_be_placed_and_plans_read_it(object_type):
 
 def test_workspaces_sample_inside_themselves():
     rng = np.random.default_rng(0)
-    for name in BEHAVIORS:
+    for name in BEHAVIOR_NAMES:
         points = np.array([sample_in_workspace(name, rng) for _ in range(50)])
         assert np.all(in_workspace(name, points))
     assert not in_any_workspace(np.array([-0.7, 0.0]))  # far side of the table: out of every arm's reach

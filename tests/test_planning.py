@@ -105,6 +105,18 @@ def _constant_mover(dx: float, n: int = 300, seed: int = 0) -> ActionEffectModel
     return ActionEffectModel(n_estimators=30, random_state=seed).fit(X, Y)
 
 
+def test_the_planner_keeps_its_models_in_the_registrys_order_whatever_the_order_given():
+    tap, push = _constant_mover(0.05), _constant_mover(0.07, seed=1)
+    planner = Planner({"push": push, "tap": tap}, n_candidates=8)
+    assert list(planner.models) == [b for b in BEHAVIOR_NAMES if b in ("push", "tap")] == ["tap", "push"]
+    features, goal = np.array([0.0, 0.0]), Move((-1.0, 0.0), 0.01)
+    assert list(planner.scores(features, goal, (-0.5, 0.0))) == ["tap", "push"]
+    given = Planner({"tap": tap, "push": push}, n_candidates=8).choose(features, goal, (-0.5, 0.0))
+    reordered = planner.choose(features, goal, (-0.5, 0.0))
+    assert (reordered.behavior, reordered.probability) == (given.behavior, given.probability)
+    assert np.array_equal(reordered.params, given.params)
+
+
 def test_toward_searches_over_two_interactions_where_the_nearest_first_step_is_a_dead_end():
     # tap moves 5 cm, push 7 cm; the target is 10 cm away, the tolerance 1.5 cm. Pushing ends nearest (3 cm)
     # but no second interaction finishes from there; two taps do.

@@ -9,6 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from affordance_env.objects import OBJECT_TYPES
+from affordance_learning.common.verdicts import MET, MISSED, NOT_MEASURED, TOO_FEW
 from affordance_learning.paper.claims import (
     MIN_INTERACTIONS,
     MIN_TRIALS,
@@ -18,9 +20,9 @@ from affordance_learning.paper.claims import (
 )
 from affordance_learning.paper.metrics import wilson_interval
 from affordance_learning.paper.report import render_report
-from affordance_learning.planning.experiment import MULTI_POLICIES, POLICIES, SHAPES, share_text, summarize
-from affordance_learning.common.verdicts import MET, MISSED, NOT_MEASURED, TOO_FEW
+from affordance_learning.planning.experiment import MULTI_POLICIES, POLICIES, share_text, summarize
 from affordance_learning.planning.report import write_plan_report
+from affordance_learning.planning.results import PlanResults
 from affordance_learning.planning.targets import (
     MIN_CALIBRATION_ACTIONS,
     MIN_EPISODES,
@@ -30,7 +32,6 @@ from affordance_learning.planning.targets import (
     evaluate_targets,
     measured_targets,
 )
-from affordance_learning.planning.results import PlanResults
 
 STRADDLE = "1 x 3 map: a category straddles the critical size"
 SHAPE_TARGET = "each left-out shape, success on its feasible goals"
@@ -88,7 +89,7 @@ def _plan_results(shape_goals: dict[str, tuple[int, int, int]] | None = None, si
         300, 250, 240), episodes: tuple[int, int] = (80, 75)) -> dict:
     """Plan results: ``single`` = (goals, feasible, reached by the planner), ``shape_goals`` per left-out shape,
     ``episodes`` = (multi-step episodes, reached)."""
-    shape_goals = shape_goals or {s: (60, 50, 45) for s in SHAPES}
+    shape_goals = shape_goals or {s: (60, 50, 45) for s in OBJECT_TYPES}
     records = _records(*single)
     n, k = episodes
     multi = {p: {"success": k / n if n else None, "success_ci": wilson_interval(k, n), "n": n,
@@ -112,12 +113,12 @@ def _plan_results(shape_goals: dict[str, tuple[int, int, int]] | None = None, si
 
 
 def test_a_left_out_shape_judged_on_one_goal_is_too_few_not_met() -> None:
-    results = _plan_results({**{s: (60, 50, 45) for s in SHAPES}, "box": (3, 1, 1)})  # box: 1 of 1 feasible
+    results = _plan_results({**{s: (60, 50, 45) for s in OBJECT_TYPES}, "box": (3, 1, 1)})  # box: 1 of 1 feasible
     measured, verdict = measured_targets(results)[SHAPE_TARGET], evaluate_targets(results)[SHAPE_TARGET]
     assert verdict.word == TOO_FEW and verdict.met is None
     assert measured.n == 1 and "box" in measured.unit and verdict.n == 1
     # with enough feasible goals of every shape the same shares are met
-    enough = _plan_results({**{s: (60, 50, 45) for s in SHAPES}, "box": (40, MIN_FEASIBLE_PER_SHAPE, 30)})
+    enough = _plan_results({**{s: (60, 50, 45) for s in OBJECT_TYPES}, "box": (40, MIN_FEASIBLE_PER_SHAPE, 30)})
     assert evaluate_targets(enough)[SHAPE_TARGET].word == MET
 
 
@@ -209,16 +210,16 @@ def test_a_missed_calibration_names_the_most_overconfident_objects_and_the_ece_w
 
 
 def test_a_missed_left_out_shape_is_set_beside_the_same_goals_with_the_shape_in_training(tmp_path: Path) -> None:
-    results = _plan_results({"sphere": (60, 50, 20), **{s: (60, 50, 45) for s in SHAPES if s != "sphere"}})
+    results = _plan_results({"sphere": (60, 50, 20), **{s: (60, 50, 45) for s in OBJECT_TYPES if s != "sphere"}})
     results["goals"] = [_goal(type=s, planner=k < 45, planner_left_out=k < (20 if s == "sphere" else 45))
-                        for s in SHAPES for k in range(50)]
+                        for s in OBJECT_TYPES for k in range(50)]
     row = _missed_target_row(results, SHAPE_TARGET, tmp_path)
     assert ("sphere: 40.0 % [28, 54] (n=50 feasible) left out, 90.0 % [79, 96] (n=50 feasible) with spheres in "
             "the training data (best fixed") in row
 
 
 def test_the_plan_report_shows_n_beside_every_rate_and_no_zero_for_nothing(tmp_path: Path) -> None:
-    results = _plan_results({**{s: (60, 50, 45) for s in SHAPES}, "box": (4, 0, 0)})
+    results = _plan_results({**{s: (60, 50, 45) for s in OBJECT_TYPES}, "box": (4, 0, 0)})
     text = write_plan_report(results, tmp_path).read_text()
     box = next(line for line in text.splitlines() if line.startswith("| box |"))
     assert box == "| box | not measured (n=0) | not measured (n=0) | 0.0 % [0, 49] (n=4) |"  # 0 of 0, but 0 of 4

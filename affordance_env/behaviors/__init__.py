@@ -59,7 +59,9 @@ class _Behaviors(Mapping):
         return len(REGISTERED)
 
 
-#: Every behaviour by name (:func:`get_behavior`).
+#: Every behaviour's object by name (:func:`get_behavior`), in the registry's order. ``BEHAVIORS`` means this
+#: everywhere: a mapping from names to the behaviour objects (each module of this package has one of those it
+#: defines); the names alone, and their order, are :data:`affordance_env.registry.BEHAVIOR_NAMES`.
 BEHAVIORS: Mapping[str, Behavior] = _Behaviors()
 
 __all__ = ["ACTION_DIM", "BEHAVIORS", "ROLL_THRESHOLD", "SUCCESS_RULES", "check_action", "get_behavior", "is_success"]

@@ -253,7 +253,7 @@ def _rotation_z(a: float) -> np.ndarray:
     return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
 
 
-#: The draw, by name (:mod:`affordance_env.registry` lists it).
+#: The draw's object, by name (:mod:`affordance_env.registry` lists it).
 BEHAVIORS: Mapping[str, DrawBehavior] = {
     "draw": DrawBehavior(
         "draw", draw_orientation(),

@@ -540,7 +540,7 @@ class GraspBehavior:
                           "on_table": outcome.on_table}}
 
 
-#: The grasp, by name (:mod:`affordance_env.registry` lists it).
+#: The grasp's object, by name (:mod:`affordance_env.registry` lists it).
 BEHAVIORS: Mapping[str, GraspBehavior] = {
     "grasp": GraspBehavior(
         "grasp", grasp_orientation(0.0),

@@ -421,7 +421,7 @@ class StrokeBehavior:
         return {"stroke_speed": outcome.speed}
 
 
-#: The strokes, by name (:mod:`affordance_env.registry` lists them).
+#: The strokes' objects, by name (:mod:`affordance_env.registry` lists them).
 BEHAVIORS: Mapping[str, StrokeBehavior] = {
     "tap": StrokeBehavior(
         "tap", np.array([0.0, -1.0]), palm_rotation((-1, 0, 0), (0, -1, 0)), 0.012,

@@ -61,6 +61,7 @@ from affordance_env.exceptions import InvalidValueError, MissingDependencyError
 from affordance_env.options import EnvOptions
 from affordance_env.progress import progress_bar, show_progress  # noqa: F401  (show_progress: re-exported)
 from affordance_env.registry import BEHAVIOR_NAMES
+from affordance_env.values import is_integer
 from affordance_env.workers import worker_env
 
 ACTIONS = ("canonical", "random")
@@ -294,7 +295,7 @@ def collect(
     """
     for name, value, low in (("episodes", episodes, 1), ("workers", workers, 1),
                              ("chunk_size", chunk_size, 1), ("seed", seed, 0)):
-        if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < low:
+        if not is_integer(value) or value < low:
             raise InvalidValueError(f"{name} must be an integer >= {low}, got {value!r}.")
     if episodes > MAX_EPISODES:
         raise InvalidValueError(f"episodes must be at most {MAX_EPISODES:,} (a dataset's limit), got {episodes!r}.")

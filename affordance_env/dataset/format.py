@@ -47,6 +47,7 @@ from affordance_env.exceptions import DatasetError, InvalidValueError
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
 from affordance_env.fileio import write_atomically
 from affordance_env.registry import ENV_IDS, GOAL_ENV_ID
+from affordance_env.values import is_integer
 
 if TYPE_CHECKING:  # the results are made by the simulator, which reading a dataset does not need
     from affordance_env.results import InteractionResult
@@ -212,11 +213,6 @@ def chunk_name(index: int) -> str:
     return f"chunk-{index:05d}.parquet"
 
 
-def _count(value: Any) -> bool:
-    """Whether ``value`` is an integer (not a boolean)."""
-    return isinstance(value, int) and not isinstance(value, bool)
-
-
 def chunk_ranges(episodes: int, chunk_size: int) -> list[tuple[int, int]]:
     return [(s, min(s + chunk_size, episodes)) for s in range(0, episodes, chunk_size)]
 
@@ -330,7 +326,7 @@ def read_manifest(path: str | os.PathLike) -> dict[str, Any]:
         raise DatasetError(f"{path} is not a TapAffordance dataset (its {MANIFEST} has no format "
                            f"{FORMAT!r}).")
     version = manifest.get("schema_version")
-    if not isinstance(version, int) or isinstance(version, bool) or not 1 <= version <= SCHEMA_VERSION:
+    if not is_integer(version) or not 1 <= version <= SCHEMA_VERSION:
         raise DatasetError(f"{path} has dataset schema version {version!r}; this tap-affordance reads "
                            f"versions 1 to {SCHEMA_VERSION}: upgrade the package "
                            "(pip install -U tap-affordance).")
@@ -340,7 +336,7 @@ def read_manifest(path: str | os.PathLike) -> dict[str, Any]:
                            f"{settings!r}.")
     chunk_size = settings.get("chunk_size")
     episodes = manifest.get("episodes")
-    if not _count(episodes) or not 1 <= episodes <= MAX_EPISODES or not _count(chunk_size) or chunk_size < 1:
+    if not is_integer(episodes) or not 1 <= episodes <= MAX_EPISODES or not is_integer(chunk_size) or chunk_size < 1:
         raise DatasetError(f"{path / MANIFEST} is damaged: episodes {episodes!r} (an integer in 1..{MAX_EPISODES}), "
                            f"chunk_size {chunk_size!r} (an integer >= 1).")
     return manifest

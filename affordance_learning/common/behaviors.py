@@ -1,7 +1,8 @@
-"""The behaviours the learning side knows, and how each one's success and failure read in figures and reports.
+"""How each behaviour's success and failure read in figures and reports.
 
-The environment (``affordance_env.behaviors``) defines what a behaviour does and what its ``success`` label
-measures; this module only names them for people. The paper learns one model per behaviour ("a separate SOM
+The behaviours' names and their order are :data:`affordance_env.registry.BEHAVIOR_NAMES`; the environment
+(``affordance_env.behaviors``) defines what a behaviour does and what its ``success`` label measures; this module
+only words them for people. The paper learns one model per behaviour ("a separate SOM
 and SVM for each behavior"), so every result, report and default model belongs to one of these.
 """
 
@@ -9,20 +10,17 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
-from affordance_env.registry import BEHAVIOR_NAMES, check_behavior_name
+from affordance_env.registry import check_behavior_name
 from affordance_learning.common.exceptions import InvalidValueError
 
 #: Per behaviour, how its success and its failure read: ``(success, failure)``.
 OUTCOME_WORDS: dict[str, tuple[str, str]] = {
     "tap": ("rolled", "did not roll"),
-    "grasp": ("lifted and held", "not held"),
     "tap_back": ("rolled", "did not roll"),
     "push": ("moved", "did not move"),
+    "grasp": ("lifted and held", "not held"),
     "draw": ("moved", "did not move"),
 }
-#: The behaviours of the environment (:mod:`affordance_env.registry`), in the order reports list them: the
-#: paper's two, then the others.
-BEHAVIORS: tuple[str, ...] = ("tap", "grasp", *(name for name in BEHAVIOR_NAMES if name not in ("tap", "grasp")))
 #: How the ``rolled`` label reads: the label of a frame that has no ``success`` column.
 ROLLED_WORDS = ("rolled", "did not roll")
 #: The behaviours whose success is ``rolled``: only their frames may stand in ``rolled`` for a missing ``success``.
@@ -32,7 +30,8 @@ GENERIC_WORDS = ("success", "fail")
 
 
 def check_behavior(behavior: str) -> str:
-    """``behavior`` if it is one of :data:`BEHAVIORS`; raises InvalidValueError naming the valid ones otherwise."""
+    """``behavior`` if it is one of :data:`affordance_env.registry.BEHAVIOR_NAMES`; raises InvalidValueError naming
+    the valid ones otherwise."""
     return check_behavior_name(behavior)
 
 
@@ -40,7 +39,8 @@ def check_env_offers(behaviors: Iterable[str], hint: str = "") -> list[str]:
     """The behaviours, each checked to be offered by the installed environment (whose interactions can then be
     collected); raises ValueError otherwise, before any work, with ``hint`` appended to the message.
 
-    The environment's behaviours are read from ``affordance_env.behaviors.BEHAVIORS`` when called.
+    The environment's behaviours are read from ``affordance_env.behaviors.BEHAVIORS`` (the behaviour objects it
+    defines, by name) when called.
     """
     import affordance_env.behaviors as env_behaviors
 

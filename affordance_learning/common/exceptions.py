@@ -1,19 +1,14 @@
 """The errors ``affordance_learning`` raises on purpose, each naming the value it was given and what it expects.
 
-All derive from :class:`AffordanceLearningError`; those for a value that cannot be used also from ``ValueError``
-(as scikit-learn's estimators raise), so that code written against the built-in types still catches them. An
-exception of another type that escapes the package is a bug, and the ``affordance`` command keeps its traceback.
+All derive from :class:`AffordanceLearningError`, which with :class:`InvalidValueError` (a value that cannot be
+used, also a ``ValueError`` as scikit-learn's estimators raise) is defined once for both packages in
+:mod:`affordance_env.exceptions` and re-exported here; the default models' errors are the learning package's own.
+An exception of another type that escapes the package is a bug, and the ``affordance`` command keeps its traceback.
 """
 
 from __future__ import annotations
 
-
-class AffordanceLearningError(Exception):
-    """Base of the errors ``affordance_learning`` raises on purpose."""
-
-
-class InvalidValueError(AffordanceLearningError, ValueError):
-    """A value the learning, the planner, a report or a command cannot take: features, goals, results, names."""
+from affordance_env.exceptions import AffordanceError, AffordanceLearningError, InvalidValueError
 
 
 class DefaultModelError(AffordanceLearningError, RuntimeError):
@@ -24,4 +19,5 @@ class DefaultModelMissingError(DefaultModelError, FileNotFoundError):
     """A default model file does not exist; the message gives the command that builds it."""
 
 
-__all__ = ["AffordanceLearningError", "DefaultModelError", "DefaultModelMissingError", "InvalidValueError"]
+__all__ = ["AffordanceError", "AffordanceLearningError", "DefaultModelError", "DefaultModelMissingError",
+           "InvalidValueError"]

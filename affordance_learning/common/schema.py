@@ -11,10 +11,12 @@ from collections.abc import Sequence
 
 import pandas as pd
 
+from affordance_env.objects import OBJECT_TYPES, ROLLING_TYPES
 from affordance_learning.common.exceptions import InvalidValueError
 
-#: The object types of the paper, in the order figures and case studies list them.
-OBJECT_TYPES = ("sphere", "horizontal_cylinder", "box", "vertical_cylinder")
+#: The object types (:data:`affordance_env.objects.OBJECT_TYPES`) in the order figures and case studies list them:
+#: the rolling ones first, as the paper does.
+TYPE_ORDER: tuple[str, ...] = tuple(sorted(OBJECT_TYPES, key=lambda t: t not in ROLLING_TYPES))
 #: Feature groups and their sizes in the order of ``FEATURE_NAMES`` (paper, section III.B).
 GROUP_SIZES = (("shape", 24), ("size", 18), ("relation", 7))
 #: Columns a frame's success/fail label can come from, in order of preference.

@@ -7,7 +7,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from affordance_learning.common.schema import OBJECT_TYPES, feature_groups, feature_names, label_column
+from affordance_learning.common.schema import TYPE_ORDER, feature_groups, feature_names, label_column
 
 
 def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:
@@ -52,7 +52,7 @@ def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:
 
     types = frame["type"].astype(str).to_numpy()
     by_type = {}
-    for t in [t for t in OBJECT_TYPES if t in set(types)] + sorted(set(types) - set(OBJECT_TYPES)):
+    for t in [t for t in TYPE_ORDER if t in set(types)] + sorted(set(types) - set(TYPE_ORDER)):
         rows = types == t
         seen = rows & visible if visible is not None else rows
         by_type[t] = {

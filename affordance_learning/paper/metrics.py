@@ -16,6 +16,7 @@ from sklearn.pipeline import Pipeline, make_pipeline
 from sklearn.preprocessing import StandardScaler
 from sklearn.svm import SVC
 
+from affordance_env.values import is_integer
 from affordance_learning.common.exceptions import InvalidValueError
 
 
@@ -175,7 +176,7 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
     success = _as_success(success)
     if not np.all(np.isfinite(sizes)):
         raise InvalidValueError("sizes must be finite [m].")
-    if isinstance(n_bins, bool) or not isinstance(n_bins, int | np.integer) or n_bins < 1:
+    if not is_integer(n_bins) or n_bins < 1:
         raise InvalidValueError(f"n_bins must be an integer >= 1, got {n_bins!r}.")
     low, high = float(sizes.min()), float(sizes.max())
     edges = np.linspace(low, high, n_bins + 1) if high > low else np.array([low, high])

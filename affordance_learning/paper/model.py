@@ -35,6 +35,7 @@ from sklearn.preprocessing import StandardScaler
 from sklearn.utils import Tags
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from affordance_env.values import is_integer
 from affordance_learning.common.exceptions import InvalidValueError
 from affordance_learning.paper.metrics import make_svm
 from affordance_learning.paper.relieff import MULTICLASS_THRESHOLD, relieff_weights
@@ -98,8 +99,7 @@ def _check_relevancy(relevancy: object) -> float:
 
 def _check_int(name: str, value: object, low: int, high: int | None = None) -> int:
     if (
-        isinstance(value, bool)
-        or not isinstance(value, numbers.Integral)
+        not is_integer(value)
         or value < low
         or (high is not None and value > high)
     ):

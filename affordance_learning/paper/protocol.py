@@ -49,9 +49,10 @@ from joblib import Parallel, delayed
 from sklearn.model_selection import train_test_split
 from sklearn.preprocessing import StandardScaler
 
+from affordance_env.values import is_integer
 from affordance_learning.common.behaviors import ROLLED_IS_SUCCESS, outcome_words
 from affordance_learning.common.exceptions import InvalidValueError
-from affordance_learning.common.schema import OBJECT_TYPES, feature_groups, feature_names, frame_behavior, label_column
+from affordance_learning.common.schema import TYPE_ORDER, feature_groups, feature_names, frame_behavior, label_column
 from affordance_learning.common.validation import first_non_finite
 from affordance_learning.paper.diagnostics import effect_summary
 from affordance_learning.paper.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
@@ -244,7 +245,7 @@ def _check_protocol_args(
 ) -> tuple[list[int], list[float]]:
     ks = list(ks)
     if not ks or any(
-        isinstance(k, bool) or not isinstance(k, numbers.Integral) or not 2 <= k <= MULTICLASS_THRESHOLD
+        not is_integer(k) or not 2 <= k <= MULTICLASS_THRESHOLD
         for k in ks
     ):
         raise InvalidValueError(f"ks must be integers in [2, {MULTICLASS_THRESHOLD}] (map sizes), got {ks!r}.")
@@ -257,9 +258,9 @@ def _check_protocol_args(
         raise InvalidValueError(f"relevancies must be numbers in [0, 1], got {relevancies!r}.")
     if len({r_key(r) for r in relevancies}) != len(relevancies):
         raise InvalidValueError(f"relevancies must not repeat a value, got {relevancies!r}.")
-    if isinstance(n_trials, bool) or not isinstance(n_trials, numbers.Integral) or n_trials < 1:
+    if not is_integer(n_trials) or n_trials < 1:
         raise InvalidValueError(f"n_trials must be an integer >= 1, got {n_trials!r}.")
-    if isinstance(random_state, bool) or not isinstance(random_state, numbers.Integral) or random_state < 0:
+    if not is_integer(random_state) or random_state < 0:
         raise InvalidValueError(
             f"random_state must be an integer >= 0 (the protocol is always seeded), got {random_state!r}."
         )
@@ -354,8 +355,8 @@ def run_protocol(
         if stratify
         else f"random, not stratified (type counts {type_counts.to_dict()} too small to stratify)"
     )
-    type_order = [t for t in OBJECT_TYPES if t in type_counts.index] + sorted(
-        t for t in type_counts.index if t not in OBJECT_TYPES
+    type_order = [t for t in TYPE_ORDER if t in type_counts.index] + sorted(
+        t for t in type_counts.index if t not in TYPE_ORDER
     )
     jobs = (
         delayed(_run_trial)(

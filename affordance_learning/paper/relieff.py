@@ -52,6 +52,7 @@ from scipy.spatial.distance import pdist, squareform
 from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from affordance_env.values import is_integer
 from affordance_learning.common.exceptions import InvalidValueError
 from affordance_learning.common.validation import first_non_finite
 
@@ -68,7 +69,7 @@ DataType = Literal["continuous", "discrete", "mixed", "constant"]
 
 
 def _check_n_neighbors(n_neighbors: object) -> int:
-    if isinstance(n_neighbors, bool) or not isinstance(n_neighbors, int | np.integer) or n_neighbors < 1:
+    if not is_integer(n_neighbors) or n_neighbors < 1:
         raise InvalidValueError(
             f"n_neighbors must be an integer >= 1 (neighbours per class), got {n_neighbors!r}; skrebate's "
             "float form (a fraction of the instances) is not replicated."
@@ -108,7 +109,7 @@ class ReliefFScorer:
     """
 
     def __init__(self, X: ArrayLike, *, discrete_threshold: int = DISCRETE_THRESHOLD) -> None:
-        if isinstance(discrete_threshold, bool) or not isinstance(discrete_threshold, int | np.integer):
+        if not is_integer(discrete_threshold):
             raise InvalidValueError(f"discrete_threshold must be an integer, got {discrete_threshold!r}.")
         X = _check_features(X)
         self.X = X

@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_learning.common.exceptions import InvalidValueError
 
 if TYPE_CHECKING:
@@ -92,7 +93,7 @@ def reproduce(
         The results dict of each behaviour run, by behaviour.
     """
     import affordance_env.behaviors as env_behaviors
-    from affordance_learning.common.behaviors import BEHAVIORS, check_env_offers
+    from affordance_learning.common.behaviors import check_env_offers
     from affordance_learning.paper.report import write_overview
 
     behaviors = list(behaviors)
@@ -117,7 +118,7 @@ def reproduce(
             progress=progress, range_noise=range_noise,
         )
     found: dict[str, Results | dict[str, Any]] = {**_earlier_runs(out, behaviors), **runs}
-    order = [b for b in BEHAVIORS if b in found] + sorted(set(found) - set(BEHAVIORS))
+    order = [b for b in BEHAVIOR_NAMES if b in found] + sorted(set(found) - set(BEHAVIOR_NAMES))
     overview = write_overview({b: found[b] for b in order}, out)
     print(f"total {time.perf_counter() - start:.1f} s")
     print()

@@ -14,6 +14,7 @@ from numpy.typing import ArrayLike
 from sklearn.base import BaseEstimator, ClusterMixin
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from affordance_env.values import is_integer
 from affordance_learning.common.exceptions import InvalidValueError
 
 #: Largest seed minisom's ``numpy.random.RandomState`` accepts.
@@ -28,7 +29,7 @@ def som_seed(random_state: int | np.random.RandomState | np.random.Generator | N
     """
     if random_state is None:
         return None
-    if isinstance(random_state, numbers.Integral) and not isinstance(random_state, bool):
+    if is_integer(random_state):
         if not 0 <= int(random_state) <= _MAX_SEED:
             raise InvalidValueError(f"random_state must be an integer in [0, 2**32 - 1], got {random_state!r}.")
         return int(random_state)
@@ -100,7 +101,7 @@ class SOMClustering(ClusterMixin, BaseEstimator):
     def _check_params(self) -> None:
         for name, low in (("n_clusters", 1), ("n_iterations", 1), ("n_init", 1)):
             value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
+            if not is_integer(value) or value < low:
                 raise InvalidValueError(f"{name} must be an integer >= {low}, got {value!r}.")
         for name in ("sigma", "learning_rate"):
             value = getattr(self, name)

@@ -4,14 +4,15 @@ critical size are held and larger ones are not."""
 
 from __future__ import annotations
 
-import numbers
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
+from affordance_env.objects import OBJECT_TYPES, ROLLING_TYPES
+from affordance_env.values import is_integer
 from affordance_learning.common.exceptions import InvalidValueError
-from affordance_learning.common.schema import OBJECT_TYPES
+from affordance_learning.common.schema import TYPE_ORDER
 
 #: Behaviours :func:`make_synthetic_frame` can imitate, with their object size ranges [m].
 SYNTHETIC_SIZE_RANGES = {"tap": (0.04, 0.10), "grasp": (0.03, 0.09)}
@@ -43,7 +44,7 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
         random_state: Seed.
         behavior: ``"tap"`` or ``"grasp"`` (the ``behavior`` column).
     """
-    if isinstance(n_rows, bool) or not isinstance(n_rows, numbers.Integral) or n_rows < 8:
+    if not is_integer(n_rows) or n_rows < 8:
         raise InvalidValueError(f"n_rows must be an integer >= 8, got {n_rows!r}.")
     if behavior not in SYNTHETIC_SIZE_RANGES:
         raise InvalidValueError(f"behavior must be one of {tuple(SYNTHETIC_SIZE_RANGES)}, got {behavior!r}.")
@@ -55,7 +56,7 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
     except ImportError:
         names = [f"f{i:02d}" for i in range(49)]
     rng = np.random.default_rng(random_state)
-    types = np.array(OBJECT_TYPES)[np.arange(n_rows) % 4]
+    types = np.array(TYPE_ORDER)[np.arange(n_rows) % 4]  # dealt out in that order, then shuffled
     rng.shuffle(types)
     kind = np.searchsorted(np.array(sorted(OBJECT_TYPES)), types)  # 0 box, 1 horizontal, 2 sphere, 3 vertical
     size = rng.uniform(*SYNTHETIC_SIZE_RANGES[behavior], n_rows)
@@ -63,7 +64,7 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
         held = rng.random(n_rows) < 1.0 / (1.0 + np.exp((size - SYNTHETIC_CRITICAL_SIZE) / SYNTHETIC_GRASP_SPREAD))
         rolled = np.zeros(n_rows, dtype=bool)
     else:
-        rollable = np.isin(types, ("sphere", "horizontal_cylinder"))
+        rollable = np.isin(types, ROLLING_TYPES)
         rolled = np.where(rollable, rng.random(n_rows) < 0.95, rng.random(n_rows) < 0.03)
 
     # Shape: a latitude and a longitude histogram per type, 12 bins each, perturbed and renormalised.

@@ -31,6 +31,7 @@ from sklearn.base import BaseEstimator, RegressorMixin
 from sklearn.ensemble import ExtraTreesRegressor, RandomForestRegressor
 from sklearn.utils.validation import check_is_fitted, validate_data
 
+from affordance_env.values import is_integer
 from affordance_learning.common.exceptions import InvalidValueError
 from affordance_learning.planning.goals import Goal
 
@@ -207,7 +208,7 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         if not (isinstance(self.flag_weight, int | float) and self.flag_weight > 0):
             raise InvalidValueError(f"flag_weight must be a positive number, got {self.flag_weight!r}.")
         k = self.action_inputs
-        if isinstance(k, bool) or not isinstance(k, int | np.integer) or not 0 <= k <= X.shape[1]:
+        if not is_integer(k) or not 0 <= k <= X.shape[1]:
             raise InvalidValueError(f"action_inputs must be an integer in [0, {X.shape[1]}] (how many of the last "
                                     f"inputs are the action's parameters), got {k!r}.")
         y = np.asarray(y, dtype=np.float64)

@@ -63,6 +63,7 @@ import numpy as np
 import pandas as pd
 
 from affordance_env.goal_env import GOAL_TABLE_MARGIN, draw_target
+from affordance_env.objects import OBJECT_TYPES
 from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
 from affordance_env.scene import table_extent
 from affordance_learning.planning.effect_model import ActionEffectModel, behavior_model
@@ -70,9 +71,7 @@ from affordance_learning.planning.goals import Goal, Lift, Move, Place, Roll
 from affordance_learning.planning.outcomes import model_inputs, outcome_table
 from affordance_learning.planning.planner import FAILURE_RADIUS, Planner
 
-BEHAVIORS = BEHAVIOR_NAMES
 GOAL_KINDS = ("roll", "lift", "move", "place")
-SHAPES = ("sphere", "box", "horizontal_cylinder", "vertical_cylinder")
 POLICIES = ("planner", "random", "best_fixed", "canonical_choice", "som_categories", "oracle")
 MULTI_POLICIES = ("planner", "direction", "random")
 #: Goals: Move's distance [m], Place's distance from the object [m] and tolerance [m].
@@ -198,7 +197,7 @@ def training_frames(frame: pd.DataFrame, max_per_behavior: int, exclude_type: st
     if exclude_type is not None:
         frame = frame[frame["type"] != exclude_type]
     frame = frame.sort_values(["episode", "step"])
-    return {b: frame[frame["behavior"] == b].head(max_per_behavior) for b in BEHAVIORS}
+    return {b: frame[frame["behavior"] == b].head(max_per_behavior) for b in BEHAVIOR_NAMES}
 
 
 def fit_models(frames: Mapping[str, pd.DataFrame], random_state: int, n_jobs: int | None = None
@@ -322,10 +321,10 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
     feasible = feasible_at(env, state)
     outcomes = Outcomes(env, state)
     oracle_set = oracle_params()
-    tried = [(b, k, outcomes.run(b, params)) for b in BEHAVIORS for k, params in enumerate(oracle_set)]
+    tried = [(b, k, outcomes.run(b, params)) for b in BEHAVIOR_NAMES for k, params in enumerate(oracle_set)]
     # Every oracle action's P(goal) is read from its predictive outcomes, computed once for the object.
     X = np.hstack([np.repeat(features[None], len(oracle_set), axis=0), oracle_set])
-    predicted = {b: planner.on_table(planner.models[b].predictive_outcomes(X), start) for b in BEHAVIORS}
+    predicted = {b: planner.on_table(planner.models[b].predictive_outcomes(X), start) for b in BEHAVIOR_NAMES}
     canonical_pick = Planner(planner.models, n_candidates=1, threshold=planner.threshold)
     left_out = shape_planners.get(item["shape"])
     for p in (planner, left_out):
@@ -346,9 +345,9 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
         if left_out is not None:
             record["planner_left_out"] = _decide(left_out, features, goal, start, feasible, outcomes)[1]
         hits = {(b, k): reached(goal, info) for b, k, info in tried}
-        pick = int(rng.integers(len(BEHAVIORS))), int(rng.integers(len(oracle_set)))
-        record["random"] = hits[(BEHAVIORS[pick[0]], pick[1])]
-        record["canonical"] = {b: hits[(b, 0)] for b in BEHAVIORS}
+        pick = int(rng.integers(len(BEHAVIOR_NAMES))), int(rng.integers(len(oracle_set)))
+        record["random"] = hits[(BEHAVIOR_NAMES[pick[0]], pick[1])]
+        record["canonical"] = {b: hits[(b, 0)] for b in BEHAVIOR_NAMES}
         best = canonical_pick.choose(features, goal, start, feasible=feasible)
         record["canonical_choice"] = bool(best.behavior and record["canonical"][best.behavior])
         if som is not None:
@@ -356,8 +355,8 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
         record["oracle"] = any(hits.values())
         record["oracle_hits"] = sum(hits.values())
         record["size"] = size
-        p = np.concatenate([predicted[b].probability(goal, start) for b in BEHAVIORS])
-        record["pooled"] = (p, np.array([hits[(b, k)] for b in BEHAVIORS for k in range(len(oracle_set))]))
+        p = np.concatenate([predicted[b].probability(goal, start) for b in BEHAVIOR_NAMES])
+        record["pooled"] = (p, np.array([hits[(b, k)] for b in BEHAVIOR_NAMES for k in range(len(oracle_set))]))
         records.append(record)
     return records
 
@@ -376,9 +375,9 @@ def _direction_heuristic(start: np.ndarray, target: np.ndarray) -> str:
     """The behaviour that moves an object the way the target lies: push away (-x), draw toward the robot (+x)
     where the env has it, tap to -y, tap back to +y."""
     d = target - start
-    if -d[0] > abs(d[1]) and "push" in BEHAVIORS:
+    if -d[0] > abs(d[1]) and "push" in BEHAVIOR_NAMES:
         return "push"
-    if d[0] > abs(d[1]) and "draw" in BEHAVIORS:
+    if d[0] > abs(d[1]) and "draw" in BEHAVIOR_NAMES:
         return "draw"
     return "tap" if d[1] < 0 else "tap_back"
 
@@ -466,7 +465,7 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
         elif policy == "direction":
             behavior, params = _direction_heuristic(start, target), np.zeros(3)
         else:
-            behavior, params = BEHAVIORS[int(rng.integers(len(BEHAVIORS)))], rng.uniform(-1, 1, 3)
+            behavior, params = BEHAVIOR_NAMES[int(rng.integers(len(BEHAVIOR_NAMES)))], rng.uniform(-1, 1, 3)
         obs, _, terminated, _, info = env.step({"behavior": behavior, "params": np.asarray(params, np.float32)})
         steps += 1
         if reach_failure(info):
@@ -504,7 +503,7 @@ def step_reach(frame: pd.DataFrame, quantile: float = 0.9) -> dict[str, dict[str
     kept = (frame["outcome"].astype(str) != "off_table").to_numpy()
     types = frame["type"].astype(str).to_numpy()
     out = {}
-    for shape in SHAPES:
+    for shape in OBJECT_TYPES:
         rows = kept & (types == shape)
         if rows.any():
             parts = dict(zip(DIRECTIONS, (dx[rows], -dx[rows], dy[rows], -dy[rows]), strict=True))
@@ -597,7 +596,7 @@ def best_fixed(records: list[dict[str, Any]]) -> dict[str, str]:
     for kind in GOAL_KINDS:
         rows = [r for r in records if r["kind"] == kind]
         if rows:
-            choice[kind] = max(BEHAVIORS, key=lambda b: sum(r["canonical"][b] for r in rows))
+            choice[kind] = max(BEHAVIOR_NAMES, key=lambda b: sum(r["canonical"][b] for r in rows))
     for r in records:
         r["best_fixed"] = r["canonical"][choice[r["kind"]]]
     return choice
@@ -617,7 +616,7 @@ def _items(seed: int, part: int, n: int) -> list[dict]:
     for i in range(n):
         ss = np.random.SeedSequence([seed, EVAL_STREAM, part, i])
         env_seed, rng_seed = (int(v) for v in ss.generate_state(2))
-        items.append({"seed": env_seed, "rng": rng_seed, "index": i, "shape": SHAPES[i % len(SHAPES)]})
+        items.append({"seed": env_seed, "rng": rng_seed, "index": i, "shape": OBJECT_TYPES[i % len(OBJECT_TYPES)]})
     return items
 
 
@@ -678,13 +677,13 @@ def collect_training(out: Path, settings: PlanSettings, seed: int, workers: int,
     camera_options = {"camera_width": camera[0], "camera_height": camera[1]}
     # The behaviours TapAffordance-v2 runs as the goal env does (all but the grasp, which the goal env runs as pick
     # and place): their interactions in its scene with both arms are the goal env's, and cost no goal episode.
-    same = [b for b in BEHAVIORS if get_behavior(b) is get_behavior(b, goal=True)]
+    same = [b for b in BEHAVIOR_NAMES if get_behavior(b) is get_behavior(b, goal=True)]
     while True:
         collect(out, episodes, seed=seed, workers=workers, action="random", env_id=GOAL_ENV_ID,
                 env_options={"position_range": "workspace", **camera_options}, max_failure_share=1.0,
                 chunk_size=chunk)
         frame = load_dataset(out)
-        counts = {b: int((frame["behavior"] == b).sum()) for b in BEHAVIORS}
+        counts = {b: int((frame["behavior"] == b).sum()) for b in BEHAVIOR_NAMES}
         short = min(n for b, n in counts.items() if b not in same)
         if short >= settings.max_per_behavior or episodes >= settings.max_episodes:
             break
@@ -718,7 +717,7 @@ def load_training(out: str | os.PathLike) -> pd.DataFrame:
 
     out = Path(out)
     frames = [load_dataset(out)]
-    for behavior in BEHAVIORS:
+    for behavior in BEHAVIOR_NAMES:
         path = top_up_path(out, behavior)
         if (path / MANIFEST).exists():
             extra = load_dataset(path)
@@ -753,7 +752,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         shape: Planner(fit_models(training_frames(frame, settings.max_per_behavior, exclude_type=shape), seed,
                                   n_jobs=workers),
                        n_candidates=settings.candidates, threshold=settings.threshold, random_state=seed)
-        for shape in SHAPES}
+        for shape in OBJECT_TYPES}
     timings["fit"] = time.perf_counter() - t
     say(f"[2/5] fitted the effect models, each shape's without it, and the paper's categories "
         f"({timings['fit']:.1f} s)")
@@ -779,12 +778,12 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         + f"; {single['oracle']['n_feasible']} goals feasible")
 
     loso: dict[str, Any] = {}
-    for shape in SHAPES:
+    for shape in OBJECT_TYPES:
         shape_records = [{**r, "planner": r.get("planner_left_out", False)} for r in records if r["type"] == shape]
         loso[shape] = summarize(shape_records, ("planner", "best_fixed", "random", "oracle"))
     say("[4/5] leaving each shape out (judged in step 3): "
         + ", ".join(f"{s} " + share_text(loso[s]["planner"]["success_feasible"], loso[s]["planner"]["n_feasible"],
-                                         loso[s]["planner"]["success_feasible_ci"], "feasible") for s in SHAPES))
+                                         loso[s]["planner"]["success_feasible_ci"], "feasible") for s in OBJECT_TYPES))
 
     multi: dict[str, Any] = {}
     for i, policy in enumerate(MULTI_POLICIES):
@@ -811,7 +810,7 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
 
     multi["planner"]["by_type"] = {
         shape: {"n": len(eps), "success": sum(e["success"] for e in eps) / len(eps)}
-        for shape in SHAPES if (eps := [e for e in planner_episodes if e["type"] == shape])}
+        for shape in OBJECT_TYPES if (eps := [e for e in planner_episodes if e["type"] == shape])}
     reach, tolerance = step_reach(frame), planner_episodes[0]["tolerance"]  # the goal env's
     multi["step_reach_p90_m"], multi["tolerance_m"], multi["max_interactions"] = (reach, tolerance,
                                                                                   GOAL_MAX_EPISODE_STEPS)
@@ -839,7 +838,8 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
         "workers": workers, "cpu_count": os.cpu_count(),
         "oracle": {"actions_per_behavior": len(oracle_params()), "levels": list(ORACLE_LEVELS),
                    "objects": n_objects, "goals_per_object": dict(GOALS_PER_OBJECT),
-                   "objects_per_shape": {s: len({r["object"] for r in records if r["type"] == s}) for s in SHAPES}},
+                   "objects_per_shape": {s: len({r["object"] for r in records if r["type"] == s})
+                                         for s in OBJECT_TYPES}},
         "single_step": single,
         "single_step_by_goal": {kind: summarize([r for r in records if r["kind"] == kind], POLICIES)
                                 for kind in GOAL_KINDS},

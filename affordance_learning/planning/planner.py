@@ -24,9 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import qmc
 
+from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_env.scene import table_extent
-from affordance_env.values import float_array
-from affordance_learning.common.behaviors import BEHAVIORS
+from affordance_env.values import float_array, is_integer
 from affordance_learning.common.exceptions import InvalidValueError
 from affordance_learning.common.validation import check_float32_range
 from affordance_learning.planning.effect_model import ActionEffectModel, PredictiveOutcomes
@@ -110,7 +110,7 @@ def _check_start(start_xy) -> np.ndarray:
 def candidate_params(n: int, random_state: int = 0) -> np.ndarray:
     """(n, 3) action parameters in [-1, 1]: the canonical action (zeros) and n - 1 points of a scrambled Sobol
     sequence seeded by ``random_state``."""
-    if isinstance(n, bool) or not isinstance(n, int | np.integer) or n < 1:
+    if not is_integer(n) or n < 1:
         raise InvalidValueError(f"n must be an integer >= 1, got {n!r}.")
     power = int(np.ceil(np.log2(max(2, n - 1))))  # Sobol's balance holds for powers of 2: the first n - 1 of them
     sobol = qmc.Sobol(3, scramble=True, seed=random_state).random_base2(power)[: n - 1]
@@ -147,8 +147,8 @@ class Planner:
 
     Args:
         models: A fitted :class:`~.effect_model.ActionEffectModel` per behaviour name (one of
-            :data:`affordance_learning.common.behaviors.BEHAVIORS`), each of the same inputs: the object's features (the
-            49 of ``affordance_env.FEATURE_NAMES``) and the 3 action parameters.
+            :data:`affordance_env.registry.BEHAVIOR_NAMES`, in any order), each of the same inputs: the object's
+            features (the 49 of ``affordance_env.FEATURE_NAMES``) and the 3 action parameters.
         n_candidates: Parameter vectors scored per behaviour.
         threshold: Abstain below this P(goal).
         random_state: Seed of the candidates.
@@ -172,22 +172,25 @@ class Planner:
             raise InvalidValueError("models must map at least one behaviour name to its fitted ActionEffectModel.")
         if not (isinstance(threshold, int | float) and 0.0 <= threshold <= 1.0):
             raise InvalidValueError(f"threshold must be a probability in [0, 1], got {threshold!r}.")
-        if isinstance(max_checks, bool) or not isinstance(max_checks, int | np.integer) or max_checks < 1:
+        if not is_integer(max_checks) or max_checks < 1:
             raise InvalidValueError(f"max_checks must be an integer >= 1, got {max_checks!r}.")
-        unknown = [name for name in models if name not in BEHAVIORS]
+        unknown = [name for name in models if name not in BEHAVIOR_NAMES]
         if unknown:
             raise InvalidValueError(f"Unknown behavior(s) {', '.join(map(repr, unknown))} in models. Valid behaviors: "
-                             f"{', '.join(BEHAVIORS)}.")
+                             f"{', '.join(BEHAVIOR_NAMES)}.")
         for name, model in models.items():
             if not isinstance(model, ActionEffectModel) or not hasattr(model, "forest_"):
                 raise TypeError(f"models[{name!r}] must be a fitted ActionEffectModel, got {type(model).__name__}.")
         inputs = {name: model.n_features_in_ for name, model in models.items()}
         if len(set(inputs.values())) > 1:
             raise InvalidValueError(f"the models must take the same inputs, got {inputs} input columns per behaviour.")
-        self.models = dict(models)
+        #: The models by behaviour, in the registry's order (:data:`affordance_env.registry.BEHAVIOR_NAMES`)
+        #: whatever the order of ``models``: the order of :meth:`scores`, and candidates that rank equal go to the
+        #: earlier behaviour.
+        self.models = {name: models[name] for name in BEHAVIOR_NAMES if name in models}
         self.threshold = float(threshold)
         self.max_checks = int(max_checks)
-        if isinstance(random_state, bool) or not isinstance(random_state, int | np.integer) or random_state < 0:
+        if not is_integer(random_state) or random_state < 0:
             raise InvalidValueError(f"random_state must be an integer >= 0, got {random_state!r}.")
         self.params = candidate_params(n_candidates, random_state)
         if table is not None:
@@ -412,8 +415,7 @@ class Planner:
                 behaviour reaches, and outcomes that leave the object where no behaviour reaches count as
                 ``OFF_TABLE_DISTANCE`` away when actions are ranked by distance. None: everywhere.
         """
-        if steps_left is not None and (isinstance(steps_left, bool) or not isinstance(steps_left, int | np.integer)
-                                       or steps_left < 1):
+        if steps_left is not None and (not is_integer(steps_left) or steps_left < 1):
             raise InvalidValueError(f"steps_left must be None or an integer >= 1, got {steps_left!r}.")
         goal = Place(target_xy, tolerance)
         target = np.asarray(goal.target_xy)
