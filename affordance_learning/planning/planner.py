@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import qmc
 
-from affordance_env.scene import table_extent
+from affordance_env.table import table_extent
 from affordance_env.values import float_array
 from affordance_learning.common.behaviors import BEHAVIORS
 from affordance_learning.common.exceptions import InvalidValueError
