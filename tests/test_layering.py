@@ -100,3 +100,12 @@ def test_learning_rooms_are_layered_common_below_paper_below_planning():
         assert imports, f"no modules found in affordance_learning/{room}"
         offenders = {path: [m for m in names if not m.startswith(ok)] for path, names in imports.items()}
         assert not {k: v for k, v in offenders.items() if v}, offenders
+
+
+def test_importing_the_planner_loads_neither_mujoco_nor_pinocchio():
+    # A planner runs where its effect models are, not the simulator: its goals and the table top's extent are
+    # plain numbers, read without compiling a scene.
+    code = ("import sys; import affordance_learning.planning.planner; "
+            "print(sorted(m for m in ('mujoco', 'pinocchio') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]"

@@ -63,6 +63,23 @@ def test_goals_judge_outcomes():
     np.testing.assert_array_equal(Percept((1.0,), 0.5).reached(outcomes), [False, True, False])
 
 
+def test_goals_measure_their_own_progress_and_name_what_a_planner_needs():
+    # The planner and the evaluation ask each goal, never which class it is.
+    outcomes = {"dx": np.array([0.06, 0.06, -0.10]), "dy": np.array([0.0, 0.08, 0.0]),
+                "off_table": np.array([False, True, False]), "rolled": np.zeros(3), "lifted": np.zeros(3)}
+    np.testing.assert_allclose(Move((1, 0), 0.05).progress(outcomes), [0.06, -1.0, -0.10])  # off: a metre away
+    np.testing.assert_allclose(Place((-0.2, 0.0), 0.03).progress(outcomes, (-0.26, 0.0)), [0.0, -1.0, -0.16],
+                               atol=1e-12)
+    with pytest.raises(ValueError, match="start_xy"):
+        Place((-0.2, 0.0)).progress(outcomes)
+    goals = [Roll(), Lift(), Move((1, 0)), Place((-0.2, 0.0)), Percept((1.0,))]
+    for goal in goals:
+        assert (goal.progress(outcomes, (-0.26, 0.0)) is not None) == goal.has_distance, goal
+    assert [g.kind for g in goals if g.needs_start] == [g.kind for g in goals if g.ranks_by_progress] == ["place"]
+    assert [g.positions() for g in goals] == [{}, {}, {}, {"target_xy": (-0.2, 0.0)}, {}]
+    assert [g.placement_error((-0.2, 0.04)) for g in goals] == [None, None, None, pytest.approx(0.04), None]
+
+
 def test_the_model_predicts_a_distribution_that_follows_the_action(model):
     X, Y = synthetic(400, seed=1)
     weights = model.predictive_weights(X)

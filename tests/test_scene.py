@@ -7,7 +7,8 @@ import pytest
 from affordance_env.objects import OBJECT_TYPES, object_geometry
 from affordance_env.physics import TapPhysics
 from affordance_env.robot_model import ACTIVE_JOINTS, CONTACT_LINKS, HELD_ARM_TORSO_RANGES, get_variant
-from affordance_env.scene import BACK_EMF, build_model
+from affordance_env.scene import BACK_EMF, build_model, table_extent
+from affordance_env.table import table_extent as table_extent_read
 
 
 def test_every_element_is_named(model):
@@ -57,6 +58,26 @@ def test_robot_never_collides_with_itself(model):
         assert touch(g, table) and touch(g, sphere)  # the hand rests on the table and taps the object
         assert not touch(g, floor)
     assert touch(sphere, table) and touch(sphere, floor)  # objects rest on the table, and fall to the floor
+
+
+def test_the_table_read_from_the_xml_is_the_compiled_scenes():
+    # affordance_env.table reads the table top from assets/scene.xml without MuJoCo: the same numbers, exactly.
+    assert table_extent_read() == table_extent()
+
+
+def test_a_rotated_table_is_refused_not_misread(tmp_path, monkeypatch):
+    import affordance_env.table as table
+
+    scene = (table.assets_dir() / "scene.xml").read_text()
+    (tmp_path / "scene.xml").write_text(scene.replace('<body name="table" pos="-0.46 0 -0.085">',
+                                                      '<body name="table" pos="-0.46 0 -0.085" euler="0 0 0.3">'))
+    monkeypatch.setattr(table, "assets_dir", lambda: tmp_path)
+    table.table_extent.cache_clear()
+    try:
+        with pytest.raises(ValueError, match="body 'table' rotated"):
+            table.table_extent()
+    finally:
+        table.table_extent.cache_clear()
 
 
 def test_the_table_is_finite_and_objects_fall_off_its_edge(physics):

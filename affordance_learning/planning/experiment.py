@@ -338,9 +338,9 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
         choice, ok, done, seconds = _decide(planner, features, goal, start, feasible, outcomes)
         record.update(planner=ok, planner_p=choice.probability, planner_behavior=choice.behavior,
                       decision_s=seconds, planner_reach_failure=bool(done and reach_failure(done)))
-        if done is not None and isinstance(goal, Place):
-            end = np.asarray(done["object"]["final_pose"][:2])
-            record["placement_error"] = float(np.linalg.norm(end - np.asarray(goal.target_xy)))
+        error = None if done is None else goal.placement_error(done["object"]["final_pose"][:2])
+        if error is not None:  # a goal of a place
+            record["placement_error"] = error
             record["placement_committed"] = not choice.abstained
         if left_out is not None:
             record["planner_left_out"] = _decide(left_out, features, goal, start, feasible, outcomes)[1]

@@ -3,7 +3,10 @@
 Each goal says, for outcomes (:mod:`.outcomes`), whether they reach it: ``goal.reached(outcomes,
 start_xy)`` takes an outcome table (or a dict of its columns as arrays, one row per sample) and where the object
 was [m], and returns a boolean per row. A planner estimates P(goal) as the share of an effect model's predictive
-samples that reach it; an evaluation asks the same of the outcome the simulator measured.
+samples that reach it; an evaluation asks the same of the outcome the simulator measured. A goal with a distance
+(:attr:`Goal.has_distance`) also says how far each outcome goes towards it (``goal.progress(outcomes, start_xy)``),
+and a goal names what a planner must know of it (:class:`Goal`), so that nothing that uses goals asks which kind
+one is.
 
 - :class:`Roll`: the object rolls (further than the behaviour's roll threshold).
 - :class:`Lift`: a grasp lifts and holds it.
@@ -21,12 +24,16 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from affordance_env.values import float_array
 from affordance_learning.common.exceptions import InvalidValueError
+
+#: An outcome that leaves the table counts as this far from any place [m] when outcomes are ranked by how far they
+#: go towards a goal (:meth:`Goal.progress`).
+OFF_TABLE_DISTANCE = 1.0
 
 
 def _column(outcomes: Any, name: str) -> np.ndarray:
@@ -44,8 +51,47 @@ def _finite(name: str, value: Any, shape: tuple[int, ...] | None = ()) -> np.nda
     return float_array(name, value, shape, expected=expected, error=InvalidValueError)
 
 
+class Goal:
+    """What every goal answers, whatever its kind.
+
+    Attributes:
+        kind: The goal's name in JSON (:func:`goal_from_dict`).
+        needs_start: Judging it needs where the object was (``start_xy``): a place is relative to it.
+        has_distance: It has a distance: :meth:`progress` says how far an outcome goes towards it (else None).
+        ranks_by_progress: Among actions of nearly the same P(goal), the one that goes further towards it is the
+            better (a planner ranks P in coarse steps, then by progress): for a place, a nearer expected end is a
+            real difference where the last few per cent of P are its noise.
+    """
+
+    kind: ClassVar[str]
+    needs_start: ClassVar[bool] = False
+    has_distance: ClassVar[bool] = False
+    ranks_by_progress: ClassVar[bool] = False
+
+    def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
+        """Per row of ``outcomes``, whether it reaches the goal from ``start_xy`` [m]."""
+        raise NotImplementedError
+
+    def progress(self, outcomes: Any, start_xy: Any = None) -> np.ndarray | None:
+        """Per row of ``outcomes``, how far it goes towards the goal from ``start_xy`` [m] (higher is better; an
+        outcome off the table counts as :data:`OFF_TABLE_DISTANCE` away); None for a goal without a distance."""
+        return None
+
+    def positions(self) -> dict[str, tuple[float, float]]:
+        """The places on the table the goal names, (x, y) [m] by field: each must lie on the table top."""
+        return {}
+
+    def placement_error(self, end_xy: Any) -> float | None:
+        """How far [m] an object that ended at ``end_xy`` is from where the goal wants it; None for a goal of no
+        place."""
+        return None
+
+    def to_dict(self) -> dict[str, Any]:
+        raise NotImplementedError
+
+
 @dataclass(frozen=True)
-class Roll:
+class Roll(Goal):
     """The object rolls."""
 
     kind = "roll"
@@ -58,7 +104,7 @@ class Roll:
 
 
 @dataclass(frozen=True)
-class Lift:
+class Lift(Goal):
     """A grasp lifts and holds the object."""
 
     kind = "lift"
@@ -71,13 +117,14 @@ class Lift:
 
 
 @dataclass(frozen=True)
-class Move:
+class Move(Goal):
     """The object's centre moves at least ``min_distance`` [m] along ``direction`` (normalised) and stays on the
     table."""
 
     direction: tuple[float, float]
     min_distance: float = 0.05
     kind = "move"
+    has_distance = True
 
     def __post_init__(self) -> None:
         d = _finite("direction", self.direction, (2,))
@@ -92,6 +139,13 @@ class Move:
     def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
         along = _column(outcomes, "dx") * self.direction[0] + _column(outcomes, "dy") * self.direction[1]
         return (along >= self.min_distance) & ~_column(outcomes, "off_table").astype(bool)
+
+    def progress(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
+        """How far [m] each outcome moves the object along the direction; -:data:`OFF_TABLE_DISTANCE` off the
+        table."""
+        off = _column(outcomes, "off_table").astype(bool)
+        along = _column(outcomes, "dx") * self.direction[0] + _column(outcomes, "dy") * self.direction[1]
+        return np.where(off, -OFF_TABLE_DISTANCE, along)
 
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "direction": list(self.direction), "min_distance": self.min_distance}
@@ -114,12 +168,15 @@ def check_start(start_xy: Any) -> np.ndarray:
 
 
 @dataclass(frozen=True)
-class Place:
+class Place(Goal):
     """The object comes to rest within ``tolerance`` [m] of ``target_xy`` [m], on the table."""
 
     target_xy: tuple[float, float]
     tolerance: float = 0.03
     kind = "place"
+    needs_start = True
+    has_distance = True
+    ranks_by_progress = True
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "target_xy", tuple(float(v) for v in _finite("target_xy", self.target_xy, (2,))))
@@ -135,12 +192,25 @@ class Place:
         near = np.hypot(x - self.target_xy[0], y - self.target_xy[1]) <= self.tolerance
         return near & ~_column(outcomes, "off_table").astype(bool)
 
+    def progress(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
+        """Minus how far [m] each outcome leaves the object from the target (:data:`OFF_TABLE_DISTANCE` off the
+        table)."""
+        off = _column(outcomes, "off_table").astype(bool)
+        end = check_start(start_xy) + np.column_stack([_column(outcomes, "dx"), _column(outcomes, "dy")])
+        return -np.where(off, OFF_TABLE_DISTANCE, np.linalg.norm(end - np.asarray(self.target_xy), axis=1))
+
+    def positions(self) -> dict[str, tuple[float, float]]:
+        return {"target_xy": self.target_xy}
+
+    def placement_error(self, end_xy: Any) -> float:
+        return float(np.linalg.norm(np.asarray(end_xy) - np.asarray(self.target_xy)))
+
     def to_dict(self) -> dict[str, Any]:
         return {"kind": self.kind, "target_xy": list(self.target_xy), "tolerance": self.tolerance}
 
 
 @dataclass(frozen=True)
-class Percept:
+class Percept(Goal):
     """The perceptual effect comes within ``tolerance`` of ``target_effect``: the root-mean-square over features
     of the difference, each in units of ``scale`` (default 1: the features' own units)."""
 
@@ -185,7 +255,6 @@ class Percept:
                 "scale": None if self.scale is None else list(self.scale)}
 
 
-Goal = Roll | Lift | Move | Place | Percept
 #: Goal classes by ``kind``.
 GOAL_KINDS: dict[str, type] = {cls.kind: cls for cls in (Roll, Lift, Move, Place, Percept)}
 
@@ -222,5 +291,5 @@ def describe(goal: Goal) -> str:
     return goal.kind
 
 
-__all__: Sequence[str] = ["Goal", "Lift", "Move", "Percept", "Place", "Roll", "check_goal", "describe",
-                          "goal_from_dict"]
+__all__: Sequence[str] = ["OFF_TABLE_DISTANCE", "Goal", "Lift", "Move", "Percept", "Place", "Roll", "check_goal",
+                          "describe", "goal_from_dict"]

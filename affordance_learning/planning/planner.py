@@ -25,12 +25,12 @@ import numpy as np
 from scipy.stats import qmc
 
 from affordance_env.registry import BEHAVIOR_NAMES
-from affordance_env.scene import table_extent
+from affordance_env.table import table_extent
 from affordance_env.values import float_array, is_integer
 from affordance_learning.common.exceptions import InvalidValueError
 from affordance_learning.common.validation import check_float32_range
 from affordance_learning.planning.effect_model import ActionEffectModel, PredictiveOutcomes
-from affordance_learning.planning.goals import Goal, Move, Place, check_goal, check_start
+from affordance_learning.planning.goals import OFF_TABLE_DISTANCE, Goal, Place, check_goal, check_start
 
 #: The scene's table top, ((x_low, y_low), (x_high, y_high)) [m] in the robot's root frame: the planner's default
 #: ``table``.
@@ -38,8 +38,6 @@ SCENE_TABLE = table_extent()
 #: Where the object is (``start_xy``) may lie this far [m] beyond the table top's edge: the centre of an object on
 #: the table is over it, but where the camera sees it (its top's mean) may hang a few centimetres over the edge.
 SEEN_MARGIN = 0.05
-#: An outcome that leaves the table counts as this far from any place [m] when actions are ranked by distance.
-OFF_TABLE_DISTANCE = 1.0
 #: The search over two interactions (:meth:`Planner.toward`): first actions looked at (the nearest on average,
 #: and half as many of the most likely), predicted outcomes followed from each, and parameter vectors per
 #: behaviour for the second interaction (the first of the planner's candidates). 8 and 4 instead of 16 and 8 make
@@ -280,38 +278,28 @@ class Planner:
         (where the object is: (2,), or (m, 2) one per query) or without a table."""
         return outcomes if start is None or self.table is None else outcomes.off_beyond(start, *self.table)
 
-    @staticmethod
-    def _progress(outcomes: PredictiveOutcomes, goal: Goal, start: np.ndarray | None) -> np.ndarray | None:
-        """Per entry of ``outcomes``, how far it goes towards ``goal`` (higher is better): along a :class:`Move`'s
-        direction, minus the distance to a :class:`Place`'s target [m]; None for other goals."""
-        off = outcomes["off_table"].astype(bool)
-        if isinstance(goal, Move):
-            along = outcomes["dx"] * goal.direction[0] + outcomes["dy"] * goal.direction[1]
-            return np.where(off, -OFF_TABLE_DISTANCE, along)
-        if isinstance(goal, Place):
-            end = start + outcomes.displacement
-            return -np.where(off, OFF_TABLE_DISTANCE, np.linalg.norm(end - np.asarray(goal.target_xy), axis=1))
-        return None
-
     def _score(self, features: np.ndarray, goal: Goal, start_xy, candidates: Mapping[str, np.ndarray] | None = None
                ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """Per behaviour, every candidate's P(goal) and expected progress towards it (:meth:`_progress`, 0 where
-        the goal has no distance), from the models' predictive outcomes (each neighbour's displacement at the
-        candidate's action: :meth:`~.effect_model.ActionEffectModel.predictive_outcomes`, read
-        with the table: :meth:`on_table`). ``candidates``: the actions per behaviour (default: :attr:`params` for
-        every behaviour). ``start_xy`` (where the object is) is needed for a :class:`Place`, and for any goal, when
-        given, says which outcomes leave the object beyond the table's edge."""
+        """Per behaviour, every candidate's P(goal) and expected progress towards it (the goal's
+        :meth:`~affordance_learning.planning.goals.Goal.progress`, 0 where it has no distance), from the models'
+        predictive outcomes (each neighbour's displacement at the candidate's action:
+        :meth:`~.effect_model.ActionEffectModel.predictive_outcomes`, read with the table: :meth:`on_table`).
+        ``candidates``: the actions per behaviour (default: :attr:`params` for every behaviour). ``start_xy`` (where
+        the object is) is needed for a goal that :attr:`~affordance_learning.planning.goals.Goal.needs_start` (a
+        :class:`Place`), and for any goal, when given, says which outcomes leave the object beyond the table's
+        edge; the places the goal names must lie on the table top."""
         check_goal(goal)
-        start = self._check_where(start_xy) if isinstance(goal, Place) or start_xy is not None else None
-        if isinstance(goal, Place) and self.table is not None:
-            _check_on_table("the goal's target_xy", goal.target_xy, np.asarray(goal.target_xy), self.table)
+        start = self._check_where(start_xy) if goal.needs_start or start_xy is not None else None
+        if self.table is not None:
+            for what, xy in goal.positions().items():
+                _check_on_table(f"the goal's {what}", xy, np.asarray(xy), self.table)
         if candidates is None:
             candidates = dict.fromkeys(self.models, self.params)
         out = {}
         for name, params in candidates.items():
             outcomes = self.on_table(self.models[name].predictive_outcomes(self._inputs(features, params)), start)
             p = outcomes.probability(goal, start)
-            progress = self._progress(outcomes, goal, start)
+            progress = goal.progress(outcomes, start)
             out[name] = (p, np.zeros(len(p)) if progress is None else outcomes.share(progress))
         return out
 
@@ -347,10 +335,11 @@ class Planner:
         return None
 
     def _ranked(self, scores: Mapping[str, tuple[np.ndarray, np.ndarray]], goal: Goal) -> list[tuple]:
-        """Every candidate (P, progress, behaviour, index), best first: by P(goal), for a place in steps of
-        P_RESOLUTION (the nearer expected end decides among them), then by progress, then the earlier candidate,
+        """Every candidate (P, progress, behaviour, index), best first: by P(goal), for a goal that
+        :attr:`~affordance_learning.planning.goals.Goal.ranks_by_progress` (a place) in steps of P_RESOLUTION (the
+        nearer expected end decides among them), then by progress, then the earlier candidate,
         behaviour after behaviour."""
-        step = P_RESOLUTION if isinstance(goal, Place) else 0.0
+        step = P_RESOLUTION if goal.ranks_by_progress else 0.0
         ranked = sorted(((float(p), float(g), k, i, name) for i, name in enumerate(scores)
                          for k, (p, g) in enumerate(zip(*scores[name], strict=True))),
                         key=lambda e: (-np.floor(e[0] / step + 1e-9) if step else -e[0], -e[1], e[2], e[3]))
@@ -375,7 +364,7 @@ class Planner:
             return Choice(None, np.zeros(3), 0.0, True, checked=len(asked))
         p, _, name, k = best
         params, checked = candidates[name][k], len(asked)
-        if isinstance(goal, Move | Place):
+        if goal.has_distance:
             local = {name: np.clip(params + self._offsets, -1.0, 1.0)}
             p_local, g_local = self._score(features, goal, start_xy, local)[name]
             around = {name: (np.append(p_local, p), np.append(g_local, best[1]))}  # the one found last
