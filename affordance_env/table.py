@@ -14,6 +14,7 @@ import xml.etree.ElementTree as ElementTree
 import numpy as np
 
 from affordance_env.assets_path import assets_dir
+from affordance_env.exceptions import InvalidValueError
 
 #: The name of the table top's geom in ``assets/scene.xml``.
 TABLE_GEOM = "table_top"
@@ -33,14 +34,14 @@ def table_extent() -> tuple[tuple[float, float], tuple[float, float]]:
     parents = {child: parent for parent in root.iter() for child in parent}
     geom = root.find(f".//worldbody//geom[@name='{TABLE_GEOM}']")
     if geom is None or geom.get("type") != "box" or geom.get("size") is None:
-        raise ValueError(f"{path} has no box geom {TABLE_GEOM!r} with its size: read the table with "
+        raise InvalidValueError(f"{path} has no box geom {TABLE_GEOM!r} with its size: read the table with "
                          "affordance_env.scene.table_extent.")
     chain = [geom]
     while parents[chain[-1]].tag != "worldbody":
         chain.append(parents[chain[-1]])
     rotated = [f"{e.tag} {e.get('name')!r}" for e in chain if any(e.get(r) is not None for r in _ROTATIONS)]
     if rotated:
-        raise ValueError(f"{path}: {', '.join(rotated)} rotated; read the table with "
+        raise InvalidValueError(f"{path}: {', '.join(rotated)} rotated; read the table with "
                          "affordance_env.scene.table_extent.")
     centre = np.zeros(3)
     for element in reversed(chain):  # the world's outermost body first, as MuJoCo composes the positions
