@@ -178,13 +178,10 @@ def test_plan_takes_a_new_or_empty_out_or_an_earlier_plans(no_work, tmp_path):
 
 
 def test_plan_results_format_is_the_one_run_plan_writes():
-    import inspect
-
     import affordance_learning.planning.experiment as plan_experiment
     from affordance_learning.cli import PLAN_DATASET, PLAN_RESULTS_FORMAT
 
-    source = inspect.getsource(plan_experiment.run_plan)
-    assert f'"format": "{PLAN_RESULTS_FORMAT}"' in source and f'out / "{PLAN_DATASET}"' in source
+    assert plan_experiment.RESULTS_FORMAT == PLAN_RESULTS_FORMAT and plan_experiment.DATASET_DIR == PLAN_DATASET
 
 
 def test_collect_options_that_do_not_go_together_are_refused_before_collecting(no_work, tmp_path, capsys):

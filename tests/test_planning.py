@@ -449,14 +449,14 @@ def _sleep_then_pid(seconds: float, scale: float = 1.0) -> tuple[float, int]:
 
 @pytest.mark.slow
 def test_the_evaluation_hands_each_item_to_the_first_free_process_and_keeps_the_order():
-    from affordance_learning.planning.experiment import _parallel
+    from affordance_env.workers import map_in_processes
 
     items = [1.5] + [0.01] * 9  # the first item is slow: the other process does the rest meanwhile
-    results = _parallel(_sleep_then_pid, items, 2, scale=1.0)
+    results = map_in_processes(_sleep_then_pid, items, 2, scale=1.0)
     assert [r[0] for r in results] == items  # in the items' order
     slow = results[0][1]
     assert [pid for _, pid in results[1:]].count(slow) <= 1  # not every other item, as fixed halves would give
-    assert _parallel(_sleep_then_pid, items[1:3], 1, scale=0.0)[0][0] == 0.01
+    assert map_in_processes(_sleep_then_pid, items[1:3], 1, scale=0.0)[0][0] == 0.01
 
 
 def test_the_evaluation_takes_new_processes_not_those_joblib_kept_from_the_collection():
@@ -466,17 +466,18 @@ def test_the_evaluation_takes_new_processes_not_those_joblib_kept_from_the_colle
 
     from joblib import Parallel, delayed
 
-    from affordance_learning.planning.experiment import _parallel
+    from affordance_env.workers import map_in_processes
 
     kept = set(Parallel(n_jobs=2, batch_size=1)(delayed(os.getpid)() for _ in range(4)))
-    fresh = {pid for _, pid in _parallel(_sleep_then_pid, [0.2, 0.2, 0.2], 2, scale=1.0)}
+    fresh = {pid for _, pid in map_in_processes(_sleep_then_pid, [0.2, 0.2, 0.2], 2, scale=1.0)}
     assert fresh and not fresh & kept
 
 
 @pytest.mark.slow
 def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     from affordance_learning.planning.experiment import PlanSettings, oracle_params, run_plan
-    from affordance_learning.planning.report import TARGETS, write_plan_figures, write_plan_report
+    from affordance_learning.planning.report import write_plan_figures, write_plan_report
+    from affordance_learning.planning.targets import TARGETS
 
     settings = PlanSettings(episodes=40, max_episodes=40, objects=2, multi_episodes=2, candidates=8,
                             som_clusters=2)
@@ -531,7 +532,7 @@ def test_a_multi_step_action_that_left_the_object_where_it_was_is_noted_as_faile
         def note_failure(self, behavior, params, start_xy=None, features=None) -> None:
             self.noted.append((behavior, np.asarray(params), np.asarray(start_xy)))
 
-    env = plan_experiment._env((40, 30))
+    env = plan_experiment.evaluation_env((40, 30))
     reset = env.reset
     env.reset = lambda seed=None, options=None: reset(seed=seed, options={
         **(options or {}), "object_type": "box", "size": 0.1, "position": (-0.3, 0.1)})
@@ -551,7 +552,7 @@ def test_an_episode_toward_the_robot_takes_an_object_the_table_leaves_room_for_s
     from affordance_env.goal_env import GOAL_DISTANCE, GOAL_TABLE_MARGIN
     from affordance_learning.planning import experiment as plan_experiment
 
-    env = plan_experiment._env((40, 30))
+    env = plan_experiment.evaluation_env((40, 30))
     reset = env.reset
     near_edge = 7
 

@@ -10,6 +10,7 @@ from pathlib import Path
 import pytest
 
 from affordance_env.objects import OBJECT_TYPES
+from affordance_learning.common.statistics import wilson_interval
 from affordance_learning.common.verdicts import MET, MISSED, NOT_MEASURED, TOO_FEW
 from affordance_learning.paper.claims import (
     MIN_INTERACTIONS,
@@ -18,7 +19,6 @@ from affordance_learning.paper.claims import (
     STRADDLE_MIN_SIZE,
     evaluate_claims,
 )
-from affordance_learning.paper.metrics import wilson_interval
 from affordance_learning.paper.report import render_report
 from affordance_learning.planning.experiment import MULTI_POLICIES, POLICIES, share_text, summarize
 from affordance_learning.planning.report import write_plan_report

@@ -214,33 +214,3 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
             out[side] = {"n": int(members.sum()),
                          "success": float(success[members].mean()) if members.any() else None}
     return out
-
-
-#: The standard normal quantile of a two-sided 95 % interval.
-Z_95 = 1.959963984540054
-
-
-def wilson_interval(successes: int, n: int, z: float = Z_95) -> tuple[float, float]:
-    """Wilson score interval of a share ``successes / n`` (95 % by default), without continuity correction.
-
-    Unlike the normal approximation ``p +- z sqrt(p (1 - p) / n)`` it stays within [0, 1] and does not shrink to a
-    point at 0 of n or n of n. ``n = 0`` gives (0, 1): nothing is known.
-
-    Args:
-        successes: How many of the ``n`` succeeded, 0 <= successes <= n.
-        n: How many there were, >= 0.
-        z: Standard normal quantile of the interval's confidence (1.96 for 95 %).
-
-    Returns:
-        (low, high), fractions in [0, 1].
-    """
-    if n < 0 or not 0 <= successes <= n:
-        raise InvalidValueError(f"need 0 <= successes <= n, got {successes} of {n}.")
-    if n == 0:
-        return 0.0, 1.0
-    p = successes / n
-    centre = (p + z * z / (2 * n)) / (1 + z * z / n)
-    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
-    low = 0.0 if successes == 0 else max(0.0, centre - half)  # exactly, where rounding would leave 1e-16
-    high = 1.0 if successes == n else min(1.0, centre + half)
-    return float(low), float(high)

@@ -1,0 +1,56 @@
+"""The evaluation's statistics: success per policy with Wilson intervals, calibration of the chosen actions, and
+decision times.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+from affordance_learning.common.statistics import calibration, wilson_interval
+
+
+def wilson(successes: int, n: int) -> tuple[float, float]:
+    """Wilson 95 % interval of a share (:func:`~affordance_learning.common.statistics.wilson_interval`); (0, 1)
+    for 0 of 0."""
+    return wilson_interval(int(successes), int(n))
+
+
+def calibrations(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+    """The calibration of P(goal) on the planner's chosen actions (each goal it acted on: ``planner_p`` against
+    ``planner``), and beside it (``pooled``) over every action of the oracle's set for every goal (``pooled``: P
+    and reached per action)."""
+    acted = [r for r in records if r["planner_behavior"]]
+    pooled_p = np.concatenate([r["pooled"][0] for r in records]) if records else np.zeros(0)
+    pooled_y = np.concatenate([r["pooled"][1] for r in records]) if records else np.zeros(0, bool)
+    return {**calibration([r["planner_p"] for r in acted], [r["planner"] for r in acted]),
+            "basis": "the planner's chosen actions",
+            "pooled": {**calibration(pooled_p, pooled_y), "basis": "every action of the oracle's set, for every goal"}}
+
+
+def summarize(records: Sequence[Mapping[str, Any]], policies: Sequence[str]) -> dict[str, Any]:
+    """Per policy, with Wilson intervals: success on every goal, on the feasible goals (those the oracle reached),
+    and on the goals the oracle or the planner reached (``success_reached``)."""
+    feasible = np.array([r["oracle"] for r in records], dtype=bool)
+    either = feasible | np.array([bool(r.get("planner", False)) for r in records], dtype=bool)
+    out = {}
+    for policy in policies:
+        values = np.array([bool(r.get(policy, False)) for r in records], dtype=bool)
+        n, k = len(values), int(values.sum())
+        nf, kf = int(feasible.sum()), int(values[feasible].sum())
+        ne, ke = int(either.sum()), int(values[either].sum())
+        out[policy] = {"success": k / n if n else None, "success_ci": wilson(k, n),
+                       "success_feasible": kf / nf if nf else None, "success_feasible_ci": wilson(kf, nf), "n": n,
+                       "n_feasible": nf, "success_reached": ke / ne if ne else None,
+                       "success_reached_ci": wilson(ke, ne), "n_reached": ne}
+    return out
+
+
+def seconds_summary(seconds: Sequence[float]) -> dict[str, Any]:
+    """Median, 99th percentile and the most of decision times [s], and their n; None for no decision."""
+    s = np.asarray(seconds, dtype=float)
+    if not len(s):
+        return {"median": None, "p99": None, "max": None, "n": 0}
+    return {"median": float(np.median(s)), "p99": float(np.quantile(s, 0.99)), "max": float(s.max()), "n": len(s)}
