@@ -62,7 +62,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from affordance_env.goal_env import GOAL_TABLE_MARGIN, draw_target
+from affordance_env.goal_env import GOAL_TABLE_MARGIN, TapAffordanceGoalEnv, draw_target
 from affordance_env.objects import OBJECT_TYPES
 from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
 from affordance_env.scene import table_extent
@@ -249,8 +249,6 @@ _worker = threading.local()
 
 def _env(camera: tuple[int, int]):
     if getattr(_worker, "env", None) is None:
-        from affordance_env.goal_env import TapAffordanceGoalEnv
-
         _worker.env = TapAffordanceGoalEnv(camera_width=camera[0], camera_height=camera[1],
                                            position_range="workspace")
     return _worker.env
@@ -728,7 +726,6 @@ def load_training(out: str | os.PathLike) -> pd.DataFrame:
 def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: PlanSettings | None = None,
              camera: tuple[int, int] = (160, 120), say: Callable[[str], None] = print) -> dict[str, Any]:
     """Run the whole experiment into ``out`` (``dataset/``, ``results.json``); returns the results."""
-    from affordance_env.goal_env import TapAffordanceGoalEnv  # noqa: F401  (fails early without the simulator)
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
 
     settings = settings or PlanSettings()
@@ -873,7 +870,6 @@ def record_episode(out: str | os.PathLike, results: Mapping[str, Any], seed: int
     """Pictures of one multi-step planner episode (the first of the evaluation's), with the models refitted from
     ``out/dataset``: the start, then the scene after each interaction, titled with the behaviour."""
     from affordance_env.dataset import load_dataset
-    from affordance_env.goal_env import TapAffordanceGoalEnv
 
     settings = PlanSettings(**results["settings"])
     frames = training_frames(load_dataset(Path(out) / "dataset"), settings.max_per_behavior)
