@@ -88,23 +88,16 @@ def _section(section: Any, key: str) -> Any:
     return section
 
 
-def _ranks(values: Sequence[float]) -> np.ndarray:
-    """Ranks 1..n, ties sharing their mean rank."""
-    values = np.asarray(values, dtype=float)
-    ranks = np.empty(values.size)
-    ranks[np.argsort(values, kind="stable")] = np.arange(1, values.size + 1)
-    for v in np.unique(values):
-        ranks[values == v] = ranks[values == v].mean()
-    return ranks
-
-
 def _rho(x: Sequence[float], y: Sequence[float]) -> float:
-    """Spearman rank correlation of x and y; 0 when y is constant (no trend either way)."""
+    """Spearman rank correlation of x and y (:func:`scipy.stats.spearmanr`: ties share their mean rank); 0 when y
+    is constant (no trend either way)."""
+    from scipy.stats import spearmanr
+
     if len(x) < 3 or np.ptp(np.asarray(x, dtype=float)) == 0:
         raise NotMeasured("fewer than 3 distinct values: no trend to measure")
     if np.ptp(np.asarray(y, dtype=float)) == 0:
         return 0.0
-    return float(np.corrcoef(_ranks(x), _ranks(y))[0, 1])
+    return float(spearmanr(np.asarray(x, dtype=float), np.asarray(y, dtype=float)).statistic)
 
 
 def _fmt(values: Sequence[float], digits: int = 1) -> str:

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from affordance_env.goal_env import TapAffordanceGoalEnv
 from affordance_env.objects import OBJECT_TYPES
 from affordance_env.workers import map_in_processes
 from affordance_learning.common.statistics import share_text
@@ -253,8 +254,6 @@ def _results(run: _Stages, frame: pd.DataFrame, frames: Mapping[str, pd.DataFram
 def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: PlanSettings | None = None,
              camera: tuple[int, int] = (160, 120), say: Callable[[str], None] = print) -> dict[str, Any]:
     """Run the whole experiment into ``out`` (``dataset/``, ``results.json``); returns the results."""
-    from affordance_env.goal_env import TapAffordanceGoalEnv  # noqa: F401  (fails early without the simulator)
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     run = _Stages(out, settings or PlanSettings(), seed, workers, camera, say, time.perf_counter(), {})
@@ -276,7 +275,6 @@ def record_episode(out: str | os.PathLike, results: Mapping[str, Any], seed: int
     """Pictures of one multi-step planner episode (the first of the evaluation's), with the models refitted from
     ``out/dataset``: the start, then the scene after each interaction, titled with the behaviour."""
     from affordance_env.dataset import load_dataset
-    from affordance_env.goal_env import TapAffordanceGoalEnv
 
     settings = PlanSettings(**results["settings"])
     frames = training_frames(load_dataset(Path(out) / DATASET_DIR), settings.max_per_behavior)
