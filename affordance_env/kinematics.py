@@ -83,6 +83,19 @@ def _build_model(variant: str) -> pin.Model:
     return model
 
 
+def _stall_test(give_up_beyond: tuple[float, float] | None, position_tolerance: float, orientation_tolerance: float
+                ) -> tuple[bool, float, float, float]:
+    """Whether :meth:`Kinematics.solve_ik` runs the stall test (with ``give_up_beyond``; none with a zero
+    tolerance), and its scale and bounds: the factor that puts the orientation error in units of the position
+    tolerance (each iteration's error is over its tolerance), and the position [m] and orientation [rad] errors
+    beyond which a target whose error stands still is given up (:data:`STALL_MARGIN` times the caller's); the
+    three are NaN without the test."""
+    if not (give_up_beyond is not None and position_tolerance > 0 and orientation_tolerance > 0):
+        return False, np.nan, np.nan, np.nan
+    rot_scale = position_tolerance / (0.5 * orientation_tolerance)  # in units of the position tolerance
+    return True, rot_scale, STALL_MARGIN * give_up_beyond[0], STALL_MARGIN * give_up_beyond[1]
+
+
 class Kinematics:
     """Pinocchio model of the iCub reduced to the joints the project moves.
 
@@ -215,6 +228,43 @@ class Kinematics:
             regulariser.flags.writeable = False
         return regulariser
 
+    def _checked_target(self, p_world_target: np.ndarray, R_world_target: np.ndarray | None
+                        ) -> tuple[np.ndarray, np.ndarray | None]:
+        """The target of :meth:`solve_ik` as float arrays: its position, and its orientation or None;
+        InvalidValueError unless they are 3 finite coordinates and a 3x3 rotation matrix."""
+        p_target = np.asarray(p_world_target, dtype=float)
+        if p_target.shape != (3,) or not np.logical_and.reduce(np.isfinite(p_target)):
+            raise InvalidValueError(f"p_world_target must be 3 finite coordinates [m], got {p_world_target!r}.")
+        if R_world_target is not None:
+            R_world_target = np.asarray(R_world_target, dtype=float)
+            # a stroke asks for one orientation many times: the last one checked need not be checked again
+            # (elementwise equality of two 3x3 arrays: np.array_equal's answer, without its checks)
+            if not (R_world_target.shape == (3, 3) and (R_world_target == self._last_rotation).all()):
+                if (R_world_target.shape != (3, 3)
+                        or np.abs(matmul(R_world_target, R_world_target.T) - np.eye(3)).max() > 1e-6):
+                    raise InvalidValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
+                self._last_rotation = R_world_target.copy()
+        return p_target, R_world_target
+
+    def _clipped_start(self, q_init: np.ndarray, joint_ranges: Mapping[str, tuple[float, float]] | None
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """``q_init`` in Pinocchio's order, clipped to the limits :meth:`solve_ik` keeps to (a new array), and the
+        reach joints' (lower, upper) limits in that order (:meth:`_ik_limits`)."""
+        lower_all, upper_all, lower, upper = self._ik_limits(joint_ranges)
+        q = np.minimum(np.maximum(self._check_q(q_init)[self._to_pin], lower_all), upper_all)
+        return q, lower, upper
+
+    def _errors_at(self, q: np.ndarray, p_target: np.ndarray, R_world_target: np.ndarray | None, rot_err: float
+                   ) -> tuple[float, float]:
+        """(position, orientation) errors of the palm at ``q`` (Pinocchio's order) from the target; the
+        orientation error is ``rot_err`` when no orientation is asked."""
+        pin.framesForwardKinematics(self.model, self.data, q)
+        T_world_hand = self.data.oMf[self.hand_frame_id]
+        pos_err = norm(p_target - T_world_hand.translation)
+        if R_world_target is not None:
+            rot_err = norm(pin.log3(matmul(R_world_target, T_world_hand.rotation.T)))
+        return pos_err, rot_err
+
     def solve_ik(
         self,
         p_world_target: np.ndarray,
@@ -250,21 +300,9 @@ class Kinematics:
                 know whether they are met (a feasibility check), not the closest configuration: the solver gives up
                 once its error stands still beyond them (:data:`STALL_WINDOW`) rather than spend the whole budget.
         """
-        p_target = np.asarray(p_world_target, dtype=float)
-        if p_target.shape != (3,) or not np.logical_and.reduce(np.isfinite(p_target)):
-            raise InvalidValueError(f"p_world_target must be 3 finite coordinates [m], got {p_world_target!r}.")
-        if R_world_target is not None:
-            R_world_target = np.asarray(R_world_target, dtype=float)
-            # a stroke asks for one orientation many times: the last one checked need not be checked again
-            # (elementwise equality of two 3x3 arrays: np.array_equal's answer, without its checks)
-            if not (R_world_target.shape == (3, 3) and (R_world_target == self._last_rotation).all()):
-                if (R_world_target.shape != (3, 3)
-                        or np.abs(matmul(R_world_target, R_world_target.T) - np.eye(3)).max() > 1e-6):
-                    raise InvalidValueError(f"R_world_target must be a 3x3 rotation matrix, got {R_world_target!r}.")
-                self._last_rotation = R_world_target.copy()
+        p_target, R_world_target = self._checked_target(p_world_target, R_world_target)
         # In Pinocchio's order from here on; the reach joints' limits apart.
-        lower_all, upper_all, lower, upper = self._ik_limits(joint_ranges)
-        q = np.minimum(np.maximum(self._check_q(q_init)[self._to_pin], lower_all), upper_all)
+        q, lower, upper = self._clipped_start(q_init, joint_ranges)
         dofs = self._reach_pin
         model, data, frame = self.model, self.data, self.hand_frame_id
         n_error = 3 if R_world_target is None else 6
@@ -273,12 +311,9 @@ class Kinematics:
         error_position, error_rotation = error[:3], error[3:]  # views, made once
         pos_err = rot_err = np.inf
         iteration = 0
-        # The stall test (give_up_beyond; none with a zero tolerance): each iteration's error over its tolerance.
-        stall_test = give_up_beyond is not None and position_tolerance > 0 and orientation_tolerance > 0
-        if stall_test:
-            errors: list[float] = []
-            rot_scale = position_tolerance / (0.5 * orientation_tolerance)  # in units of the position tolerance
-            pos_beyond, rot_beyond = STALL_MARGIN * give_up_beyond[0], STALL_MARGIN * give_up_beyond[1]
+        stall_test, rot_scale, pos_beyond, rot_beyond = _stall_test(give_up_beyond, position_tolerance,
+                                                                    orientation_tolerance)
+        errors: list[float] = []  # each iteration's error over its tolerance, for the stall test
         # Pinocchio's functions and the frames' placements bound once: the loop below runs a few times per call.
         jacobian, log3, placements = pin.computeFrameJacobian, pin.log3, data.oMf
         world_aligned = pin.LOCAL_WORLD_ALIGNED
@@ -308,10 +343,12 @@ class Kinematics:
             step = matmul_f64(solve_spd(matmul_f64(jac, jac.T) + regulariser, error), jac)
             q[dofs] = np.minimum(np.maximum(q[dofs] + step, lower), upper)
         else:
-            pin.framesForwardKinematics(model, data, q)
-            T_world_hand = data.oMf[frame]
-            pos_err = norm(p_target - T_world_hand.translation)
-            if R_world_target is not None:
-                rot_err = norm(pin.log3(matmul(R_world_target, T_world_hand.rotation.T)))
+            pos_err, rot_err = self._errors_at(q, p_target, R_world_target, rot_err)
+        return self._result(q, pos_err, rot_err, iteration, position_tolerance, orientation_tolerance)
+
+    def _result(self, q: np.ndarray, pos_err: float, rot_err: float, iterations: int, position_tolerance: float,
+                orientation_tolerance: float) -> IKResult:
+        """The :class:`IKResult` of ``q`` (Pinocchio's order) with its errors: a success when both are within their
+        tolerances."""
         success = pos_err <= position_tolerance and rot_err <= orientation_tolerance
-        return IKResult(q[self._from_pin], bool(success), pos_err, rot_err, iteration)
+        return IKResult(q[self._from_pin], bool(success), pos_err, rot_err, iterations)

@@ -314,13 +314,8 @@ def _plan(args: argparse.Namespace) -> int:
     return 0
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The parser of every subcommand; each value is checked as it is parsed (counts, seeds, shares, sizes)."""
-    from affordance_learning import __version__
-
-    parser = _Parser(prog="affordance", description=__doc__)
-    parser.add_argument("--version", action="version", version=f"%(prog)s (tap-affordance) {__version__}")
-    sub = parser.add_subparsers(dest="command", required=True)
+def _add_demo_parser(sub: argparse._SubParsersAction) -> None:
+    """The ``demo`` subcommand: tap a few objects and print what happened."""
     demo = sub.add_parser("demo", help="tap a few objects with the canonical tap and print what happened")
     demo.add_argument("--episodes", type=positive_int, default=8, help="number of interactions (default 8)")
     demo.add_argument("--seed", type=non_negative_int, default=0, help="seed of the first interaction (default 0)")
@@ -328,9 +323,9 @@ def build_parser() -> argparse.ArgumentParser:
     demo.add_argument("--object", default=None, help="only this object type (default: all four)")
     demo.set_defaults(func=_demo)
 
-    add_collect_parser(sub)
-    add_export_parser(sub)
 
+def _add_reproduce_parser(sub: argparse._SubParsersAction) -> None:
+    """The ``reproduce`` subcommand: the paper's experiment per behaviour."""
     reproduce = sub.add_parser(
         "reproduce", help="the paper's experiment per behaviour (tap and grasp): collect, learn, write "
         "results.json, figures and a report for each, and a report over all of them",
@@ -357,6 +352,9 @@ def build_parser() -> argparse.ArgumentParser:
                            help="collect with the range camera's depth noise model (default: exact ranges)")
     reproduce.set_defaults(func=_reproduce)
 
+
+def _add_fingerprint_parser(sub: argparse._SubParsersAction) -> None:
+    """The ``fingerprint`` subcommand: pin down (or check) the interactions behind a reproduction."""
     fingerprint = sub.add_parser(
         "fingerprint", help="pin down (or check) the first interactions behind a reproduction's results.json",
         description="For each reproduction directory (one behaviour's, holding results.json, e.g. "
@@ -373,6 +371,9 @@ def build_parser() -> argparse.ArgumentParser:
     fingerprint.add_argument("--workers", type=positive_int, default=1, help="worker processes (default 1)")
     fingerprint.set_defaults(func=_fingerprint)
 
+
+def _add_compare_parser(sub: argparse._SubParsersAction) -> None:
+    """The ``compare`` subcommand: a reproduction's numbers beside a reference's."""
     compare = sub.add_parser(
         "compare", help="set a reproduction's numbers beside a reference's, with the tolerances they must keep",
         description="Compare two reproductions of one behaviour (directories holding results.json of `affordance "
@@ -384,6 +385,9 @@ def build_parser() -> argparse.ArgumentParser:
     compare.add_argument("found", type=Path, metavar="DIR", help="the reproduction to check, e.g. reproduction/tap")
     compare.set_defaults(func=_compare)
 
+
+def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
+    """The ``plan`` subcommand: learn the behaviours' effects, then plan to reach goals."""
     plan = sub.add_parser(
         "plan", help="learn what each behaviour does to objects, then choose behaviours to reach goals, against "
         "baselines (results.json, REPORT.md, figures)",
@@ -407,6 +411,9 @@ def build_parser() -> argparse.ArgumentParser:
                       help=f"multi-step episodes per policy (default {PLAN_DEFAULTS['multi_episodes']})")
     plan.set_defaults(func=_plan)
 
+
+def _add_train_default_parser(sub: argparse._SubParsersAction) -> None:
+    """The ``train-default`` subcommand: rebuild a behaviour's default model."""
     train = sub.add_parser("train-default", help="rebuild a behaviour's default model behind predict_effect")
     train.add_argument("--behavior", default="tap", metavar="NAME",
                        help="whose model: tap (default) or grasp (both shipped), tap_back, push or draw")
@@ -424,6 +431,23 @@ def build_parser() -> argparse.ArgumentParser:
                        "from goal episodes with random actions, collected into --dataset (default "
                        "./default-actions) until every behaviour has 1000 interactions")
     train.set_defaults(func=_train_default)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The parser of every subcommand; each value is checked as it is parsed (counts, seeds, shares, sizes)."""
+    from affordance_learning import __version__
+
+    parser = _Parser(prog="affordance", description=__doc__)
+    parser.add_argument("--version", action="version", version=f"%(prog)s (tap-affordance) {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True)
+    _add_demo_parser(sub)
+    add_collect_parser(sub)
+    add_export_parser(sub)
+    _add_reproduce_parser(sub)
+    _add_fingerprint_parser(sub)
+    _add_compare_parser(sub)
+    _add_plan_parser(sub)
+    _add_train_default_parser(sub)
     return parser
 
 

@@ -135,7 +135,21 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
         DatasetError: not a dataset, a newer schema, a corrupt, changed or foreign chunk, or (unless
             ``allow_incomplete``) missing chunks.
     """
-    path = Path(path)
+    path = _dataset_directory(Path(path))
+    manifest = read_manifest(path)
+    renames = _old_names(manifest["schema_version"])
+    redo = collect_command(path, manifest)
+    tables, failures, missing = _read_chunks(path, manifest, renames, with_images, redo)
+    if missing and not allow_incomplete:
+        raise DatasetError(f"{path} is incomplete: {len(missing)} chunk(s) missing or unfinished "
+                           f"({', '.join(missing[:3])}{', ...' if len(missing) > 3 else ''}); finish it with "
+                           f"`{redo}`, or pass allow_incomplete=True.")
+    return _frame(tables, failures, manifest, renames, with_images)
+
+
+def _dataset_directory(path: Path) -> Path:
+    """The directory of the dataset at ``path`` (the directory or its manifest); FileNotFoundError if nothing is
+    there, DatasetError if it is one of a dataset's chunks or not a dataset."""
     if not path.exists():
         raise FileNotFoundError(f"No dataset at {path}.")
     if path.is_file() and path.name == MANIFEST:
@@ -149,11 +163,15 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
     if not path.is_dir() or not (path / MANIFEST).is_file():
         raise DatasetError(f"{path} is not a TapAffordance dataset (a directory with {MANIFEST}); make one "
                            "with `affordance collect`.")
-    manifest = read_manifest(path)
+    return path
+
+
+def _read_chunks(path: Path, manifest: dict, renames: dict[str, str], with_images: bool, redo: str
+                 ) -> tuple[list[pa.Table], dict, list[str]]:
+    """The tables of the dataset's finished chunks in order (:func:`_read_chunk`), the failures they record
+    (episode -> reason) and the names of the chunks missing or unfinished."""
     version = manifest["schema_version"]
-    renames = _old_names(version)
     images_on_disk = {old for old, new in renames.items() if new in IMAGE_COLUMNS} | set(IMAGE_COLUMNS)
-    redo = collect_command(path, manifest)
     tables, failures, missing = [], {}, []
     ranges = chunk_ranges(manifest["episodes"], manifest["settings"]["chunk_size"])
     for index, (start, stop) in enumerate(ranges):
@@ -162,27 +180,42 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
         if not chunk.exists() or (version >= 5 and chunk.name not in (manifest.get(CHECKSUMS) or {})):
             missing.append(chunk.name)
             continue
-        try:
-            if version >= 5:
-                check_checksum(chunk, manifest)
-            if version >= 2:
-                failures.update(check_chunk(chunk, manifest, start, stop)["chunk"]["failures"])
-            names = pq.read_schema(chunk).names
-            columns = None if with_images else [c for c in names if c not in images_on_disk]
-            table = pq.read_table(chunk, columns=columns)
-        except DatasetError as exc:
-            raise DatasetError(f"{exc} Redo it with `{redo}` (it collects that chunk again).") from exc
-        except Exception as exc:  # pyarrow raises several types for damaged files
-            raise DatasetError(f"{chunk} is corrupt ({exc}); redo it with `{redo}` (it collects that chunk "
-                               "again).") from exc
-        if version == 1:
-            failures.update(json.loads((table.schema.metadata or {}).get(b"tap_affordance_failures", b"{}")))
-            table = table.drop_columns([c for c in images_on_disk if c in table.column_names])
-        tables.append(table.replace_schema_metadata(None))
-    if missing and not allow_incomplete:
-        raise DatasetError(f"{path} is incomplete: {len(missing)} chunk(s) missing or unfinished "
-                           f"({', '.join(missing[:3])}{', ...' if len(missing) > 3 else ''}); finish it with "
-                           f"`{redo}`, or pass allow_incomplete=True.")
+        tables.append(_read_chunk(chunk, manifest, (start, stop), images_on_disk, with_images, redo, failures))
+    return tables, failures, missing
+
+
+def _read_chunk(chunk: Path, manifest: dict, episodes: tuple[int, int], images_on_disk: set[str],
+                with_images: bool, redo: str, failures: dict) -> pa.Table:
+    """The table of one chunk of episodes ``(start, stop)``, checked against the manifest (its checksum from
+    version 5 on, its metadata from version 2 on), without its image columns (``images_on_disk``, by any of
+    their names) unless ``with_images``, and without schema metadata; the failures it records are added to
+    ``failures``. DatasetError naming the chunk and ``redo``, the command that collects it again, if it is
+    changed, foreign or corrupt."""
+    version = manifest["schema_version"]
+    try:
+        if version >= 5:
+            check_checksum(chunk, manifest)
+        if version >= 2:
+            failures.update(check_chunk(chunk, manifest, *episodes)["chunk"]["failures"])
+        names = pq.read_schema(chunk).names
+        columns = None if with_images else [c for c in names if c not in images_on_disk]
+        table = pq.read_table(chunk, columns=columns)
+    except DatasetError as exc:
+        raise DatasetError(f"{exc} Redo it with `{redo}` (it collects that chunk again).") from exc
+    except Exception as exc:  # pyarrow raises several types for damaged files
+        raise DatasetError(f"{chunk} is corrupt ({exc}); redo it with `{redo}` (it collects that chunk "
+                           "again).") from exc
+    if version == 1:
+        failures.update(json.loads((table.schema.metadata or {}).get(b"tap_affordance_failures", b"{}")))
+        table = table.drop_columns([c for c in images_on_disk if c in table.column_names])
+    return table.replace_schema_metadata(None)
+
+
+def _frame(tables: list[pa.Table], failures: dict, manifest: dict, renames: dict[str, str], with_images: bool
+           ) -> pd.DataFrame:
+    """The frame of the chunks' tables (an empty one of the dataset's schema if there are none) under the current
+    column names, with ``success`` (derived for versions 1 to 3), and the manifest and the failures (by episode)
+    in its attrs."""
     if not tables:
         tables = [arrow_schema(with_images and manifest["settings"].get("save_images", False),
                                goal=is_goal_dataset(manifest)).empty_table()]

@@ -194,57 +194,20 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
             exists already; nothing is written.
         DatasetError: ``dataset`` is not a complete dataset.
     """
-    if data_format not in DATA_FORMATS:
-        raise InvalidValueError(f"data_format must be one of {DATA_FORMATS}, got {data_format!r}.")
-    minari, EpisodeBuffer = _minari()
-    if data_format == "hdf5":
-        try:
-            import h5py  # noqa: F401 (Minari's HDF5 storage needs it)
-        except ImportError as exc:
-            raise MissingDependencyError("Minari's hdf5 format needs the h5py package: pip install 'minari[hdf5]' "
-                                         "(or export with data_format='arrow')") from exc
+    minari, EpisodeBuffer = _minari_for(data_format)
     namespace, _, _ = check_dataset_id(dataset_id)
-    from minari.storage.datasets_root_dir import get_dataset_path
-
-    root = get_dataset_path()
-    target = root / dataset_id
-    if dataset_id in minari.list_local_datasets() or target.exists():
-        raise InvalidValueError(f"a Minari dataset {dataset_id!r} exists already ({target}); delete it with "
-                         f"`minari delete {dataset_id}` (or remove that directory) or choose another id.")
-    frame = load_dataset(dataset, with_images=True)
+    root, target = _free_target(minari, dataset_id)
+    frame = _interactions(dataset)
     manifest = frame.attrs["manifest"]
-    if is_goal_dataset(manifest):
-        raise DatasetError(f"{dataset} holds TapAffordanceGoal-v2 episodes; the Minari export writes one "
-                           "TapAffordance-v2 episode per interaction and does not take goal episodes: read them "
-                           "with load_dataset (a row per interaction, with 'episode' and 'step').")
     options = manifest["settings"]["env_options"]
     with_images = bool(manifest["settings"].get("save_images"))
-    stages = {stage: frame[[f"{stage}_{n}" for n in FEATURE_NAMES]].to_numpy(np.float32) for stage in STAGES}
-    if with_images:
-        decoded = {f"{stage}_{kind}": images(frame, f"image_{stage}_{kind}")
-                   for stage in STAGES for kind in ("range", "mask")}
-    actions = frame[[f"action_{j}" for j in range(3)]].to_numpy(np.float32)
-    rewards = frame["displacement"].to_numpy(np.float64)
-    buffers = []
-    for i, seed in enumerate(frame["seed"]):
-        observations = {"features": np.stack([stages["initial"][i], stages["final"][i]])}
-        if with_images:
-            observations["range"] = np.stack([decoded["initial_range"][i], decoded["final_range"][i]])
-            observations["mask"] = np.stack([decoded["initial_mask"][i], decoded["final_mask"][i]]).astype(np.int8)
-        # Minari numbers episodes 0..n-1 (it counts them from the largest id); the valid interactions are
-        # renumbered in order, each keeps its seed (and its dataset episode in its infos).
-        buffers.append(EpisodeBuffer(id=i, seed=int(seed), observations=observations,
-                                     actions=actions[i : i + 1], rewards=[float(rewards[i])], terminations=[True],
-                                     truncations=[False], infos=_infos(frame, i)))
+    buffers = _episode_buffers(frame, with_images, EpisodeBuffer)
     import gymnasium as gym
 
     from affordance_env.registration import ENV_ID, register_envs
 
     register_envs()
-    dropped = left_out(with_images)
-    text = description or f"TapAffordance interactions exported from {Path(dataset).resolve()}."
-    text += (" Observations: the environment's, without " + "; ".join(f"{k} ({why})" for k, why in dropped.items())
-             + ". Infos: the ground truth of each interaction.")
+    text = _description(description, dataset, with_images)
     env = gym.make(ENV_ID, **options)  # the env recover_environment() makes: its spec and its spaces
     staging = Path(tempfile.mkdtemp(prefix=".tap-affordance-export-", dir=root))  # hidden: Minari skips it
     try:
@@ -267,13 +230,92 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
                 jpeg_encoding=False,
                 requirements=[f"tap-affordance=={manifest['package_version']}"],
             )
-        from minari.namespace import create_namespace, list_local_namespaces
-
-        if namespace is not None and namespace not in list_local_namespaces():
-            create_namespace(namespace)
-        target.parent.mkdir(parents=True, exist_ok=True)
-        os.replace(staging / dataset_id, target)
+        _move_into_place(staging / dataset_id, target, namespace)
     finally:
         env.close()
         shutil.rmtree(staging, ignore_errors=True)
     return minari.load_dataset(dataset_id)
+
+
+def _minari_for(data_format: str):
+    """``(minari, EpisodeBuffer)`` once ``data_format`` is one of :data:`DATA_FORMATS` and what it needs is
+    installed: ValueError for another format, ImportError (saying how to install it) without minari, or without
+    h5py for ``"hdf5"``."""
+    if data_format not in DATA_FORMATS:
+        raise InvalidValueError(f"data_format must be one of {DATA_FORMATS}, got {data_format!r}.")
+    minari, EpisodeBuffer = _minari()
+    if data_format == "hdf5":
+        try:
+            import h5py  # noqa: F401 (Minari's HDF5 storage needs it)
+        except ImportError as exc:
+            raise MissingDependencyError("Minari's hdf5 format needs the h5py package: pip install 'minari[hdf5]' "
+                                         "(or export with data_format='arrow')") from exc
+    return minari, EpisodeBuffer
+
+
+def _free_target(minari, dataset_id: str) -> tuple[Path, Path]:
+    """``(root, target)``: the directory of Minari's datasets and the one dataset ``dataset_id`` would have;
+    ValueError if a Minari dataset (or a directory) with that id exists already."""
+    from minari.storage.datasets_root_dir import get_dataset_path
+
+    root = get_dataset_path()
+    target = root / dataset_id
+    if dataset_id in minari.list_local_datasets() or target.exists():
+        raise InvalidValueError(f"a Minari dataset {dataset_id!r} exists already ({target}); delete it with "
+                         f"`minari delete {dataset_id}` (or remove that directory) or choose another id.")
+    return root, target
+
+
+def _interactions(dataset: str | os.PathLike):
+    """The frame of the complete dataset at ``dataset``, with its images (:func:`load_dataset`); DatasetError if
+    it holds goal episodes, which the export does not take."""
+    frame = load_dataset(dataset, with_images=True)
+    if is_goal_dataset(frame.attrs["manifest"]):
+        raise DatasetError(f"{dataset} holds TapAffordanceGoal-v2 episodes; the Minari export writes one "
+                           "TapAffordance-v2 episode per interaction and does not take goal episodes: read them "
+                           "with load_dataset (a row per interaction, with 'episode' and 'step').")
+    return frame
+
+
+def _episode_buffers(frame, with_images: bool, EpisodeBuffer) -> list:
+    """One Minari episode of one step per row of ``frame``: its observations before and after (the features,
+    and the range image and mask ``with_images``), action, reward (the displacement [m]) and infos."""
+    stages = {stage: frame[[f"{stage}_{n}" for n in FEATURE_NAMES]].to_numpy(np.float32) for stage in STAGES}
+    if with_images:
+        decoded = {f"{stage}_{kind}": images(frame, f"image_{stage}_{kind}")
+                   for stage in STAGES for kind in ("range", "mask")}
+    actions = frame[[f"action_{j}" for j in range(3)]].to_numpy(np.float32)
+    rewards = frame["displacement"].to_numpy(np.float64)
+    buffers = []
+    for i, seed in enumerate(frame["seed"]):
+        observations = {"features": np.stack([stages["initial"][i], stages["final"][i]])}
+        if with_images:
+            observations["range"] = np.stack([decoded["initial_range"][i], decoded["final_range"][i]])
+            observations["mask"] = np.stack([decoded["initial_mask"][i], decoded["final_mask"][i]]).astype(np.int8)
+        # Minari numbers episodes 0..n-1 (it counts them from the largest id); the valid interactions are
+        # renumbered in order, each keeps its seed (and its dataset episode in its infos).
+        buffers.append(EpisodeBuffer(id=i, seed=int(seed), observations=observations,
+                                     actions=actions[i : i + 1], rewards=[float(rewards[i])], terminations=[True],
+                                     truncations=[False], infos=_infos(frame, i)))
+    return buffers
+
+
+def _description(description: str | None, dataset: str | os.PathLike, with_images: bool) -> str:
+    """The dataset's description in the Minari metadata: ``description`` (by default where it was exported
+    from), then what the observations leave out and why, and what the infos hold."""
+    dropped = left_out(with_images)
+    text = description or f"TapAffordance interactions exported from {Path(dataset).resolve()}."
+    return text + (" Observations: the environment's, without "
+                   + "; ".join(f"{k} ({why})" for k, why in dropped.items())
+                   + ". Infos: the ground truth of each interaction.")
+
+
+def _move_into_place(staged: Path, target: Path, namespace: str | None) -> None:
+    """Move the dataset written at ``staged`` to ``target``, among Minari's datasets, creating its
+    ``namespace`` first if Minari does not know it yet."""
+    from minari.namespace import create_namespace, list_local_namespaces
+
+    if namespace is not None and namespace not in list_local_namespaces():
+        create_namespace(namespace)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    os.replace(staged, target)

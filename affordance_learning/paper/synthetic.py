@@ -44,30 +44,69 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
         random_state: Seed.
         behavior: ``"tap"`` or ``"grasp"`` (the ``behavior`` column).
     """
+    _check_arguments(n_rows, behavior)
+    grasp = behavior == "grasp"
+    names = _feature_names()
+    rng = np.random.default_rng(random_state)
+    types, kind, size, held, rolled = _objects(rng, n_rows, behavior)
+    shape = _shape_features(rng, kind, n_rows)
+    size_features, pixels = _size_features(rng, size, n_rows)
+    relation = rng.normal(0.0, 1.0, (n_rows, 7)) * np.array([5, 5, 7, 0.02, 0.02, 0.02, 0.03])
+    initial = np.hstack([shape, size_features, relation])
+    travel, off_table = _travel(rng, types, held, rolled, grasp)
+    final, effect = _final_and_effect(rng, initial, pixels, travel, off_table, types, rolled)
+    columns: dict[str, Any] = {}
+    for prefix, values in (("initial_", initial), ("final_", final), ("effect_", effect)):
+        columns.update({f"{prefix}{n}": values[:, j] for j, n in enumerate(names)})
+    columns.update({"behavior": np.full(n_rows, behavior), "type": types, "size": size, "rolled": rolled,
+                    "success": held if grasp else rolled, "displacement": np.abs(travel),
+                    "rolling_distance": np.where(rolled, np.abs(travel), 0.0), "visible_final": ~off_table,
+                    "outcome": np.where(off_table, "off_table", "rest")})
+    return pd.DataFrame(columns)
+
+
+def _check_arguments(n_rows: int, behavior: str) -> None:
+    """InvalidValueError unless ``n_rows`` is an integer >= 8 and ``behavior`` one :func:`make_synthetic_frame`
+    imitates."""
     if not is_integer(n_rows) or n_rows < 8:
         raise InvalidValueError(f"n_rows must be an integer >= 8, got {n_rows!r}.")
     if behavior not in SYNTHETIC_SIZE_RANGES:
         raise InvalidValueError(f"behavior must be one of {tuple(SYNTHETIC_SIZE_RANGES)}, got {behavior!r}.")
-    grasp = behavior == "grasp"
+
+
+def _feature_names() -> list[str]:
+    """``affordance_env.features.FEATURE_NAMES`` when available, else ``f00`` ... ``f48``."""
     try:
         from affordance_env.features import FEATURE_NAMES
 
-        names = list(FEATURE_NAMES)
+        return list(FEATURE_NAMES)
     except ImportError:
-        names = [f"f{i:02d}" for i in range(49)]
-    rng = np.random.default_rng(random_state)
+        return [f"f{i:02d}" for i in range(49)]
+
+
+def _objects(rng: np.random.Generator, n_rows: int, behavior: str
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray]:
+    """``(types, kind, size, held, rolled)`` of ``n_rows`` objects, the four types equally often in a random
+    order: ``kind`` numbers the types (0 box, 1 horizontal, 2 sphere, 3 vertical), ``size`` [m] is uniform in the
+    behaviour's range; for a grasp ``held`` (by the critical size) and nothing rolled, for a tap ``held`` None and
+    ``rolled`` the rolling objects (95 %) and a few others (3 %)."""
     types = np.array(TYPE_ORDER)[np.arange(n_rows) % 4]  # dealt out in that order, then shuffled
     rng.shuffle(types)
     kind = np.searchsorted(np.array(sorted(OBJECT_TYPES)), types)  # 0 box, 1 horizontal, 2 sphere, 3 vertical
     size = rng.uniform(*SYNTHETIC_SIZE_RANGES[behavior], n_rows)
-    if grasp:
+    held = None
+    if behavior == "grasp":
         held = rng.random(n_rows) < 1.0 / (1.0 + np.exp((size - SYNTHETIC_CRITICAL_SIZE) / SYNTHETIC_GRASP_SPREAD))
         rolled = np.zeros(n_rows, dtype=bool)
     else:
         rollable = np.isin(types, ROLLING_TYPES)
         rolled = np.where(rollable, rng.random(n_rows) < 0.95, rng.random(n_rows) < 0.03)
+    return types, kind, size, held, rolled
 
-    # Shape: a latitude and a longitude histogram per type, 12 bins each, perturbed and renormalised.
+
+def _shape_features(rng: np.random.Generator, kind: np.ndarray, n_rows: int) -> np.ndarray:
+    """(n_rows, 24) shape features: a latitude and a longitude histogram per type, 12 bins each, perturbed and
+    renormalised."""
     bins = np.arange(12)
     lat_profiles = np.stack(
         [
@@ -92,7 +131,12 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
         h = profiles[kind] * rng.gamma(20.0, 1 / 20.0, (n_rows, 12))
         return h / h.sum(axis=1, keepdims=True)
 
-    shape = np.hstack([histogram(lat_profiles), histogram(lon_profiles)])
+    return np.hstack([histogram(lat_profiles), histogram(lon_profiles)])
+
+
+def _size_features(rng: np.random.Generator, size: np.ndarray, n_rows: int) -> tuple[np.ndarray, np.ndarray]:
+    """(n_rows, 18) features that depend on the size (mean position, range, pixel count, orientation, extents),
+    and the pixel counts among them."""
     jitter = rng.normal(0.0, 0.02, (n_rows, 3))
     mean_xyz = np.column_stack([-0.30 + jitter[:, 0], 0.05 + jitter[:, 1], size / 2 + jitter[:, 2] * 0.1])
     mean_range = np.linalg.norm(mean_xyz - [0.0, 0.0, 0.35], axis=1)
@@ -103,10 +147,13 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
         * rng.normal(1.0, 0.05, (n_rows, 12))
         * np.array([0.7, 0.7, 0.5, 1.0, 0.3] * 2 + [40, 40])
     )
-    size_features = np.column_stack([mean_xyz, mean_range, pixels, orientation, extents])
-    relation = rng.normal(0.0, 1.0, (n_rows, 7)) * np.array([5, 5, 7, 0.02, 0.02, 0.02, 0.03])
-    initial = np.hstack([shape, size_features, relation])
+    return np.column_stack([mean_xyz, mean_range, pixels, orientation, extents]), pixels
 
+
+def _travel(rng: np.random.Generator, types: np.ndarray, held: np.ndarray | None, rolled: np.ndarray, grasp: bool
+            ) -> tuple[np.ndarray, np.ndarray]:
+    """How far [m] each object travels, and which leave the table."""
+    n_rows = len(types)
     if grasp:  # Effects: put down 6 cm away when held, nudged by half a centimetre otherwise.
         travel = np.where(held, rng.normal(0.06, 0.004, n_rows), np.abs(rng.normal(0.005, 0.003, n_rows)))
         off_table = np.zeros(n_rows, dtype=bool)
@@ -114,6 +161,14 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
         roll = np.where(types == "sphere", rng.uniform(0.10, 0.22, n_rows), rng.uniform(0.05, 0.20, n_rows))
         travel = np.where(rolled, roll, rng.normal(0.015, 0.003, n_rows))
         off_table = rolled & (rng.random(n_rows) < 0.03)
+    return travel, off_table
+
+
+def _final_and_effect(rng: np.random.Generator, initial: np.ndarray, pixels: np.ndarray, travel: np.ndarray,
+                      off_table: np.ndarray, types: np.ndarray, rolled: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``(final, effect)`` features: jitter, the travel's moves of the position, range, pixel count, image offsets
+    and hand relation, a rolling lying cylinder's changed histogram; an object off the table is not visible, its
+    final features the documented zeros."""
     effect = rng.normal(0.0, 1.0, initial.shape) * 0.01 * (np.abs(initial).mean(axis=0) + 1e-3)
     effect[:, 24] += 0.1 * travel  # mean_x
     effect[:, 25] += travel  # mean_y
@@ -123,16 +178,8 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
     effect[:, 46] += travel  # hand_dy
     effect[:, 48] += travel  # hand_distance
     spin = np.where(types == "horizontal_cylinder", 1.0, 0.0) * rolled
-    effect[:, 12:24] += 0.05 * spin[:, None] * rng.normal(0.0, 1.0, (n_rows, 12))
+    effect[:, 12:24] += 0.05 * spin[:, None] * rng.normal(0.0, 1.0, (len(types), 12))
     final = initial + effect
     final[off_table] = 0.0  # not visible: the documented zeros
     effect[off_table] = -initial[off_table]
-
-    columns: dict[str, Any] = {}
-    for prefix, values in (("initial_", initial), ("final_", final), ("effect_", effect)):
-        columns.update({f"{prefix}{n}": values[:, j] for j, n in enumerate(names)})
-    columns.update({"behavior": np.full(n_rows, behavior), "type": types, "size": size, "rolled": rolled,
-                    "success": held if grasp else rolled, "displacement": np.abs(travel),
-                    "rolling_distance": np.where(rolled, np.abs(travel), 0.0), "visible_final": ~off_table,
-                    "outcome": np.where(off_table, "off_table", "rest")})
-    return pd.DataFrame(columns)
+    return final, effect
