@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from affordance_learning.common.verdicts import MET, MISSED, NOT_MEASURED, TOO_FEW
 from affordance_learning.paper.claims import (
     MIN_INTERACTIONS,
     MIN_TRIALS,
@@ -19,8 +20,8 @@ from affordance_learning.paper.claims import (
 from affordance_learning.paper.metrics import wilson_interval
 from affordance_learning.paper.report import render_report
 from affordance_learning.planning.experiment import MULTI_POLICIES, POLICIES, SHAPES, share_text, summarize
-from affordance_learning.common.verdicts import MET, MISSED, NOT_MEASURED, TOO_FEW
 from affordance_learning.planning.report import write_plan_report
+from affordance_learning.planning.results import PlanResults
 from affordance_learning.planning.targets import (
     MIN_CALIBRATION_ACTIONS,
     MIN_EPISODES,
@@ -30,7 +31,6 @@ from affordance_learning.planning.targets import (
     evaluate_targets,
     measured_targets,
 )
-from affordance_learning.planning.results import PlanResults
 
 STRADDLE = "1 x 3 map: a category straddles the critical size"
 SHAPE_TARGET = "each left-out shape, success on its feasible goals"
