@@ -57,16 +57,33 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
     rng = np.random.default_rng(random_state)
     types = np.array(OBJECT_TYPES)[np.arange(n_rows) % 4]
     rng.shuffle(types)
-    kind = np.searchsorted(np.array(sorted(OBJECT_TYPES)), types)  # 0 box, 1 horizontal, 2 sphere, 3 vertical
     size = rng.uniform(*SYNTHETIC_SIZE_RANGES[behavior], n_rows)
     if grasp:
         held = rng.random(n_rows) < 1.0 / (1.0 + np.exp((size - SYNTHETIC_CRITICAL_SIZE) / SYNTHETIC_GRASP_SPREAD))
         rolled = np.zeros(n_rows, dtype=bool)
     else:
         rollable = np.isin(types, ("sphere", "horizontal_cylinder"))
-        rolled = np.where(rollable, rng.random(n_rows) < 0.95, rng.random(n_rows) < 0.03)
+        held, rolled = None, np.where(rollable, rng.random(n_rows) < 0.95, rng.random(n_rows) < 0.03)
+    initial, pixels = _initial_features(rng, types, size)
+    travel, off_table = _travel(rng, types, held, rolled)
+    final, effect = _effects(rng, initial, pixels, travel, types, rolled, off_table)
 
-    # Shape: a latitude and a longitude histogram per type, 12 bins each, perturbed and renormalised.
+    columns: dict[str, Any] = {}
+    for prefix, values in (("initial_", initial), ("final_", final), ("effect_", effect)):
+        columns.update({f"{prefix}{n}": values[:, j] for j, n in enumerate(names)})
+    columns.update({"behavior": np.full(n_rows, behavior), "type": types, "size": size, "rolled": rolled,
+                    "success": held if grasp else rolled, "displacement": np.abs(travel),
+                    "rolling_distance": np.where(rolled, np.abs(travel), 0.0), "visible_final": ~off_table,
+                    "outcome": np.where(off_table, "off_table", "rest")})
+    return pd.DataFrame(columns)
+
+
+def _initial_features(rng: np.random.Generator, types: np.ndarray, size: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The 49 initial features of each object, and its pixel count: shape features (a latitude and a longitude
+    histogram per type, 12 bins each, perturbed and renormalised) by type, size features by size, relation
+    features as jitter."""
+    n_rows = len(types)
+    kind = np.searchsorted(np.array(sorted(OBJECT_TYPES)), types)  # 0 box, 1 horizontal, 2 sphere, 3 vertical
     bins = np.arange(12)
     lat_profiles = np.stack(
         [
@@ -104,15 +121,29 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
     )
     size_features = np.column_stack([mean_xyz, mean_range, pixels, orientation, extents])
     relation = rng.normal(0.0, 1.0, (n_rows, 7)) * np.array([5, 5, 7, 0.02, 0.02, 0.02, 0.03])
-    initial = np.hstack([shape, size_features, relation])
+    return np.hstack([shape, size_features, relation]), pixels
 
-    if grasp:  # Effects: put down 6 cm away when held, nudged by half a centimetre otherwise.
+
+def _travel(rng: np.random.Generator, types: np.ndarray, held: np.ndarray | None,
+            rolled: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """How far each object travels [m], and whether it left the table. A grasp (``held`` given): put down 6 cm
+    away when held, nudged by half a centimetre otherwise. A tap: along the tap direction for rolling objects, 3 %
+    of which leave the table, a 1.5 cm slide otherwise."""
+    n_rows = len(types)
+    if held is not None:
         travel = np.where(held, rng.normal(0.06, 0.004, n_rows), np.abs(rng.normal(0.005, 0.003, n_rows)))
-        off_table = np.zeros(n_rows, dtype=bool)
-    else:  # Effects: travel along the tap direction for rolling objects, a 1.5 cm slide otherwise.
-        roll = np.where(types == "sphere", rng.uniform(0.10, 0.22, n_rows), rng.uniform(0.05, 0.20, n_rows))
-        travel = np.where(rolled, roll, rng.normal(0.015, 0.003, n_rows))
-        off_table = rolled & (rng.random(n_rows) < 0.03)
+        return travel, np.zeros(n_rows, dtype=bool)
+    roll = np.where(types == "sphere", rng.uniform(0.10, 0.22, n_rows), rng.uniform(0.05, 0.20, n_rows))
+    travel = np.where(rolled, roll, rng.normal(0.015, 0.003, n_rows))
+    return travel, rolled & (rng.random(n_rows) < 0.03)
+
+
+def _effects(rng: np.random.Generator, initial: np.ndarray, pixels: np.ndarray, travel: np.ndarray,
+             types: np.ndarray, rolled: np.ndarray, off_table: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The final features and the effects: noise, the travel seen in position, range, pixel count, image offsets
+    and the hand's relation, a lying cylinder's spin in its longitude histogram; an object off the table is not
+    seen (final features all zeros, its effect minus its initial features)."""
+    n_rows = len(types)
     effect = rng.normal(0.0, 1.0, initial.shape) * 0.01 * (np.abs(initial).mean(axis=0) + 1e-3)
     effect[:, 24] += 0.1 * travel  # mean_x
     effect[:, 25] += travel  # mean_y
@@ -126,12 +157,4 @@ def make_synthetic_frame(n_rows: int = 1000, random_state: int = 0, behavior: st
     final = initial + effect
     final[off_table] = 0.0  # not visible: the documented zeros
     effect[off_table] = -initial[off_table]
-
-    columns: dict[str, Any] = {}
-    for prefix, values in (("initial_", initial), ("final_", final), ("effect_", effect)):
-        columns.update({f"{prefix}{n}": values[:, j] for j, n in enumerate(names)})
-    columns.update({"behavior": np.full(n_rows, behavior), "type": types, "size": size, "rolled": rolled,
-                    "success": held if grasp else rolled, "displacement": np.abs(travel),
-                    "rolling_distance": np.where(rolled, np.abs(travel), 0.0), "visible_final": ~off_table,
-                    "outcome": np.where(off_table, "off_table", "rest")})
-    return pd.DataFrame(columns)
+    return final, effect
