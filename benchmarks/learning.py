@@ -60,7 +60,7 @@ def main(argv: list[str] | None = None) -> None:
     start = time.perf_counter()
     results = run_protocol(frame, n_trials=args.trials, random_state=0, n_jobs=args.jobs)
     protocol_s = time.perf_counter() - start
-    n_k, n_r = len(results["config"]["ks"]), len(results["config"]["relevancies"])
+    n_k, n_r = len(results.config.get("ks")), len(results.config.get("relevancies"))
     print(
         f"run_protocol on {args.rows} rows: {n_k} k x {n_r} r x {args.trials} trials "
         f"({n_k * args.trials} maps and ReliefF weightings, {n_k * n_r * args.trials} SVMs), "

@@ -12,8 +12,10 @@ import pytest
 
 from affordance_learning import run_protocol, write_figures, write_report
 from affordance_learning.common.schema import feature_groups, feature_names
+from affordance_learning.common.typed_json import to_json
 from affordance_learning.common.verdicts import MET, MISSED, NOT_MEASURED, WORDS
 from affordance_learning.paper.report import evaluate_claims, write_overview
+from affordance_learning.paper.results import Results
 from affordance_learning.paper.synthetic import make_synthetic_frame
 
 KS = (2, 3, 4)
@@ -27,10 +29,14 @@ def frame() -> pd.DataFrame:
 
 
 @pytest.fixture(scope="module")
-def results(frame: pd.DataFrame) -> dict:
-    return run_protocol(
-        frame, ks=KS, relevancies=RS, n_trials=3, random_state=4, n_jobs=1, som_iterations=600
-    )
+def typed(frame: pd.DataFrame) -> Results:
+    return run_protocol(frame, ks=KS, relevancies=RS, n_trials=3, random_state=4, n_jobs=1, som_iterations=600)
+
+
+@pytest.fixture(scope="module")
+def results(typed: Results) -> dict:
+    """The results as results.json holds them."""
+    return typed.to_dict()
 
 
 def test_synthetic_frame_has_the_dataset_schema(frame: pd.DataFrame) -> None:
@@ -88,6 +94,13 @@ def test_results_follow_the_schema(results: dict, frame: pd.DataFrame) -> None:
     assert json.loads(json.dumps(results, allow_nan=False)) == results
 
 
+def test_the_protocol_builds_the_results_that_its_dict_reads_back_as(typed: Results, results: dict) -> None:
+    assert isinstance(typed, Results) and Results.from_dict(results) == typed
+    assert typed.uniformity[3].mean == results["uniformity"]["3"]["mean"] and typed.clusters(2)[0].left_view >= 0
+    with pytest.raises(TypeError):
+        typed.config.entries["behavior"] = "grasp"  # type: ignore[index]
+
+
 def test_protocol_finds_the_papers_structure_in_synthetic_taps(results: dict) -> None:
     # the synthetic taps roll by shape: clusters follow rolled/not rolled, and shape features are chosen
     assert results["uniformity"]["3"]["mean"] > 0.70
@@ -106,9 +119,9 @@ def test_results_do_not_depend_on_n_jobs(frame: pd.DataFrame, results: dict) -> 
     parallel = run_protocol(
         frame, ks=KS, relevancies=RS, n_trials=3, random_state=4, n_jobs=2, som_iterations=600
     )
-    assert json.dumps(parallel, sort_keys=True) == json.dumps(results, sort_keys=True)
+    assert json.dumps(parallel.to_dict(), sort_keys=True) == json.dumps(results, sort_keys=True)
     other = run_protocol(frame, ks=(4,), relevancies=RS, n_trials=3, random_state=4, som_iterations=600)
-    assert other["uniformity"]["4"] == results["uniformity"]["4"]  # seeds per (trial, k), not per position
+    assert other.to_dict()["uniformity"]["4"] == results["uniformity"]["4"]  # seeds per (trial, k), not position
 
 
 @pytest.mark.parametrize(
@@ -121,6 +134,7 @@ def test_results_do_not_depend_on_n_jobs(frame: pd.DataFrame, results: dict) -> 
         ({"random_state": None}, "random_state"),
         ({"test_size": 1.0}, "test_size"),
         ({"n_neighbors": 0}, "n_neighbors"),
+        ({"extra_config": {"ks": [2]}}, r"extra_config restates the protocol's own settings \['ks'\]"),
     ],
 )
 def test_protocol_refuses_bad_arguments(frame: pd.DataFrame, kwargs: dict, match: str) -> None:
@@ -152,12 +166,12 @@ def test_the_label_is_success_or_else_rolled(frame: pd.DataFrame) -> None:
     # a label that differs from rolled: uniformity and the case study follow success, not rolled
     flipped = frame.assign(success=~frame["rolled"], behavior="push")
     kwargs = {"ks": (2, 3), "relevancies": (0.4,), "n_trials": 1, "som_iterations": 200}
-    ours = run_protocol(flipped, **kwargs)
+    ours = run_protocol(flipped, **kwargs).to_dict()
     assert ours["config"]["label"] == "success" and ours["config"]["behavior"] == "push"
     assert (ours["config"]["success_label"], ours["config"]["fail_label"]) == ("moved", "did not move")
     assert sum(c["success"] for c in ours["case_studies"]["2"]) == (~frame["rolled"]).sum()
     # a frame without success (made before the label existed) is evaluated against rolled, and says so
-    old = run_protocol(frame.drop(columns=["success", "behavior"]), behavior="tap", **kwargs)
+    old = run_protocol(frame.drop(columns=["success", "behavior"]), behavior="tap", **kwargs).to_dict()
     assert old["config"]["label"] == "rolled" and old["config"]["success_label"] == "rolled"
     assert sum(c["success"] for c in old["case_studies"]["2"]) == frame["rolled"].sum()
     assert old["uniformity"] == ours["uniformity"]  # |S - F| is the same with the labels swapped
@@ -170,7 +184,7 @@ def test_the_label_is_success_or_else_rolled(frame: pd.DataFrame) -> None:
 def test_synthetic_grasps_have_a_critical_size() -> None:
     grasps = make_synthetic_frame(400, random_state=3, behavior="grasp")
     assert set(grasps["behavior"]) == {"grasp"} and grasps["size"].between(0.03, 0.09).all()
-    results = run_protocol(grasps, ks=(2, 3, 4), relevancies=(0.4,), n_trials=1, som_iterations=300)
+    results = run_protocol(grasps, ks=(2, 3, 4), relevancies=(0.4,), n_trials=1, som_iterations=300).to_dict()
     config = results["config"]
     assert config["behavior"] == "grasp"
     assert (config["success_label"], config["fail_label"]) == ("lifted and held", "not held")
@@ -184,13 +198,13 @@ def test_synthetic_grasps_have_a_critical_size() -> None:
 def test_a_frame_too_small_to_stratify_gets_a_random_split(frame: pd.DataFrame) -> None:
     lonely = frame.copy()
     lonely.loc[0, "type"] = "cone"
-    results = run_protocol(lonely, ks=(2,), relevancies=(0.4,), n_trials=1, som_iterations=200)
+    results = run_protocol(lonely, ks=(2,), relevancies=(0.4,), n_trials=1, som_iterations=200).to_dict()
     assert (
         "random, not stratified" in results["config"]["split"] and "'cone': 1" in results["config"]["split"]
     )
     assert (
         "stratified by object type"
-        in run_protocol(frame, ks=(2,), n_trials=1, som_iterations=200)["config"]["split"]
+        in run_protocol(frame, ks=(2,), n_trials=1, som_iterations=200).config.get("split")
     )
 
 
@@ -447,7 +461,7 @@ def test_no_critical_size_where_success_does_not_depend_on_size(results: dict, t
     rng = np.random.default_rng(3)
     sizes = rng.uniform(0.04, 0.10, 1000)  # the tap's rolled share drifts from 47 % to 56 % across the sizes
     drift = copy.deepcopy(results)
-    drift["size_success"] = size_success(sizes, rng.random(1000) < 0.47 + 0.09 * (sizes - 0.04) / 0.06)
+    drift["size_success"] = to_json(size_success(sizes, rng.random(1000) < 0.47 + 0.09 * (sizes - 0.04) / 0.06))
     assert drift["size_success"]["critical_size"] is None
     text = render_report(drift)
     assert "Success does not depend on object size" in text and "crosses 50 % at" not in text

@@ -31,6 +31,7 @@ from affordance_learning import (
 )
 from affordance_learning import default_model as default_model_module
 from affordance_learning.paper.metrics import size_success
+from affordance_learning.paper.results import SizeSuccess
 from affordance_learning.paper.synthetic import make_synthetic_frame
 
 # --------------------------------------------------------------------------------------------- fixtures
@@ -91,9 +92,9 @@ def test_purity_rand_and_cross_validated_svm() -> None:
         svm_cv_accuracy(X, np.zeros(300))
 
 
-def intercept_over_slope(found: dict) -> float:
+def intercept_over_slope(found: SizeSuccess) -> float:
     """Where the logistic fit crosses 50 % [m] (with the sign of intercept / slope)."""
-    return found["logistic"]["intercept"] / found["logistic"]["slope"]
+    return found.logistic.intercept / found.logistic.slope
 
 
 def test_size_success_finds_where_success_turns_to_failure() -> None:
@@ -101,24 +102,24 @@ def test_size_success_finds_where_success_turns_to_failure() -> None:
     sizes = rng.uniform(0.03, 0.09, 2000)
     held = rng.random(2000) < 1 / (1 + np.exp((sizes - 0.055) / 0.004))
     found = size_success(sizes, held, n_bins=6)
-    assert found["critical_size"] == pytest.approx(0.055, abs=0.002) and found["logistic"]["slope"] < 0
-    assert [b["n"] for b in found["bins"]] and sum(b["n"] for b in found["bins"]) == 2000
-    assert found["bins"][0]["success"] > 0.95 and found["bins"][-1]["success"] < 0.05
-    below, above = found["below"], found["above"]
-    assert below["n"] + above["n"] == 2000 and below["success"] > 0.8 and above["success"] < 0.2
+    assert found.critical_size == pytest.approx(0.055, abs=0.002) and found.logistic.slope < 0
+    assert [b.n for b in found.bins] and sum(b.n for b in found.bins) == 2000
+    assert found.bins[0].success > 0.95 and found.bins[-1].success < 0.05
+    below, above = found.below, found.above
+    assert below.n + above.n == 2000 and below.success > 0.8 and above.success < 0.2
     # success independent of size (90 % everywhere): a fit, but no crossing of 50 % among the sizes seen
     coin = size_success(sizes, rng.random(2000) < 0.9)
-    assert coin["logistic"] is not None and coin["critical_size"] is None and coin["below"] is None
-    assert found["test"]["depends_on_size"] and found["test"]["p_value"] < 1e-10 and found["test"]["span"] < -0.9
+    assert coin.logistic is not None and coin.critical_size is None and coin.below is None
+    assert found.test.depends_on_size and found.test.p_value < 1e-10 and found.test.span < -0.9
     # a drift that crosses 50 % within the sizes, as the tap's rolled share from 47 % to 56 %: significant
     # perhaps, but success does not depend on size, so no critical size
     drift = size_success(sizes, rng.random(2000) < 0.45 + 0.12 * (sizes - 0.03) / 0.06)
-    assert drift["logistic"] is not None and not drift["test"]["depends_on_size"]
-    assert 0.03 < -intercept_over_slope(drift) < 0.09 and drift["critical_size"] is None and drift["below"] is None
+    assert drift.logistic is not None and not drift.test.depends_on_size
+    assert 0.03 < -intercept_over_slope(drift) < 0.09 and drift.critical_size is None and drift.below is None
     # one outcome only: nothing to fit
     always = size_success(sizes, np.ones(2000, dtype=bool))
-    assert always["logistic"] is None and always["critical_size"] is None
-    assert all(b["success"] == 1.0 for b in always["bins"])
+    assert always.logistic is None and always.critical_size is None
+    assert all(b.success == 1.0 for b in always.bins)
     with pytest.raises(ValueError, match="same length"):
         size_success(sizes, held[:5])
 

@@ -40,9 +40,11 @@ def _format_1(results: dict) -> dict:
 # --- reading -----------------------------------------------------------------------------------------------------
 @pytest.mark.parametrize("where", REPRODUCTIONS, ids=[p.name for p in REPRODUCTIONS])
 def test_a_shipped_results_json_round_trips(where: Path) -> None:
-    found = json.loads((where / "results.json").read_text())
+    text = (where / "results.json").read_text()
+    found = json.loads(text)
     results = Results.from_dict(found)
     assert results.to_dict() == found  # nothing of the file is lost or changed
+    assert json.dumps(results.to_dict(), indent=2) == text  # written back as it was, key order and floats
     assert Results.from_dict(results.to_dict()) == results
     assert json.loads(json.dumps(results.to_dict())) == found
 
@@ -116,8 +118,8 @@ def test_a_missing_key_or_a_value_not_of_the_format_is_named(raw: dict, edit, na
 
 def test_required_sections_are_named_when_missing(raw: dict) -> None:
     without = {k: v for k, v in raw.items() if k not in ("svm_accuracy", "case_studies")}
-    with pytest.raises(InvalidValueError, match=r"results lack \['svm_accuracy', 'case_studies'\]; expected the dict "
-                       "returned by run_protocol"):
+    with pytest.raises(InvalidValueError, match=r"results lack \['svm_accuracy', 'case_studies'\]; expected the "
+                       r"results of run_protocol \(Results.to_dict\(\)"):
         Results.from_dict(without, required=("uniformity", "svm_accuracy", "case_studies"))
     results = Results.from_dict(without)  # the view of what they hold, and then the check
     with pytest.raises(InvalidValueError, match=r"lack \['svm_accuracy'\]"):

@@ -1,8 +1,9 @@
 """Reading a results dict (as ``json.load`` gives it) with errors that say where a value is wrong.
 
-:mod:`affordance_learning.paper.results` and :mod:`affordance_learning.planning.results` read their dicts through a
-:class:`Reader`: each check returns the value in the type asked for, or raises InvalidValueError naming its place
-(``results['uniformity']['3'] lacks 'std'``) and what the reader expected.
+:mod:`affordance_learning.planning.results` reads its dicts through a :class:`Reader`: each check returns the value
+in the type asked for, or raises InvalidValueError naming its place (``plan results['calibration'] lacks 'ece'``)
+and what the reader expected. The paper's results are read from their types by
+:mod:`affordance_learning.common.typed_json`.
 """
 
 from __future__ import annotations

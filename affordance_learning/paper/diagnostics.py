@@ -2,15 +2,16 @@
 
 from __future__ import annotations
 
-from typing import Any
+from types import MappingProxyType
 
 import numpy as np
 import pandas as pd
 
 from affordance_learning.common.schema import TYPE_ORDER, feature_groups, feature_names, label_column
+from affordance_learning.paper.results import Effects, TypeEffects
 
 
-def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:
+def effect_summary(frame: pd.DataFrame) -> Effects:
     """What the effects of a dataset contain, for a reader to check before any verdict.
 
     Per object type (``by_type``): interactions, the shares of successes (the ``success`` label, or
@@ -55,27 +56,27 @@ def effect_summary(frame: pd.DataFrame) -> dict[str, Any]:
     for t in [t for t in TYPE_ORDER if t in set(types)] + sorted(set(types) - set(TYPE_ORDER)):
         rows = types == t
         seen = rows & visible if visible is not None else rows
-        by_type[t] = {
-            "n": int(rows.sum()),
-            "success": share(success, rows),
-            "rest": share(None if outcome is None else outcome == "rest", rows),
-            "visible_final": share(visible, rows),
-            "off_table": share(None if outcome is None else outcome == "off_table", rows),
-            "displacement": median(travel, rows),
-            "seen_motion": median(seen_motion, seen),
-            "pixel_count_change": median(pixels, rows),
-            "shape_change": median(shape_change, rows),
-        }
+        by_type[t] = TypeEffects(
+            n=int(rows.sum()),
+            success=share(success, rows),
+            rest=share(None if outcome is None else outcome == "rest", rows),
+            visible_final=share(visible, rows),
+            off_table=share(None if outcome is None else outcome == "off_table", rows),
+            displacement=median(travel, rows),
+            seen_motion=median(seen_motion, seen),
+            pixel_count_change=median(pixels, rows),
+            shape_change=median(shape_change, rows),
+        )
     correlation = None
     if travel is not None and visible is not None and visible.sum() >= 3:
         from scipy.stats import spearmanr
 
         correlation = float(spearmanr(travel[visible], seen_motion[visible]).statistic)
-    return {
-        "by_type": by_type,
-        "success_visible": share(visible, success),
-        "success_rest_visible": None if visible is None or outcome is None else share(
+    return Effects(
+        by_type=MappingProxyType(by_type),
+        success_visible=share(visible, success),
+        success_rest_visible=None if visible is None or outcome is None else share(
             visible & (outcome == "rest"), success),
-        "success_effect_is_minus_initial": share(vanished, success),
-        "travel_vs_seen_motion": correlation,
-    }
+        success_effect_is_minus_initial=share(vanished, success),
+        travel_vs_seen_motion=correlation,
+    )

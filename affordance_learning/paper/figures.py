@@ -53,7 +53,7 @@ _Section = TypeVar("_Section")
 def _held(section: _Section | None, name: str) -> _Section:
     """A section of the results that :func:`write_figures` made sure they hold (``name`` names it)."""
     if section is None:
-        raise InvalidValueError(f"results lack [{name!r}]; expected the dict returned by run_protocol.")
+        raise InvalidValueError(f"results lack [{name!r}]; expected the results of run_protocol.")
     return section
 
 
@@ -294,11 +294,11 @@ def _cluster(clusters: tuple[Cluster, ...], c: int) -> Cluster | None:
 
 def write_figures(results: Results | Mapping[str, Any], out_dir: str | Path,
                   progress: bool | None = False) -> list[Path]:
-    """Write the figures of a results dict into ``out_dir`` (created if needed); returns their paths.
+    """Write the figures of the results into ``out_dir`` (created if needed); returns their paths.
 
     Args:
-        results: :class:`~affordance_learning.paper.results.Results`, or the dict returned by
-            :func:`affordance_learning.paper.protocol.run_protocol` (or read back from its JSON).
+        results: The :class:`~affordance_learning.paper.results.Results` of
+            :func:`affordance_learning.paper.protocol.run_protocol`, or their dict (a ``results.json`` read back).
         out_dir: Directory for the PNG files.
         progress: Draw a progress bar over the figures; None: a bar on a terminal, else a line every 10 s.
 

@@ -19,6 +19,7 @@ from sklearn.svm import SVC
 
 from affordance_env.values import is_integer
 from affordance_learning.common.exceptions import InvalidValueError
+from affordance_learning.paper.results import Logistic, SizeBin, SizeSide, SizeSuccess, SizeTest
 
 
 def _paired(clusters: ArrayLike, labels: ArrayLike, name: str) -> tuple[np.ndarray, np.ndarray]:
@@ -137,7 +138,7 @@ SIZE_TEST_ALPHA = 0.01
 SIZE_MIN_SPAN = 0.5
 
 
-def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
+def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> SizeSuccess:
     """How success depends on object size: the share of successes per size bin, a logistic fit, a test of
     whether success depends on size at all, and the critical size where it does.
 
@@ -155,12 +156,12 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
         n_bins: Equal-width bins over the sizes seen.
 
     Returns:
-        ``{"bins": [{"low", "high" [m], "n", "success" (share, None for an empty bin)}], "logistic":
-        {"intercept", "slope" [1/m]} or None (only one outcome: nothing to fit), "test": {"p_value", "span"
-        (fitted share at the largest size minus at the smallest), "depends_on_size", "rule"} or None (no fit),
-        "critical_size": [m] or None (success does not depend on size, or the fit does not cross 50 % within
-        the sizes seen), "below", "above": {"n", "success"} (the interactions with objects smaller, and not
-        smaller, than the critical size, and their share of successes; None without a critical size)}``.
+        The share of successes per bin (``low``, ``high`` [m], ``n``, ``success``: None for an empty bin); the
+        logistic fit (``intercept``, ``slope`` [1/m]), None with only one outcome (nothing to fit); the test
+        (``p_value``, ``span``: the fitted share at the largest size minus at the smallest, ``depends_on_size``,
+        ``rule``), None without a fit; the critical size [m], None when success does not depend on size or the
+        fit does not cross 50 % within the sizes seen; and the interactions with objects smaller, and not
+        smaller, than it (``below``, ``above``: ``n`` and their share of successes), None without one.
     """
     from scipy.stats import chi2
     from sklearn.linear_model import LogisticRegression
@@ -174,19 +175,17 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
     low, high = float(sizes.min()), float(sizes.max())
     edges = np.linspace(low, high, n_bins + 1) if high > low else np.array([low, high])
     index = np.clip(np.searchsorted(edges, sizes, side="right") - 1, 0, edges.size - 2)
-    bins = []
-    for b in range(edges.size - 1):
-        members = index == b
-        bins.append({"low": float(edges[b]), "high": float(edges[b + 1]), "n": int(members.sum()),
-                     "success": float(success[members].mean()) if members.any() else None})
-    out: dict = {"bins": bins, "logistic": None, "test": None, "critical_size": None, "below": None, "above": None}
+
+    def side(members: np.ndarray) -> tuple[int, float | None]:
+        return int(members.sum()), float(success[members].mean()) if members.any() else None
+
+    bins = tuple(SizeBin(float(edges[b]), float(edges[b + 1]), *side(index == b)) for b in range(edges.size - 1))
     if success.all() or not success.any() or high == low:
-        return out
+        return SizeSuccess(bins)
     mean, scale = sizes.mean(), sizes.std()
     fit = LogisticRegression(C=1e6, max_iter=1000).fit(((sizes - mean) / scale)[:, None], success)
     slope = float(fit.coef_[0, 0] / scale)
     intercept = float(fit.intercept_[0] - fit.coef_[0, 0] * mean / scale)
-    out["logistic"] = {"intercept": intercept, "slope": slope}
 
     def log_likelihood(p: np.ndarray) -> float:
         p = np.clip(p, 1e-12, 1.0 - 1e-12)
@@ -197,13 +196,11 @@ def size_success(sizes: ArrayLike, success: ArrayLike, n_bins: int = 6) -> dict:
                    - log_likelihood(np.full(sizes.shape, success.mean())))
     p_value, span = float(chi2.sf(max(ratio, 0.0), df=1)), float(fitted[1] - fitted[0])
     depends = p_value < SIZE_TEST_ALPHA and abs(span) >= SIZE_MIN_SPAN
-    out["test"] = {"p_value": p_value, "span": span, "depends_on_size": bool(depends),
-                   "rule": f"likelihood-ratio test of the fit p < {SIZE_TEST_ALPHA:g} and the fitted share "
-                           f"changing by at least {100 * SIZE_MIN_SPAN:.0f} points across the sizes seen"}
-    if depends and slope != 0.0 and low <= -intercept / slope <= high:
-        critical = float(-intercept / slope)
-        out["critical_size"] = critical
-        for side, members in (("below", sizes < critical), ("above", sizes >= critical)):
-            out[side] = {"n": int(members.sum()),
-                         "success": float(success[members].mean()) if members.any() else None}
-    return out
+    fit, test = Logistic(intercept, slope), SizeTest(
+        p_value, span, bool(depends), f"likelihood-ratio test of the fit p < {SIZE_TEST_ALPHA:g} and the fitted "
+        f"share changing by at least {100 * SIZE_MIN_SPAN:.0f} points across the sizes seen")
+    if not (depends and slope != 0.0 and low <= -intercept / slope <= high):
+        return SizeSuccess(bins, fit, test)
+    critical = float(-intercept / slope)
+    return SizeSuccess(bins, fit, test, critical, SizeSide(*side(sizes < critical)),
+                       SizeSide(*side(sizes >= critical)))

@@ -38,9 +38,12 @@ the grasp's critical size) and what the effects contain (:func:`affordance_learn
 simulator.
 """
 
+import copy
+import functools
 import numbers
-from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -58,7 +61,7 @@ from affordance_learning.paper.diagnostics import effect_summary
 from affordance_learning.paper.metrics import adjusted_rand, cluster_purity, make_svm, size_success, uniformity
 from affordance_learning.paper.model import _check_int, select_features
 from affordance_learning.paper.relieff import MULTICLASS_THRESHOLD, ReliefFScorer
-from affordance_learning.paper.results import RESULTS_FORMAT, UNITS, k_key, r_key
+from affordance_learning.paper.results import UNITS, Cluster, Config, Results, Stat, r_key
 from affordance_learning.paper.som import SOMClustering
 
 DEFAULT_KS = tuple(range(2, 11))
@@ -129,109 +132,145 @@ def _frame_data(frame: pd.DataFrame) -> _Data:
     )
 
 
-def _case_study(labels: np.ndarray, k: int, data: _Data, types: Sequence[str]) -> list[dict[str, Any]]:
+@dataclass(frozen=True)
+class _Settings:
+    """The protocol's settings, checked (:func:`_check_protocol_args`)."""
+
+    ks: tuple[int, ...]
+    relevancies: tuple[float, ...]
+    n_trials: int
+    random_state: int
+    test_size: float
+    n_neighbors: int
+    som_iterations: int
+    svm_C: float
+    svm_gamma: float | str
+    case_study_ks: tuple[int, ...]  # those of ks whose clusters are described
+
+
+@dataclass(frozen=True)
+class _Design:
+    """What the frame decides: the behaviour and how its outcomes read, the train/test split, the object types."""
+
+    behavior: str
+    success_label: str
+    fail_label: str
+    stratify: bool
+    split: str  # the split, for config["split"]
+    type_counts: tuple[tuple[str, int], ...]  # (type, count), in the order the results list the types
+
+
+#: The sections of the results measured per k, and per (r, k), in each trial.
+_PER_K = ("uniformity", "purity", "adjusted_rand", "n_categories", "svm_baseline")
+_PER_RK = ("svm_accuracy", "shape_fraction", "size_fraction", "n_selected")
+
+
+@dataclass
+class _Trial:
+    """One trial's numbers, filled in as it runs: per k and per (r, k) by the section of the results they go to,
+    the ReliefF weights per k, and for the first trial the case-study maps' labels and prototypes (in units)."""
+
+    per_k: dict[str, dict[int, float]] = field(default_factory=lambda: {name: {} for name in _PER_K})
+    per_rk: dict[str, dict[tuple[float, int], float]] = field(default_factory=lambda: {n: {} for n in _PER_RK})
+    weights: dict[int, np.ndarray] = field(default_factory=dict)
+    labels: dict[int, np.ndarray] = field(default_factory=dict)
+    prototypes: dict[int, np.ndarray] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class _Split:
+    """A trial's training and test rows, and their initial features."""
+
+    train: np.ndarray
+    test: np.ndarray
+    X_train: np.ndarray
+    X_test: np.ndarray
+
+
+def _case_study(labels: np.ndarray, k: int, data: _Data, types: Sequence[str]) -> tuple[Cluster, ...]:
     """Per map node: success and fail counts, object type counts, object sizes [m] (sorted), and how many of its
     objects were not seen in the final snapshot (``left_view``: their effect is minus their initial features,
     not a motion)."""
     clusters = []
     for c in range(k):
         members = labels == c
-        clusters.append(
-            {
-                "cluster": c,
-                "success": int(np.sum(data.success[members])),
-                "fail": int(np.sum(~data.success[members])),
-                "types": {t: int(np.sum(data.types[members] == t)) for t in types},
-                "sizes": [round(float(s), 6) for s in np.sort(data.sizes[members])],
-                "left_view": int(np.sum(data.left_view[members])),
-            }
-        )
-    return clusters
+        clusters.append(Cluster(
+            index=c,
+            success=int(np.sum(data.success[members])),
+            fail=int(np.sum(~data.success[members])),
+            types=MappingProxyType({t: int(np.sum(data.types[members] == t)) for t in types}),
+            sizes=tuple(round(float(s), 6) for s in np.sort(data.sizes[members])),
+            left_view=int(np.sum(data.left_view[members])),
+        ))
+    return tuple(clusters)
 
 
-def _run_trial(
-    data: _Data,
-    trial: int,
-    random_state: int,
-    ks: Sequence[int],
-    relevancies: Sequence[float],
-    test_size: float,
-    n_neighbors: int,
-    som_iterations: int,
-    svm_C: float,
-    svm_gamma: float | str,
-    case_study_ks: Sequence[int],
-    type_order: Sequence[str],
-    stratify: bool,
-) -> dict[str, Any]:
-    """One trial of the protocol: every k and r; plain numbers keyed by k and (r, k)."""
-    split_seed = np.random.SeedSequence([random_state, trial]).generate_state(1)[0]
-    rows = np.arange(len(data.X))
-    train, test = train_test_split(
-        rows, test_size=test_size, stratify=data.types if stratify else None, random_state=int(split_seed)
-    )
-    X_train, X_test = data.X[train], data.X[test]
-    scorer: ReliefFScorer | None = None
-    out: dict[str, Any] = {
-        key: {} for key in ("uniformity", "purity", "ari", "n_categories", "baseline", "weights", "cases",
-                            "prototypes")
-    }
-    out.update({key: {} for key in ("accuracy", "shape_fraction", "size_fraction", "n_selected")})
-    shape, size = data.groups == "shape", data.groups == "size"
-
-    def record_selection(r: float, k: int, selected: np.ndarray) -> None:
-        out["shape_fraction"][r, k] = float(np.mean(shape[selected]))
-        out["size_fraction"][r, k] = float(np.mean(size[selected]))
-        out["n_selected"][r, k] = int(selected.size)
-
-    for k in ks:
-        seed = np.random.SeedSequence([random_state, trial, k]).generate_state(1)[0]
-        som = SOMClustering(n_clusters=k, n_iterations=som_iterations, random_state=int(seed)).fit(data.Z)
-        labels = som.labels_
-        out["uniformity"][k] = uniformity(labels, data.success) / 100.0  # a fraction, as every share here
-        out["purity"][k] = cluster_purity(labels, data.types)
-        out["ari"][k] = adjusted_rand(labels, data.types)
-        out["n_categories"][k] = int(np.unique(labels).size)
-        if trial == 0 and k in case_study_ks:
-            out["cases"][k] = _case_study(labels, k, data, type_order)
-            # the map's prototype effects, back in feature units (the SOM learned them standardised)
-            out["prototypes"][k] = (som.cluster_centers_ * data.effect_scale + data.effect_mean).tolist()
-        y_train, y_test = labels[train], labels[test]
-        classes, counts = np.unique(y_train, return_counts=True)
-        majority = classes[np.argmax(counts)]
-        out["baseline"][k] = float(np.mean(y_test == majority))
-        if classes.size < 2:
-            # One category among the training rows: nothing to weigh or learn; like AffordanceModel, all
-            # weights are 0, the rule keeps the first feature, and the answer is always that category.
-            out["weights"][k] = np.zeros(len(data.names))
-            for r in relevancies:
-                selected = select_features(out["weights"][k], r)
-                out["accuracy"][r, k] = out["baseline"][k]
-                record_selection(r, k, selected)
-            continue
-        if scorer is None:
-            scorer = ReliefFScorer(StandardScaler().fit_transform(X_train))
-        weights = scorer.weights(y_train, n_neighbors)
-        out["weights"][k] = weights
-        accuracy: dict[tuple[int, ...], float] = {}  # thresholds that keep the same features share one SVM
-        for r in relevancies:
-            selected = select_features(weights, r)
-            key = tuple(selected.tolist())
-            if key not in accuracy:
-                svm = make_svm(svm_C, svm_gamma).fit(X_train[:, selected], y_train)
-                accuracy[key] = float(svm.score(X_test[:, selected], y_test))
-            out["accuracy"][r, k] = accuracy[key]
-            record_selection(r, k, selected)
+def _run_trial(data: _Data, trial: int, settings: _Settings, stratify: bool) -> _Trial:
+    """One trial of the protocol (module docstring): every k and r on one train/test split."""
+    split_seed = np.random.SeedSequence([settings.random_state, trial]).generate_state(1)[0]
+    train, test = train_test_split(np.arange(len(data.X)), test_size=settings.test_size,
+                                   stratify=data.types if stratify else None, random_state=int(split_seed))
+    split = _Split(train, test, data.X[train], data.X[test])
+    # ReliefF's distances over the training rows, once per trial, when a k first has two categories to weigh
+    relieff = functools.cache(lambda: ReliefFScorer(StandardScaler().fit_transform(split.X_train)))
+    out = _Trial()
+    for k in settings.ks:
+        labels = _map_effects(data, trial, k, settings, out)
+        _select_and_learn(data, labels, split, k, settings, relieff, out)
     return out
 
 
-def _stats(values: Iterable[float]) -> dict[str, float | None]:
+def _map_effects(data: _Data, trial: int, k: int, settings: _Settings, out: _Trial) -> np.ndarray:
+    """Step 1 for one k: a 1 x k map categorises every effect; its categories measured against the ground truth.
+    Returns the category of each row."""
+    seed = np.random.SeedSequence([settings.random_state, trial, k]).generate_state(1)[0]
+    som = SOMClustering(n_clusters=k, n_iterations=settings.som_iterations, random_state=int(seed)).fit(data.Z)
+    labels = som.labels_
+    out.per_k["uniformity"][k] = uniformity(labels, data.success) / 100.0  # a fraction, as every share here
+    out.per_k["purity"][k] = cluster_purity(labels, data.types)
+    out.per_k["adjusted_rand"][k] = adjusted_rand(labels, data.types)
+    out.per_k["n_categories"][k] = int(np.unique(labels).size)
+    if trial == 0 and k in settings.case_study_ks:
+        out.labels[k] = labels
+        # the map's prototype effects, back in feature units (the SOM learned them standardised)
+        out.prototypes[k] = som.cluster_centers_ * data.effect_scale + data.effect_mean
+    return labels
+
+
+def _select_and_learn(data: _Data, labels: np.ndarray, split: _Split, k: int, settings: _Settings,
+                      relieff: Callable[[], ReliefFScorer], out: _Trial) -> None:
+    """Steps 3 and 4 for one k: ReliefF weighs the features against the categories of the training rows; per r,
+    the features kept, and the SVM's accuracy on the test rows next to the majority category's."""
+    y_train, y_test = labels[split.train], labels[split.test]
+    classes, counts = np.unique(y_train, return_counts=True)
+    baseline = float(np.mean(y_test == classes[np.argmax(counts)]))
+    out.per_k["svm_baseline"][k] = baseline
+    # One category among the training rows: nothing to weigh or learn; like AffordanceModel, all weights are 0,
+    # the rule keeps the first feature, and the answer is always that category.
+    single = classes.size < 2
+    weights = np.zeros(len(data.names)) if single else relieff().weights(y_train, settings.n_neighbors)
+    out.weights[k] = weights
+    shape, size = data.groups == "shape", data.groups == "size"
+    accuracy: dict[tuple[int, ...], float] = {}  # thresholds that keep the same features share one SVM
+    for r in settings.relevancies:
+        selected = select_features(weights, r)
+        key = tuple(selected.tolist())
+        if not single and key not in accuracy:
+            svm = make_svm(settings.svm_C, settings.svm_gamma).fit(split.X_train[:, selected], y_train)
+            accuracy[key] = float(svm.score(split.X_test[:, selected], y_test))
+        out.per_rk["svm_accuracy"][r, k] = baseline if single else accuracy[key]
+        out.per_rk["shape_fraction"][r, k] = float(np.mean(shape[selected]))
+        out.per_rk["size_fraction"][r, k] = float(np.mean(size[selected]))
+        out.per_rk["n_selected"][r, k] = int(selected.size)
+
+
+def _stats(values: Iterable[float]) -> Stat:
     """Mean and population standard deviation of the finite values; None for both when there are none."""
     array = np.asarray(list(values), dtype=np.float64)
     array = array[np.isfinite(array)]
     if array.size == 0:
-        return {"mean": None, "std": None}
-    return {"mean": float(array.mean()), "std": float(array.std())}
+        return Stat(None, None)
+    return Stat(float(array.mean()), float(array.std()))
 
 
 def _check_protocol_args(
@@ -271,6 +310,107 @@ def _check_protocol_args(
     return [int(k) for k in ks], [float(r) for r in relevancies]
 
 
+def _design(df: pd.DataFrame, data: _Data, behavior: str | None, test_size: float) -> _Design:
+    """The behaviour (the frame's, or ``behavior``), its success and fail words, and the split: stratified by type
+    when every type can be on both sides; otherwise (a tiny frame) a plain random split, and the config says so."""
+    behavior = frame_behavior(df, behavior)
+    if data.label == "rolled" and behavior not in ROLLED_IS_SUCCESS:
+        raise InvalidValueError(
+            f"the frame has no 'success' column, and the success of {behavior!r} is not 'rolled' (that stands in "
+            f"only for {', '.join(ROLLED_IS_SUCCESS)}): load the dataset with an affordance_env that stores or "
+            "derives 'success' (dataset schema 4)."
+        )
+    type_counts = pd.Series(data.types).value_counts()
+    n_test = int(np.ceil(test_size * len(data.X)))
+    if min(n_test, len(data.X) - n_test) < 2:
+        raise InvalidValueError(
+            f"{len(data.X)} rows with test_size={test_size} leave {n_test} test and {len(data.X) - n_test} "
+            "training rows; expected at least 2 of each."
+        )
+    stratify = bool(type_counts.min() >= 2 and min(n_test, len(data.X) - n_test) >= type_counts.size)
+    split = (
+        "stratified by object type"
+        if stratify
+        else f"random, not stratified (type counts {type_counts.to_dict()} too small to stratify)"
+    )
+    type_order = [t for t in TYPE_ORDER if t in type_counts.index] + sorted(
+        t for t in type_counts.index if t not in TYPE_ORDER
+    )
+    return _Design(behavior, *outcome_words(behavior, data.label), stratify, split,
+                   tuple((t, int(type_counts[t])) for t in type_order))
+
+
+def _config(data: _Data, settings: _Settings, design: _Design, extra: Mapping[str, Any]) -> Config:
+    """The settings the results record: the protocol's, then ``extra`` (the caller's, such as ``affordance
+    reproduce``'s dataset and seed), which may not restate one of the protocol's."""
+    groups = feature_groups(data.names)
+    entries = {
+        "behavior": design.behavior,
+        "label": data.label,
+        "success_label": design.success_label,
+        "fail_label": design.fail_label,
+        "ks": list(settings.ks),
+        "relevancies": list(settings.relevancies),
+        "n_trials": settings.n_trials,
+        "random_state": settings.random_state,
+        "n_rows": int(len(data.X)),
+        "n_features": len(data.names),
+        "feature_groups": {g: groups.count(g) for g in dict.fromkeys(groups)},
+        "type_counts": dict(design.type_counts),
+        "success_fraction": float(np.mean(data.success)),
+        "test_size": settings.test_size,
+        "split": f"train/test split per trial, {design.split}, shared by every k and r",
+        "clustering": "1 x k minisom map of the standardised effects of all rows, seeded per (trial, k)",
+        "relieff": "skrebate-equivalent ReliefF, standardised initial features of the training rows",
+        "n_neighbors": settings.n_neighbors,
+        "som_iterations": settings.som_iterations,
+        "svm": {"kernel": "rbf", "C": float(settings.svm_C), "gamma": settings.svm_gamma, "scaling": "standard"},
+        "case_study_ks": list(settings.case_study_ks),
+        "case_study_trial": 0,
+        "std": "population standard deviation over trials (ddof=0)",
+        "units": UNITS,
+    }
+    restated = [key for key in extra if key in entries]
+    if restated:
+        raise InvalidValueError(f"extra_config restates the protocol's own settings {restated}; give other keys.")
+    return Config(MappingProxyType({**entries, **copy.deepcopy(dict(extra))}))
+
+
+def _run_trials(data: _Data, settings: _Settings, stratify: bool, n_jobs: int | None,
+                progress: bool | None) -> list[_Trial]:
+    """Every trial, in parallel, gathered in trial order whatever the workers: the results do not depend on
+    ``n_jobs``."""
+    from affordance_env.progress import progress_bar
+
+    jobs = (delayed(_run_trial)(data, t, settings, stratify) for t in range(settings.n_trials))
+    with progress_bar(progress, total=settings.n_trials, unit="trial", desc="learning trials") as bar:
+        trials = []
+        for trial in Parallel(n_jobs=n_jobs, return_as="generator")(jobs):
+            trials.append(trial)
+            bar.update()
+    return trials
+
+
+def _over_trials(trials: Sequence[_Trial], data: _Data, settings: _Settings, design: _Design) -> dict[str, Any]:
+    """The sections of the results drawn from the trials: the means and spreads per k and per (r, k), the mean
+    ReliefF weights per k, and the first trial's case studies."""
+    ks, rs, first = settings.ks, settings.relevancies, trials[0]
+    types = [t for t, _ in design.type_counts]
+    return {
+        **{name: MappingProxyType({k: _stats(t.per_k[name][k] for t in trials) for k in ks}) for name in _PER_K},
+        **{name: MappingProxyType({r: MappingProxyType({k: _stats(t.per_rk[name][r, k] for t in trials)
+                                                        for k in ks}) for r in rs}) for name in _PER_RK},
+        "case_studies": MappingProxyType({k: _case_study(first.labels[k], k, data, types)
+                                          for k in settings.case_study_ks}),
+        "prototypes": MappingProxyType({k: tuple(tuple(row) for row in first.prototypes[k].tolist())
+                                        for k in settings.case_study_ks}),
+        "feature_weights": MappingProxyType({
+            k: MappingProxyType(dict(zip(data.names, np.mean([t.weights[k] for t in trials], axis=0).tolist(),
+                                         strict=True)))
+            for k in ks}),
+    }
+
+
 def run_protocol(
     df: pd.DataFrame,
     ks: Iterable[int] = DEFAULT_KS,
@@ -287,8 +427,9 @@ def run_protocol(
     case_study_ks: Iterable[int] = CASE_STUDY_KS,
     progress: bool | None = False,
     behavior: str | None = None,
-) -> dict[str, Any]:
-    """Run the paper's protocol (module docstring) on a dataset frame; returns a JSON-ready results dict.
+    extra_config: Mapping[str, Any] | None = None,
+) -> Results:
+    """Run the paper's protocol (module docstring) on a dataset frame.
 
     Args:
         df: One behaviour's interactions in the dataset schema (at least the initial_ and effect_ columns,
@@ -308,142 +449,30 @@ def run_protocol(
             (:func:`affordance_env.progress.progress_bar`).
         behavior: The behaviour of the interactions; by default the frame's ``behavior`` column says it (and
             when given, it must agree with that column); needed for a frame without the column.
+        extra_config: Further settings to record in ``config`` after the protocol's own (``affordance
+            reproduce`` records its dataset, episodes, seed, ...), JSON values; none may restate one of them.
 
     Returns:
-        ``{"uniformity": {"<k>": {"mean", "std"}}`` [0, 1] (against the success/fail labels; a fraction like
-        every share here, :data:`affordance_learning.paper.results.UNITS`),
-        ``"svm_accuracy": {"<r>": {"<k>": {"mean", "std"}}}`` [0, 1], ``"shape_fraction"`` and
-        ``"size_fraction"`` (same keys; shares of shape and size features among the selected ones) [0, 1],
-        ``"n_selected"`` (same keys), ``"case_studies": {"<k>": [{"cluster", "success", "fail", "types":
-        {type: count}, "sizes": [m, ...], "left_view": count}]}``, ``"prototypes": {"<k>": [[effect per
-        feature], ...]}``,
-        ``"feature_names"``, ``"effects"`` (:func:`effect_summary`), ``"size_success"``
-        (:func:`affordance_learning.paper.metrics.size_success`), ``"purity"``, ``"adjusted_rand"`` (against the
-        object type), ``"n_categories"`` (non-empty clusters), ``"svm_baseline"`` (majority-category
-        accuracy), all ``{"<k>": {"mean", "std"}}``, ``"feature_weights": {"<k>": {name: mean ReliefF
-        weight}}``, and ``"config"``, which names the ``behavior``, the ``label`` column and how a success and
-        a failure read (``success_label``, ``fail_label``). r is written as ``str(float(r))`` ("0.0", "0.2",
-        ..., :func:`~.results.r_key`), k as ``str(k)`` (:func:`~.results.k_key`).
-        The schema is the same for every behaviour. A mean over no finite value is None.
-        :meth:`affordance_learning.paper.results.Results.from_dict` reads it.
+        The :class:`~affordance_learning.paper.results.Results` of every section: per k the uniformity (against
+        the success/fail labels; a fraction like every share here, :data:`affordance_learning.paper.results.UNITS`),
+        purity and adjusted Rand index (against the object type), non-empty clusters and majority-category
+        accuracy (``svm_baseline``); per r and k the SVM accuracy, the shares of shape and size features among
+        the selected ones and their number; the case studies and prototypes of the first trial's maps of
+        ``case_study_ks``; the feature names and their mean ReliefF weights per k; the effects
+        (:func:`effect_summary`) and success by size (:func:`affordance_learning.paper.metrics.size_success`);
+        and ``config``, which names the ``behavior``, the ``label`` column and how a success and a failure read
+        (``success_label``, ``fail_label``). A mean over no finite value is None. The schema is the same for
+        every behaviour; :meth:`~affordance_learning.paper.results.Results.to_dict` gives the ``results.json``
+        (r keyed ``str(float(r))``, k ``str(k)``).
     """
-    ks, relevancies = _check_protocol_args(
-        ks, relevancies, n_trials, random_state, test_size, n_neighbors, som_iterations
-    )
-    case_study_ks = [k for k in case_study_ks if k in ks]
+    checked_ks, checked_rs = _check_protocol_args(ks, relevancies, n_trials, random_state, test_size, n_neighbors,
+                                                  som_iterations)
+    settings = _Settings(tuple(checked_ks), tuple(checked_rs), int(n_trials), int(random_state), float(test_size),
+                         int(n_neighbors), int(som_iterations), svm_C, svm_gamma,
+                         tuple(k for k in case_study_ks if k in checked_ks))
     data = _frame_data(df)
-    behavior = frame_behavior(df, behavior)
-    if data.label == "rolled" and behavior not in ROLLED_IS_SUCCESS:
-        raise InvalidValueError(
-            f"the frame has no 'success' column, and the success of {behavior!r} is not 'rolled' (that stands in "
-            f"only for {', '.join(ROLLED_IS_SUCCESS)}): load the dataset with an affordance_env that stores or "
-            "derives 'success' (dataset schema 4)."
-        )
-    success_label, fail_label = outcome_words(behavior, data.label)
-    type_counts = pd.Series(data.types).value_counts()
-    n_test = int(np.ceil(test_size * len(data.X)))
-    if min(n_test, len(data.X) - n_test) < 2:
-        raise InvalidValueError(
-            f"{len(data.X)} rows with test_size={test_size} leave {n_test} test and {len(data.X) - n_test} "
-            "training rows; expected at least 2 of each."
-        )
-    # Stratified by type when every type can be on both sides; otherwise (a tiny frame) a plain random
-    # split, and the config says so.
-    stratify = bool(type_counts.min() >= 2 and min(n_test, len(data.X) - n_test) >= type_counts.size)
-    split = (
-        "stratified by object type"
-        if stratify
-        else f"random, not stratified (type counts {type_counts.to_dict()} too small to stratify)"
-    )
-    type_order = [t for t in TYPE_ORDER if t in type_counts.index] + sorted(
-        t for t in type_counts.index if t not in TYPE_ORDER
-    )
-    jobs = (
-        delayed(_run_trial)(
-            data,
-            t,
-            int(random_state),
-            ks,
-            relevancies,
-            float(test_size),
-            n_neighbors,
-            som_iterations,
-            svm_C,
-            svm_gamma,
-            case_study_ks,
-            type_order,
-            stratify,
-        )
-        for t in range(n_trials)
-    )
-    from affordance_env.progress import progress_bar
-
-    # in trial order whatever the workers: the results do not depend on n_jobs
-    with progress_bar(progress, total=n_trials, unit="trial", desc="learning trials") as bar:
-        trials = []
-        for trial in Parallel(n_jobs=n_jobs, return_as="generator")(jobs):
-            trials.append(trial)
-            bar.update()
-
-    def per_k(key: str) -> dict[str, dict[str, float | None]]:
-        return {k_key(k): _stats(trial[key][k] for trial in trials) for k in ks}
-
-    def per_rk(key: str) -> dict[str, dict[str, dict[str, float | None]]]:
-        return {
-            r_key(r): {k_key(k): _stats(trial[key][r, k] for trial in trials) for k in ks} for r in relevancies
-        }
-
-    groups = feature_groups(data.names)
-    return {
-        "results_format": RESULTS_FORMAT,
-        "uniformity": per_k("uniformity"),
-        "svm_accuracy": per_rk("accuracy"),
-        "shape_fraction": per_rk("shape_fraction"),
-        "size_fraction": per_rk("size_fraction"),
-        "n_selected": per_rk("n_selected"),
-        "case_studies": {k_key(k): trials[0]["cases"][k] for k in case_study_ks},
-        "prototypes": {k_key(k): trials[0]["prototypes"][k] for k in case_study_ks},
-        "feature_names": list(data.names),
-        "effects": effect_summary(df),
-        "size_success": size_success(data.sizes, data.success),
-        "purity": per_k("purity"),
-        "adjusted_rand": per_k("ari"),
-        "n_categories": per_k("n_categories"),
-        "svm_baseline": per_k("baseline"),
-        "feature_weights": {
-            k_key(k): dict(
-                zip(
-                    data.names,
-                    np.mean([trial["weights"][k] for trial in trials], axis=0).tolist(),
-                    strict=True,
-                )
-            )
-            for k in ks
-        },
-        "config": {
-            "behavior": behavior,
-            "label": data.label,
-            "success_label": success_label,
-            "fail_label": fail_label,
-            "ks": ks,
-            "relevancies": relevancies,
-            "n_trials": int(n_trials),
-            "random_state": int(random_state),
-            "n_rows": int(len(data.X)),
-            "n_features": len(data.names),
-            "feature_groups": {g: groups.count(g) for g in dict.fromkeys(groups)},
-            "type_counts": {t: int(type_counts[t]) for t in type_order},
-            "success_fraction": float(np.mean(data.success)),
-            "test_size": float(test_size),
-            "split": f"train/test split per trial, {split}, shared by every k and r",
-            "clustering": "1 x k minisom map of the standardised effects of all rows, seeded per (trial, k)",
-            "relieff": "skrebate-equivalent ReliefF, standardised initial features of the training rows",
-            "n_neighbors": int(n_neighbors),
-            "som_iterations": int(som_iterations),
-            "svm": {"kernel": "rbf", "C": float(svm_C), "gamma": svm_gamma, "scaling": "standard"},
-            "case_study_ks": list(case_study_ks),
-            "case_study_trial": 0,
-            "std": "population standard deviation over trials (ddof=0)",
-            "units": UNITS,
-        },
-    }
+    design = _design(df, data, behavior, settings.test_size)
+    config = _config(data, settings, design, extra_config or {})
+    trials = _run_trials(data, settings, design.stratify, n_jobs, progress)
+    return Results(**_over_trials(trials, data, settings, design), feature_names=tuple(data.names),
+                   effects=effect_summary(df), size_success=size_success(data.sizes, data.success), config=config)

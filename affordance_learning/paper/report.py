@@ -242,8 +242,8 @@ def write_report(results: Results | Mapping[str, Any], out_dir: str | Path) -> P
     """Write ``REPORT.md`` into ``out_dir`` (created if needed), linking the PNG figures found there.
 
     Args:
-        results: :class:`~affordance_learning.paper.results.Results`, or the dict returned by
-            :func:`affordance_learning.paper.protocol.run_protocol` (or its JSON).
+        results: The :class:`~affordance_learning.paper.results.Results` of
+            :func:`affordance_learning.paper.protocol.run_protocol`, or their dict (a ``results.json`` read back).
         out_dir: Output directory.
 
     Returns:
@@ -253,10 +253,11 @@ def write_report(results: Results | Mapping[str, Any], out_dir: str | Path) -> P
         InvalidValueError: ``results`` are not the protocol's: no uniformity, or a section not of the format.
     """
     if not isinstance(results, Results | Mapping):
-        raise InvalidValueError(f"results must be the dict returned by run_protocol, got {type(results).__name__}.")
+        raise InvalidValueError(f"results must be the results of run_protocol (Results or its dict), got "
+                                f"{type(results).__name__}.")
     results = as_results(results)
     if results.uniformity is None:
-        raise InvalidValueError("results must be the dict returned by run_protocol (it has no 'uniformity').")
+        raise InvalidValueError("results must be the results of run_protocol (these have no 'uniformity').")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     figures = sorted(p.name for p in out.glob("*.png"))
@@ -340,18 +341,18 @@ def write_overview(runs: Mapping[str, Results | Mapping[str, Any]], out_dir: str
     with their verdicts, and links to its report and figures in ``out_dir/<behavior>/``.
 
     Args:
-        runs: The results dict of each behaviour (:func:`affordance_learning.paper.protocol.run_protocol`), by
-            behaviour, in the order to show them.
+        runs: The results of each behaviour (:func:`affordance_learning.paper.protocol.run_protocol`, Results or
+            their dict), by behaviour, in the order to show them.
         out_dir: Output directory, holding one directory per behaviour.
 
     Returns:
         The path of ``REPORT.md``.
     """
     if not runs or not all(isinstance(r, Results | Mapping) for r in runs.values()):
-        raise InvalidValueError("runs must map each behaviour to the dict returned by run_protocol.")
+        raise InvalidValueError("runs must map each behaviour to the results of run_protocol.")
     read = {behavior: as_results(results) for behavior, results in runs.items()}
     if not all(results.uniformity is not None for results in read.values()):
-        raise InvalidValueError("runs must map each behaviour to the dict returned by run_protocol.")
+        raise InvalidValueError("runs must map each behaviour to the results of run_protocol.")
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     figures = {b: sorted(p.name for p in (out / b).glob("*.png")) for b in read}

@@ -42,18 +42,6 @@ if TYPE_CHECKING:
 DEFAULT_BEHAVIORS = ("tap", "grasp")
 
 
-def _jsonable(value):
-    if isinstance(value, dict):
-        return {str(k): _jsonable(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    return value
-
-
 def _shown_path(path: Path, out: Path) -> str:
     """``path`` relative to the output directory when it lies inside it (the report then reads the same on any
     machine), else as given."""
@@ -74,7 +62,7 @@ def reproduce(
     datasets: Mapping[str, Path] | None = None,
     progress: bool | None = None,
     range_noise: str | None = None,
-) -> dict[str, dict[str, Any]]:
+) -> dict[str, Results]:
     """Run the whole experiment for each behaviour and write its outputs into ``out``.
 
     Args:
@@ -90,7 +78,7 @@ def reproduce(
         range_noise: Collect with the range camera's noise model on (for example ``"kinect_v1"``).
 
     Returns:
-        The results dict of each behaviour run, by behaviour.
+        The results of each behaviour run, by behaviour.
     """
     import affordance_env.behaviors as env_behaviors
     from affordance_learning.common.behaviors import check_env_offers
@@ -111,13 +99,13 @@ def reproduce(
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     start = time.perf_counter()
-    runs: dict[str, dict[str, Any]] = {}
+    runs: dict[str, Results] = {}
     for behavior in behaviors:
         runs[behavior] = _reproduce_one(
             out, behavior, datasets.get(behavior), episodes=episodes, trials=trials, seed=seed, workers=workers,
             progress=progress, range_noise=range_noise,
         )
-    found: dict[str, Results | dict[str, Any]] = {**_earlier_runs(out, behaviors), **runs}
+    found: dict[str, Results] = {**_earlier_runs(out, behaviors), **runs}
     order = [b for b in BEHAVIOR_NAMES if b in found] + sorted(set(found) - set(BEHAVIOR_NAMES))
     overview = write_overview({b: found[b] for b in order}, out)
     print(f"total {time.perf_counter() - start:.1f} s")
@@ -129,7 +117,7 @@ def reproduce(
 
 
 def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: int, trials: int, seed: int,
-                   workers: int, progress: bool | None, range_noise: str | None) -> dict[str, Any]:
+                   workers: int, progress: bool | None, range_noise: str | None) -> Results:
     """Collect, learn and report one behaviour into ``out/<behavior>``; returns its results."""
     from affordance_env.dataset import collect, failure_summary, load_dataset
     from affordance_env.dataset.fingerprint import fingerprint
@@ -155,15 +143,13 @@ def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: 
           f"({collected - start:.1f} s)")
     print(f"[{behavior} 2/3] learning protocol: k = 2..10, r in 0.0..0.8, {trials} trials")
     results = run_protocol(frame, n_trials=trials, random_state=seed, n_jobs=workers, progress=progress,
-                           behavior=behavior)
-    results["config"].update(
-        {"episodes": int(len(frame)), "dataset": _shown_path(dataset, where), "seed": seed, "trials": trials,
-         "range_noise": range_noise or "none"}
-    )
+                           behavior=behavior,
+                           extra_config={"episodes": int(len(frame)), "dataset": _shown_path(dataset, where),
+                                         "seed": seed, "trials": trials, "range_noise": range_noise or "none"})
     learned = time.perf_counter()
     print(f"      done ({learned - collected:.1f} s)")
     print(f"[{behavior} 3/3] writing results.json, {FINGERPRINT}, figures and REPORT.md into {where}")
-    (where / "results.json").write_text(json.dumps(_jsonable(results), indent=2))
+    (where / "results.json").write_text(json.dumps(results.to_dict(), indent=2))
     _write_fingerprint(fingerprint(frame), where)
     figures = write_figures(results, where, progress=progress)
     write_report(results, where)

@@ -1,30 +1,33 @@
-"""The results of :func:`~affordance_learning.paper.protocol.run_protocol`: their format and units, the reading of older
-ones, and :class:`Results`, the typed, read-only view every report, figure and check reads them through.
+"""The results of :func:`~affordance_learning.paper.protocol.run_protocol`: :class:`Results`, the typed, read-only
+results that the protocol builds and every report, figure and check reads; their format and units; the reading of
+older ones.
 
 Units (:data:`UNITS`, also written into every results dict as ``config["units"]``): every share is a fraction
 in [0, 1] (uniformity, SVM accuracy and its baseline, the shape and size shares of the selected features, the
 share of successes, purity); sizes and distances are in metres, times in seconds. Reports and figures show
 shares as percentages.
 
-The results dict (and its ``results.json``) keys a map size k by :func:`k_key` (``str(k)``: "2", "3", ...) and a
-relevancy threshold r by :func:`r_key` (``str(float(r))``: "0.0", "0.2", ...); :class:`Results` keys them by
-number, so that no reader handles those strings.
+:class:`Results` and its parts are written to the results dict (``results.json``) and read back by
+:mod:`affordance_learning.common.typed_json`, from their types: the dict keys a map size k by :func:`k_key`
+(``str(k)``: "2", "3", ...) and a relevancy threshold r by :func:`r_key` (``str(float(r))``: "0.0", "0.2", ...);
+:class:`Results` keys them by number, so that no reader handles those strings.
 
 Format 1 (written before ``results_format`` existed) gave the uniformity in percent; :func:`current_results`
-reads it as format 2, so reports, figures and claims can be drawn from an ``results.json`` of either.
+upgrades it to format 2 before it is read, so reports, figures and claims can be drawn from a ``results.json``
+of either. A newer format is refused, naming it.
 """
 
 from __future__ import annotations
 
 import copy
-from collections.abc import Callable, Iterable, Iterator, Mapping, MutableMapping
+import numbers
+from collections.abc import Iterable, Iterator, Mapping, MutableMapping
 from dataclasses import dataclass, field, fields
 from types import MappingProxyType
-from typing import Any
+from typing import Annotated, Any
 
 from affordance_learning.common.exceptions import InvalidValueError
-from affordance_learning.common.json_reading import Path as _Path
-from affordance_learning.common.json_reading import Reader, is_number
+from affordance_learning.common.typed_json import from_json, json_options, to_json
 
 #: Version of the results dict; raise it when the meaning or the unit of a key changes.
 RESULTS_FORMAT = 2
@@ -38,11 +41,12 @@ UNIFORMITY_DEFINITION = (
     "as many of both."
 )
 #: What the error messages point to.
-_EXPECTED = "expected the dict returned by run_protocol"
+_EXPECTED = "expected the results of run_protocol (Results.to_dict(), or its results.json read back)"
 
-_READ = Reader("results", _EXPECTED)
-_where, _mapping, _list, _entry = _READ.where, _READ.mapping, _READ.list, _READ.entry
-_number, _count, _is_number = _READ.number, _READ.count, is_number
+#: How the results key a map size k, a relevancy threshold r, and a count, for the messages on a value not of them.
+K = Annotated[int, "a map size k"]
+R = Annotated[float, "a relevancy threshold r"]
+Count = Annotated[int, "a count"]
 
 
 def k_key(k: int) -> str:
@@ -70,10 +74,15 @@ def current_results(results: Mapping[str, Any]) -> Mapping[str, Any]:
     uniformity = upgraded.get("uniformity")
     for entry in (uniformity.values() if isinstance(uniformity, Mapping) else ()):
         for key in ("mean", "std"):
-            if isinstance(entry, MutableMapping) and entry.get(key) is not None:
+            if isinstance(entry, MutableMapping) and _is_number(entry.get(key)):  # others are refused when read
                 entry[key] = entry[key] / 100.0
     upgraded["results_format"] = RESULTS_FORMAT
     return upgraded
+
+
+def _section() -> Any:
+    """A section of :class:`Results`: None, and then left out of the results dict, when the results lack it."""
+    return field(default=None, metadata=json_options(omit_none=True))
 
 
 # --- the parts ------------------------------------------------------------------------------------------------
@@ -90,15 +99,11 @@ class Stat:
     mean: float | None
     std: float | None
 
-    def to_dict(self) -> dict[str, float | None]:
-        """``{"mean", "std"}``, as the results dict holds it."""
-        return {"mean": self.mean, "std": self.std}
-
 
 #: A number per map size k (k -> :class:`Stat`), read-only, in the order the results hold it.
-PerK = Mapping[int, Stat]
+PerK = Mapping[K, Stat]
 #: A number per relevancy threshold r and map size k (r -> k -> :class:`Stat`), read-only, in the order held.
-PerRK = Mapping[float, PerK]
+PerRK = Mapping[R, PerK]
 _NO_STATS: PerK = MappingProxyType({})
 
 
@@ -116,23 +121,17 @@ class Cluster:
             which did not count them.
     """
 
-    index: int
-    success: int
-    fail: int
-    types: Mapping[str, int]
+    index: Count = field(metadata=json_options(key="cluster"))
+    success: Count
+    fail: Count
+    types: Mapping[str, Count]
     sizes: tuple[float, ...] = field(repr=False)
-    left_view: int | None = None
+    left_view: Count | None = field(default=None, metadata=json_options(omit_none=True))
 
     @property
     def n(self) -> int:
         """The interactions in the cluster."""
         return self.success + self.fail
-
-    def to_dict(self) -> dict[str, Any]:
-        """The cluster as the results dict holds it."""
-        out = {"cluster": self.index, "success": self.success, "fail": self.fail, "types": dict(self.types),
-               "sizes": list(self.sizes)}
-        return out if self.left_view is None else {**out, "left_view": self.left_view}
 
 
 @dataclass(frozen=True)
@@ -141,7 +140,7 @@ class SizeBin:
 
     low: float
     high: float
-    n: int
+    n: Count
     success: float | None
 
 
@@ -170,7 +169,7 @@ class SizeSide:
     """The interactions on one side of the critical size (``below``: smaller objects, ``above``: the others) and
     their share of successes (None when there are none)."""
 
-    n: int
+    n: Count
     success: float | None
 
 
@@ -205,14 +204,6 @@ class SizeSuccess:
             return None
         return self.critical_size, self.below.success, self.above.success
 
-    def to_dict(self) -> dict[str, Any]:
-        """The section as the results dict holds it."""
-        def plain(part: Any) -> Any:
-            return None if part is None else {f.name: getattr(part, f.name) for f in fields(part)}
-
-        return {"bins": [plain(b) for b in self.bins], "logistic": plain(self.logistic), "test": plain(self.test),
-                "critical_size": self.critical_size, "below": plain(self.below), "above": plain(self.above)}
-
 
 @dataclass(frozen=True)
 class TypeEffects:
@@ -221,7 +212,7 @@ class TypeEffects:
     table; the medians of the travel [m], of the 3-D motion seen [m], of the change of the pixel count [pixels] and
     of the normal histograms (sum of |effect| over the shape features). None where the dataset could not say."""
 
-    n: int
+    n: Count
     success: float | None
     rest: float | None
     visible_final: float | None
@@ -244,19 +235,15 @@ class Effects:
     success_effect_is_minus_initial: float | None = None
     travel_vs_seen_motion: float | None = None
 
-    def to_dict(self) -> dict[str, Any]:
-        """The section as the results dict holds it."""
-        by_type = {t: {f.name: getattr(row, f.name) for f in fields(row)} for t, row in self.by_type.items()}
-        return {"by_type": by_type, **{f.name: getattr(self, f.name) for f in fields(self) if f.name != "by_type"}}
-
 
 @dataclass(frozen=True)
 class Config:
     """The settings a results dict records (``config``): read through the typed properties what is computed on,
     and through :meth:`get` and :meth:`items` anything else, as written (the protocol's and ``affordance
-    reproduce``'s settings, for the reports to list)."""
+    reproduce``'s settings, for the reports to list). The JSON holds the settings themselves."""
 
-    entries: Mapping[str, Any]
+    entries: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}),
+                                       metadata=json_options(inline=True))
 
     def get(self, key: str, default: Any = None) -> Any:
         """The setting ``key`` as written (a copy: the results stay as they were read), or ``default``."""
@@ -302,21 +289,17 @@ class Config:
 # --- the results ----------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class Results:
-    """The results of :func:`~affordance_learning.paper.protocol.run_protocol` (or of its ``results.json``), typed and
-    read-only, in the current format: build it with :meth:`from_dict`.
+    """The results of :func:`~affordance_learning.paper.protocol.run_protocol` (or of its ``results.json``, read
+    with :meth:`from_dict`), typed and read-only, in the current format.
 
     Every section is None when the results lack it (results may be partial: the claims on what they hold are
     still judged). Map sizes k are ints, relevancy thresholds r floats; each mapping keeps the order the results
-    hold. Shares are fractions in [0, 1] (:data:`UNITS`).
+    hold. Shares are fractions in [0, 1] (:data:`UNITS`). The fields are in the order ``results.json`` holds
+    them.
 
     Attributes:
-        results_format: The format read (:data:`RESULTS_FORMAT`; format 1 is upgraded).
-        config: The recorded settings.
+        results_format: The format (:data:`RESULTS_FORMAT`; format 1 is upgraded when read).
         uniformity: Uniformity of the clusters against the success/fail labels, per k [fraction].
-        purity: Purity of the clusters against the object type, per k [fraction].
-        adjusted_rand: Adjusted Rand index of the clusters against the object type, per k.
-        n_categories: Non-empty clusters, per k.
-        svm_baseline: Accuracy of always answering the most common training category, per k [fraction].
         svm_accuracy: SVM accuracy on held-out interactions, per r and k [fraction].
         shape_fraction: Share of shape features among the selected ones, per r and k [fraction].
         size_fraction: Share of size features among the selected ones, per r and k [fraction].
@@ -325,36 +308,40 @@ class Results:
         prototypes: The prototype effect of each node of those maps, per k, in feature units (one row per node,
             one value per feature of :attr:`feature_names`).
         feature_names: The names of the features.
-        feature_weights: The mean ReliefF weight of each feature, per k.
         effects: What the effects contain.
         size_success: How success depends on object size.
+        purity: Purity of the clusters against the object type, per k [fraction].
+        adjusted_rand: Adjusted Rand index of the clusters against the object type, per k.
+        n_categories: Non-empty clusters, per k.
+        svm_baseline: Accuracy of always answering the most common training category, per k [fraction].
+        feature_weights: The mean ReliefF weight of each feature, per k.
+        config: The recorded settings.
     """
 
-    results_format: int
-    config: Config
-    uniformity: PerK | None = None
-    purity: PerK | None = None
-    adjusted_rand: PerK | None = None
-    n_categories: PerK | None = None
-    svm_baseline: PerK | None = None
-    svm_accuracy: PerRK | None = None
-    shape_fraction: PerRK | None = None
-    size_fraction: PerRK | None = None
-    n_selected: PerRK | None = None
-    case_studies: Mapping[int, tuple[Cluster, ...]] | None = None
-    prototypes: Mapping[int, tuple[tuple[float, ...], ...]] | None = None
-    feature_names: tuple[str, ...] | None = None
-    feature_weights: Mapping[int, Mapping[str, float]] | None = None
-    effects: Effects | None = None
-    size_success: SizeSuccess | None = None
+    results_format: int = RESULTS_FORMAT
+    uniformity: PerK | None = _section()
+    svm_accuracy: PerRK | None = _section()
+    shape_fraction: PerRK | None = _section()
+    size_fraction: PerRK | None = _section()
+    n_selected: PerRK | None = _section()
+    case_studies: Mapping[K, tuple[Cluster, ...]] | None = _section()
+    prototypes: Mapping[K, tuple[tuple[float, ...], ...]] | None = _section()
+    feature_names: tuple[str, ...] | None = _section()
+    effects: Effects | None = _section()
+    size_success: SizeSuccess | None = _section()
+    purity: PerK | None = _section()
+    adjusted_rand: PerK | None = _section()
+    n_categories: PerK | None = _section()
+    svm_baseline: PerK | None = _section()
+    feature_weights: Mapping[K, Mapping[str, float]] | None = _section()
+    config: Config = field(default_factory=Config)
 
     @classmethod
     def from_dict(cls, results: Results | Mapping[str, Any], required: Iterable[str] = ()) -> Results:
         """Read a results dict (of any format this package reads, :func:`current_results`) and check it.
 
         Args:
-            results: The dict of :func:`~affordance_learning.paper.protocol.run_protocol`, or its ``results.json`` read
-                back, or part of it.
+            results: The dict of :meth:`to_dict` (a ``results.json`` read back), or part of it; or Results.
             required: Sections the caller cannot do without (``"uniformity"``, ``"case_studies"``, ...).
 
         Raises:
@@ -366,23 +353,15 @@ class Results:
             results.check_required(required)
             return results
         if not isinstance(results, Mapping):
-            raise InvalidValueError(f"results must be a mapping, {_EXPECTED} (or its results.json read back), "
-                                    f"got {type(results).__name__}.")
-        current = current_results(results)
-        parsed = cls(
-            results_format=RESULTS_FORMAT,
-            config=Config(MappingProxyType(copy.deepcopy(dict(_mapping(current.get("config") or {}, ("config",)))))),
-            **{name: _optional(current, name, _per_k) for name in _PER_K},
-            **{name: _optional(current, name, _per_rk) for name in _PER_RK},
-            case_studies=_optional(current, "case_studies", _case_studies),
-            prototypes=_optional(current, "prototypes", _prototypes),
-            feature_names=_optional(current, "feature_names", _feature_names),
-            feature_weights=_optional(current, "feature_weights", _feature_weights),
-            effects=_optional(current, "effects", _effects),
-            size_success=_optional(current, "size_success", _size_success),
-        )
+            raise InvalidValueError(f"results must be a mapping, {_EXPECTED}, got {type(results).__name__}.")
+        parsed = from_json(cls, current_results(results), name="results", expected=_EXPECTED)
         parsed.check_required(required)
         return parsed
+
+    def to_dict(self) -> dict[str, Any]:
+        """The results dict of the current format, as ``results.json`` holds it: the sections held, in the order
+        of the fields, with k and r keyed by :func:`k_key` and :func:`r_key`."""
+        return to_json(self)
 
     def missing(self, sections: Iterable[str]) -> list[str]:
         """Which of ``sections`` (names of the results dict: ``"uniformity"``, ``"svm_accuracy"``, ...) the results
@@ -428,38 +407,9 @@ class Results:
         """The clusters of the 1 x ``k`` map of the first trial; empty when it was not described."""
         return (self.case_studies or {}).get(int(k), ())
 
-    def to_dict(self) -> dict[str, Any]:
-        """The results dict of the current format, as :func:`~affordance_learning.paper.protocol.run_protocol` writes
-        it (the sections held, with k and r keyed by :func:`k_key` and :func:`r_key`)."""
-        out: dict[str, Any] = {"results_format": self.results_format}
-        for name in _PER_K:
-            if (section := getattr(self, name)) is not None:
-                out[name] = {k_key(k): s.to_dict() for k, s in section.items()}
-        for name in _PER_RK:
-            if (section := getattr(self, name)) is not None:
-                out[name] = {r_key(r): {k_key(k): s.to_dict() for k, s in per_k.items()}
-                             for r, per_k in section.items()}
-        if self.case_studies is not None:
-            out["case_studies"] = {k_key(k): [c.to_dict() for c in cs] for k, cs in self.case_studies.items()}
-        if self.prototypes is not None:
-            out["prototypes"] = {k_key(k): [list(row) for row in p] for k, p in self.prototypes.items()}
-        if self.feature_names is not None:
-            out["feature_names"] = list(self.feature_names)
-        if self.feature_weights is not None:
-            out["feature_weights"] = {k_key(k): dict(w) for k, w in self.feature_weights.items()}
-        if self.effects is not None:
-            out["effects"] = self.effects.to_dict()
-        if self.size_success is not None:
-            out["size_success"] = self.size_success.to_dict()
-        out["config"] = dict(self.config.items())
-        return out
 
-
-#: The sections of a results dict, per k and per r and k, and all of them, as :class:`Results` names them.
-_PER_K = ("uniformity", "purity", "adjusted_rand", "n_categories", "svm_baseline")
-_PER_RK = ("svm_accuracy", "shape_fraction", "size_fraction", "n_selected")
-_SECTIONS = (*_PER_K, *_PER_RK, "case_studies", "prototypes", "feature_names", "feature_weights", "effects",
-             "size_success")
+#: The sections of a results dict, as :class:`Results` names them.
+_SECTIONS = tuple(f.name for f in fields(Results) if f.name not in ("results_format", "config"))
 
 
 def as_results(results: Results | Mapping[str, Any], required: Iterable[str] = ()) -> Results:
@@ -468,131 +418,12 @@ def as_results(results: Results | Mapping[str, Any], required: Iterable[str] = (
     return Results.from_dict(results, required)
 
 
-# --- reading and checking -------------------------------------------------------------------------------------
-
-
 def _count_or_none(value: Any) -> int | None:
     return int(value) if _is_number(value) else None
 
 
-def _k(key: Any, path: _Path) -> int:
-    try:
-        return int(key)
-    except (TypeError, ValueError):
-        raise InvalidValueError(f"{_where(path)} holds the key {key!r}, which is not a map size k (an integer "
-                                f"written as str(k)); {_EXPECTED}.") from None
-
-
-def _r(key: Any, path: _Path) -> float:
-    try:
-        return float(key)
-    except (TypeError, ValueError):
-        raise InvalidValueError(f"{_where(path)} holds the key {key!r}, which is not a relevancy threshold r (a "
-                                f"number written as str(float(r))); {_EXPECTED}.") from None
-
-
-def _optional(results: Mapping[str, Any], name: str, read: Callable[[Any, _Path], Any]) -> Any:
-    """Section ``name`` read by ``read``; None when the results lack it (or hold None)."""
-    value = results.get(name)
-    return None if value is None else read(value, (name,))
-
-
-def _stat(value: Any, path: _Path) -> Stat:
-    entry = _entry(value, path, ("mean", "std"))
-    return Stat(_number(entry["mean"], (*path, "mean"), True), _number(entry["std"], (*path, "std"), True))
-
-
-def _per_k(value: Any, path: _Path) -> PerK:
-    section = _mapping(value, path)
-    return MappingProxyType({_k(k, path): _stat(entry, (*path, k)) for k, entry in section.items()})
-
-
-def _per_rk(value: Any, path: _Path) -> PerRK:
-    section = _mapping(value, path)
-    return MappingProxyType({_r(r, path): _per_k(per_k, (*path, r)) for r, per_k in section.items()})
-
-
-def _cluster(value: Any, path: _Path) -> Cluster:
-    entry = _entry(value, path, ("cluster", "success", "fail", "types", "sizes"))
-    types = _mapping(entry["types"], (*path, "types"))
-    return Cluster(
-        index=_count(entry["cluster"], (*path, "cluster")),
-        success=_count(entry["success"], (*path, "success")),
-        fail=_count(entry["fail"], (*path, "fail")),
-        types=MappingProxyType({str(t): _count(n, (*path, "types", t)) for t, n in types.items()}),
-        sizes=tuple(_number(s, (*path, "sizes")) for s in _list(entry["sizes"], (*path, "sizes"))),
-        left_view=None if entry.get("left_view") is None else _count(entry["left_view"], (*path, "left_view")),
-    )
-
-
-def _case_studies(value: Any, path: _Path) -> Mapping[int, tuple[Cluster, ...]]:
-    section = _mapping(value, path)
-    return MappingProxyType({
-        _k(k, path): tuple(_cluster(c, (*path, k, i)) for i, c in enumerate(_list(cs, (*path, k))))
-        for k, cs in section.items()})
-
-
-def _prototypes(value: Any, path: _Path) -> Mapping[int, tuple[tuple[float, ...], ...]]:
-    section = _mapping(value, path)
-    return MappingProxyType({
-        _k(k, path): tuple(tuple(_number(v, (*path, k)) for v in _list(row, (*path, k)))
-                           for row in _list(rows, (*path, k)))
-        for k, rows in section.items()})
-
-
-def _feature_names(value: Any, path: _Path) -> tuple[str, ...]:
-    return tuple(str(name) for name in _list(value, path))
-
-
-def _feature_weights(value: Any, path: _Path) -> Mapping[int, Mapping[str, float]]:
-    section = _mapping(value, path)
-    return MappingProxyType({
-        _k(k, path): MappingProxyType({str(n): _number(w, (*path, k, n))
-                                       for n, w in _mapping(weights, (*path, k)).items()})
-        for k, weights in section.items()})
-
-
-def _effects(value: Any, path: _Path) -> Effects:
-    section = _mapping(value, path)
-    shares = [f.name for f in fields(TypeEffects) if f.name != "n"]
-    by_type = {}
-    for t, row in _mapping(section.get("by_type") or {}, (*path, "by_type")).items():
-        where = (*path, "by_type", t)
-        entry = _entry(row, where, ("n", *shares))
-        by_type[str(t)] = TypeEffects(n=_count(entry["n"], (*where, "n")),
-                                      **{s: _number(entry[s], (*where, s), True) for s in shares})
-    overall = [f.name for f in fields(Effects) if f.name != "by_type"]
-    return Effects(by_type=MappingProxyType(by_type),
-                   **{s: _number(section.get(s), (*path, s), True) for s in overall})
-
-
-def _size_success(value: Any, path: _Path) -> SizeSuccess:
-    section = _entry(value, path, ("bins",))
-    bins = []
-    for i, b in enumerate(_list(section["bins"], (*path, "bins"))):
-        where = (*path, "bins", i)
-        entry = _entry(b, where, ("low", "high", "n", "success"))
-        bins.append(SizeBin(_number(entry["low"], (*where, "low")), _number(entry["high"], (*where, "high")),
-                            _count(entry["n"], (*where, "n")), _number(entry["success"], (*where, "success"),
-                                                                         True)))
-
-    def part(key: str, keys: tuple[str, ...]) -> Mapping[str, Any] | None:
-        return None if section.get(key) is None else _entry(section[key], (*path, key), keys)
-
-    fit, test = part("logistic", ("intercept", "slope")), part("test", ("p_value", "span", "depends_on_size", "rule"))
-    sides = {key: part(key, ("n", "success")) for key in ("below", "above")}
-    return SizeSuccess(
-        bins=tuple(bins),
-        logistic=None if fit is None else Logistic(_number(fit["intercept"], (*path, "logistic", "intercept")),
-                                                   _number(fit["slope"], (*path, "logistic", "slope"))),
-        test=None if test is None else SizeTest(_number(test["p_value"], (*path, "test", "p_value")),
-                                                _number(test["span"], (*path, "test", "span")),
-                                                bool(test["depends_on_size"]), str(test["rule"])),
-        critical_size=_number(section.get("critical_size"), (*path, "critical_size"), True),
-        **{key: None if side is None else SizeSide(_count(side["n"], (*path, key, "n")),
-                                                   _number(side["success"], (*path, key, "success"), True))
-           for key, side in sides.items()},
-    )
+def _is_number(value: Any) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
 __all__ = ["RESULTS_FORMAT", "UNITS", "UNIFORMITY_DEFINITION", "Cluster", "Config", "Effects", "Logistic", "PerK",
