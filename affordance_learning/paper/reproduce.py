@@ -24,19 +24,31 @@ at once with a clear error.
 from __future__ import annotations
 
 import json
+import tempfile
 import time
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
+import affordance_env.behaviors as env_behaviors
+from affordance_env.dataset import collect, failure_summary, load_dataset
+from affordance_env.dataset.fingerprint import (
+    FINGERPRINT_EPISODES,
+    FingerprintCheck,
+    compare_fingerprints,
+    fingerprint,
+)
 from affordance_env.registry import BEHAVIOR_NAMES
+from affordance_learning.common.behaviors import check_env_offers
 from affordance_learning.common.exceptions import InvalidValueError
-
-if TYPE_CHECKING:
-    from affordance_env.dataset.fingerprint import FingerprintCheck
-    from affordance_learning.paper.results import Results
+from affordance_learning.common.verdicts import tally_text
+from affordance_learning.paper.claims import claims_scope, evaluate_claims
+from affordance_learning.paper.figures import write_figures
+from affordance_learning.paper.protocol import run_protocol
+from affordance_learning.paper.report import HEADLINE_R, headline_accuracy, write_overview, write_report
+from affordance_learning.paper.results import Results, as_results
 
 #: The behaviours the paper reports on, run by default.
 DEFAULT_BEHAVIORS = ("tap", "grasp")
@@ -80,10 +92,6 @@ def reproduce(
     Returns:
         The results of each behaviour run, by behaviour.
     """
-    import affordance_env.behaviors as env_behaviors
-    from affordance_learning.common.behaviors import check_env_offers
-    from affordance_learning.paper.report import write_overview
-
     behaviors = list(behaviors)
     runnable = [b for b in behaviors if isinstance(b, str) and b in env_behaviors.BEHAVIORS] or ["tap"]
     behaviors = check_env_offers(behaviors, hint=", or run only the behaviours it offers (affordance reproduce "
@@ -119,12 +127,6 @@ def reproduce(
 def _reproduce_one(out: Path, behavior: str, dataset: Path | None, *, episodes: int, trials: int, seed: int,
                    workers: int, progress: bool | None, range_noise: str | None) -> Results:
     """Collect, learn and report one behaviour into ``out/<behavior>``; returns its results."""
-    from affordance_env.dataset import collect, failure_summary, load_dataset
-    from affordance_env.dataset.fingerprint import fingerprint
-    from affordance_learning.paper.figures import write_figures
-    from affordance_learning.paper.protocol import run_protocol
-    from affordance_learning.paper.report import write_report
-
     where = out / behavior
     where.mkdir(parents=True, exist_ok=True)
     dataset = dataset if dataset is not None else where / "dataset"
@@ -173,11 +175,6 @@ def _write_fingerprint(found: dict[str, Any], where: Path) -> Path:
 def _collect_reference(where: Path, workers: int = 1) -> dict[str, Any]:
     """The fingerprint of the first interactions that ``affordance reproduce`` collects for the reproduction in
     ``where``, collected now (with the settings of its ``results.json``: behaviour, seed, range noise)."""
-    import tempfile
-
-    from affordance_env.dataset import collect, load_dataset
-    from affordance_env.dataset.fingerprint import FINGERPRINT_EPISODES, fingerprint
-
     try:
         config = json.loads((where / "results.json").read_text())["config"]
         behavior, seed = config["behavior"], int(config["seed"])
@@ -206,8 +203,6 @@ def check_fingerprint(where: str | Path, workers: int = 1) -> FingerprintCheck:
     again and compare them with its ``fingerprint.json``: bit for bit where it was made with the versions and CPU
     found here, otherwise by what holds across machines
     (:func:`~affordance_env.dataset.fingerprint.compare_fingerprints`)."""
-    from affordance_env.dataset.fingerprint import compare_fingerprints
-
     where = Path(where)
     try:
         expected = json.loads((where / FINGERPRINT).read_text())
@@ -223,8 +218,6 @@ def check_fingerprint(where: str | Path, workers: int = 1) -> FingerprintCheck:
 def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, Results]:
     """Results an earlier run left in ``out/<behavior>/results.json`` for behaviours not run now; only those of
     the current schema (whose config names the behaviour of their directory)."""
-    from affordance_learning.paper.results import Results
-
     found = {}
     for path in sorted(out.glob("*/results.json")):
         behavior = path.parent.name
@@ -241,11 +234,6 @@ def _earlier_runs(out: Path, skip: Iterable[str]) -> dict[str, Results]:
 
 def summary(results: Results | Mapping[str, Any], report: Path) -> str:
     """The headline numbers of one behaviour's reproduction, and where its report is, in a few lines."""
-    from affordance_learning.common.verdicts import tally_text
-    from affordance_learning.paper.claims import claims_scope, evaluate_claims
-    from affordance_learning.paper.report import HEADLINE_R, headline_accuracy
-    from affordance_learning.paper.results import as_results
-
     results = as_results(results, required=("uniformity", "svm_accuracy"))
     behavior = results.behavior
     effects = results.effects

@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from affordance_env.behaviors import get_behavior
+from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
 from affordance_env.registry import BEHAVIOR_NAMES, GOAL_ENV_ID
 from affordance_learning.planning.effect_model import ActionEffectModel, behavior_model
 from affordance_learning.planning.experiment.settings import PlanSettings
@@ -52,9 +54,6 @@ def collect_training(out: Path, settings: PlanSettings, seed: int, workers: int,
     scene with both arms, objects over its workspace (in ``out`` beside the goal episodes, named after it): the
     draw, which reaches only objects near the robot, gets a tenth of the goal episodes' interactions. The frame of
     both."""
-    from affordance_env.behaviors import get_behavior
-    from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
-
     episodes, chunk = settings.episodes, 25
     if (out / MANIFEST).exists():  # an earlier collection, perhaps extended: resumed as far as it went
         episodes = max(episodes, int(read_manifest(out)["episodes"]))
@@ -97,8 +96,6 @@ def load_training(out: str | os.PathLike) -> pd.DataFrame:
     """The training frame :func:`collect_training` collected into ``out`` (``affordance plan``'s
     ``OUT/dataset``): its goal episodes, then each behaviour's top-up beside it (each interaction an episode of
     one step, numbered from ``TOP_UP_EPISODES``)."""
-    from affordance_env.dataset import MANIFEST, load_dataset
-
     out = Path(out)
     frames = [load_dataset(out)]
     for behavior in BEHAVIOR_NAMES:
