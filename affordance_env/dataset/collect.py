@@ -9,8 +9,11 @@ An interaction that the environment marks as failed (``info["failure"]``: an unr
 a physics fault) is not written; its episode and reason go to the chunk's metadata and the manifest. Anything
 else that goes wrong (an exception from ``reset`` or ``step``, a record with non-finite numbers) is a bug: it
 stops the collection with its traceback, and the chunks already written stay. A goal episode never runs an action
-that ``feasible`` refuses: where no feasible action is drawn, or the head does not see the object, the episode
-ends there, truncated (its reason in the chunk's metadata), and is no failure. When more than
+that ``feasible`` refuses: where no feasible action is drawn, or the head does not see the object (hidden behind an
+arm, or out of every view of the head: its interaction would fail), the episode ends there, truncated (its reason
+in the chunk's metadata: ``"truncated"``: episode -> ``"infeasible: ..."`` or ``"lost: ..."``), keeps its rows and is
+no failure; an episode is recorded up to its first failed interaction (left out; the episode counts as failed).
+When more than
 ``max_failure_share`` of the interactions collected so far have failed, the collection stops with
 :class:`FailureShareError`, which lists the reasons: rerun with a larger share to accept them.
 """
@@ -282,38 +285,20 @@ def collect(
         env_id: ``"TapAffordance-v2"`` (one interaction per episode, a row each) or ``"TapAffordanceGoal-v2"``: goal
             episodes of up to 5 interactions (``GOAL_MAX_EPISODE_STEPS``), each the first action the arm can reach
             (``feasible``) among the behaviours in a random order, each with ``PARAM_DRAWS`` parameter vectors by
-            ``action`` (:func:`goal_step_actions`), one row per interaction with its ``step`` and the goal columns. An
-            action that ``feasible`` refuses is never run: a step for which none of the draws is feasible ends the
-            episode before it, as does an object the head does not see (hidden behind an arm, or out of every view of
-            the head), whose interaction would fail. Such an episode keeps its rows and counts as truncated, not failed:
-            the chunk's metadata records why (``"truncated"``: episode -> ``"infeasible: ..."`` or ``"lost: ..."``). An
-            episode is recorded up to its first failed interaction (left out; the episode counts as failed). The rule is
-            part of the dataset's settings (``goal_episodes``): a dataset collected otherwise is not resumed with it.
+            ``action`` (:func:`goal_step_actions`), one row per interaction with its ``step`` and the goal columns;
+            episodes end early as the module docstring says (truncated: ``"infeasible: ..."`` or ``"lost: ..."`` in
+            the chunk's metadata; or at a failed interaction, left out). The rule is part of the dataset's settings
+            (``goal_episodes``): a dataset collected otherwise is not resumed with it.
 
     Returns:
         The dataset directory.
     """
-    for name, value, low in (("episodes", episodes, 1), ("workers", workers, 1),
-                             ("chunk_size", chunk_size, 1), ("seed", seed, 0)):
-        if not is_integer(value) or value < low:
-            raise InvalidValueError(f"{name} must be an integer >= {low}, got {value!r}.")
-    if episodes > MAX_EPISODES:
-        raise InvalidValueError(f"episodes must be at most {MAX_EPISODES:,} (a dataset's limit), got {episodes!r}.")
-    if action not in ACTIONS:
-        raise InvalidValueError(f"action must be one of {ACTIONS}, got {action!r}.")
-    if isinstance(max_failure_share, bool) or not (isinstance(max_failure_share, int | float | np.floating)
-                                                   and 0.0 <= max_failure_share <= 1.0):
-        raise InvalidValueError(f"max_failure_share must be a share in [0, 1], got {max_failure_share!r}.")
-    if env_id not in ENV_IDS:
-        raise InvalidValueError(f"env_id must be one of {ENV_IDS}, got {env_id!r}.")
-    if scheduler not in SCHEDULERS:
-        raise InvalidValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}.")
+    _check_collect_arguments(episodes, seed, workers, action, chunk_size, scheduler, max_failure_share, env_id)
     if dask_address is not None:
         scheduler = "dask"
     options = _full_options(dict(env_options or {}), env_id)
-    options_json = json.dumps(options, sort_keys=True)
-    if scheduler == "joblib" and workers == 1:
-        worker_env(env_id, options_json)  # this process collects: build its env now, before any work
+    if scheduler == "joblib" and workers == 1:  # this process collects: build its env now, before any work
+        worker_env(env_id, json.dumps(options, sort_keys=True))
     header = dataset_header(seed, action, chunk_size, options, save_images, env_id)
     if env_id == GOAL_ENV_ID:
         header["settings"]["goal_episodes"] = GOAL_EPISODE_RULE
@@ -330,31 +315,65 @@ def collect(
         for stale in out.glob(".*.tmp"):  # left by a run that was killed while writing
             stale.unlink(missing_ok=True)
         ranges = chunk_ranges(episodes, chunk_size)
-        done = {}
-        for index, (start, stop) in enumerate(ranges):
-            found = _existing_chunk(out / chunk_name(index), header, start, stop, stored)
-            if found is not None:
-                meta, digest = found
-                done[index] = ChunkResult.from_metadata(meta["chunk"], digest)
+        done = _chunks_done(out, ranges, header, stored)
         write_manifest(out, header, episodes, done)
         _check_failure_share(done, max_failure_share, out)
         tasks = [(str(out), i, start, stop, header)
                  for i, (start, stop) in enumerate(ranges) if i not in done]
-        n_failed = sum(len(chunk.failures) for chunk in done.values())
-        with progress_bar(progress, total=episodes, initial=sum(chunk.episodes for chunk in done.values()),
-                          unit="interaction", desc=out.name, smoothing=0.05) as bar:
-            bar.set_postfix(failed=n_failed, refresh=False)
-            for chunk in _run(tasks, scheduler, workers, dask_address):
-                if not (out / chunk_name(chunk.index)).exists():
-                    raise DatasetError(f"a worker wrote {chunk_name(chunk.index)} where this process cannot see "
-                                       f"it: the Dask workers must share {out} with this machine.")
-                done[chunk.index] = chunk
-                write_manifest(out, header, episodes, done)
-                n_failed += len(chunk.failures)
-                bar.set_postfix(failed=n_failed, refresh=False)
-                bar.update(chunk.episodes)
-                _check_failure_share(done, max_failure_share, out)
+        _collect_chunks(out, tasks, done, header, episodes, progress, max_failure_share,
+                        (scheduler, workers, dask_address))
     return out
+
+
+def _check_collect_arguments(episodes: int, seed: int, workers: int, action: str, chunk_size: int, scheduler: str,
+                             max_failure_share: float, env_id: str) -> None:
+    """InvalidValueError naming the first argument of :func:`collect` that it cannot take."""
+    for name, value, low in (("episodes", episodes, 1), ("workers", workers, 1),
+                             ("chunk_size", chunk_size, 1), ("seed", seed, 0)):
+        if not is_integer(value) or value < low:
+            raise InvalidValueError(f"{name} must be an integer >= {low}, got {value!r}.")
+    if episodes > MAX_EPISODES:
+        raise InvalidValueError(f"episodes must be at most {MAX_EPISODES:,} (a dataset's limit), got {episodes!r}.")
+    if action not in ACTIONS:
+        raise InvalidValueError(f"action must be one of {ACTIONS}, got {action!r}.")
+    if isinstance(max_failure_share, bool) or not (isinstance(max_failure_share, int | float | np.floating)
+                                                   and 0.0 <= max_failure_share <= 1.0):
+        raise InvalidValueError(f"max_failure_share must be a share in [0, 1], got {max_failure_share!r}.")
+    if env_id not in ENV_IDS:
+        raise InvalidValueError(f"env_id must be one of {ENV_IDS}, got {env_id!r}.")
+    if scheduler not in SCHEDULERS:
+        raise InvalidValueError(f"scheduler must be one of {SCHEDULERS}, got {scheduler!r}.")
+
+
+def _chunks_done(out: Path, ranges: list[tuple[int, int]], header: dict, stored: dict) -> dict[int, ChunkResult]:
+    """The chunks of ``out`` already written whole with these settings, by index."""
+    done = {}
+    for index, (start, stop) in enumerate(ranges):
+        found = _existing_chunk(out / chunk_name(index), header, start, stop, stored)
+        if found is not None:
+            meta, digest = found
+            done[index] = ChunkResult.from_metadata(meta["chunk"], digest)
+    return done
+
+
+def _collect_chunks(out: Path, tasks: list, done: dict[int, ChunkResult], header: dict, episodes: int,
+                    progress: bool | None, max_failure_share: float, how: tuple[str, int, str | None]) -> None:
+    """Run the missing chunks' ``tasks`` (``how``: scheduler, workers, Dask address), recording each in ``done`` and
+    the manifest as it comes, with a progress bar over all ``episodes``."""
+    n_failed = sum(len(chunk.failures) for chunk in done.values())
+    with progress_bar(progress, total=episodes, initial=sum(chunk.episodes for chunk in done.values()),
+                      unit="interaction", desc=out.name, smoothing=0.05) as bar:
+        bar.set_postfix(failed=n_failed, refresh=False)
+        for chunk in _run(tasks, *how):
+            if not (out / chunk_name(chunk.index)).exists():
+                raise DatasetError(f"a worker wrote {chunk_name(chunk.index)} where this process cannot see "
+                                   f"it: the Dask workers must share {out} with this machine.")
+            done[chunk.index] = chunk
+            write_manifest(out, header, episodes, done)
+            n_failed += len(chunk.failures)
+            bar.set_postfix(failed=n_failed, refresh=False)
+            bar.update(chunk.episodes)
+            _check_failure_share(done, max_failure_share, out)
 
 
 def failure_summary(failures: dict[str, str], examples: int = 1) -> str:
