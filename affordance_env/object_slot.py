@@ -13,6 +13,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from affordance_env.linalg import dot, norm
 from affordance_env.objects import ObjectGeometry
 from affordance_env.scene_index import SceneIndex
 
@@ -24,7 +25,7 @@ OBJECT_CONTYPE, OBJECT_CONAFFINITY = 1, 3
 
 
 class ObjectSlot:
-    """Swaps the object in ``model`` and places it in ``data``.
+    """Swaps the object in ``model``, places it in ``data`` and tells where it is.
 
     Args:
         model: The scene's model, changed in place by :meth:`make`.
@@ -33,14 +34,19 @@ class ObjectSlot:
             simulated state.
         index: The scene's named elements.
         table_top: Height of the table top [m].
+        table_low: Lower corner of the table top in world x, y [m].
+        table_high: Upper corner of the table top in world x, y [m].
     """
 
     def __init__(self, model: mujoco.MjModel, data: mujoco.MjData, scratch: mujoco.MjData, index: SceneIndex,
-                 table_top: float) -> None:
+                 table_top: float, table_low: np.ndarray, table_high: np.ndarray) -> None:
         self.model, self.data, self.scratch = model, data, scratch
         self.object_body, self.object_geoms = index.object_body, index.object_geoms
         self.object_qpos, self.object_qvel = index.object_qpos, index.object_qvel
-        self.table_top = table_top
+        self.table_top, self.table_low, self.table_high = table_top, table_low, table_high
+        #: The object's active primitive (a geom id) and its geometry (None until :meth:`make`).
+        self.active_geom = self.object_geoms["sphere"]
+        self.geometry: ObjectGeometry | None = None
         # Inactive primitives keep these sizes, so the model never depends on earlier objects.
         self._hidden_size = {p: model.geom_size[g].copy() for p, g in self.object_geoms.items()}
         self._hidden_aabb = {p: model.geom_aabb[g].copy() for p, g in self.object_geoms.items()}
@@ -72,6 +78,8 @@ class ObjectSlot:
         m.body_inertia[self.object_body] = geometry.inertia
         m.body_ipos[self.object_body] = 0.0
         m.body_iquat[self.object_body] = [1.0, 0.0, 0.0, 0.0]
+        self.active_geom = g
+        self.geometry = geometry
         mujoco.mj_setConst(m, self.scratch)  # on scratch data: it resets the state it is given to qpos0
         return g
 
@@ -100,3 +108,36 @@ class ObjectSlot:
         self.data.qpos[a : a + 7] = pose
         self.data.qvel[self.object_qvel : self.object_qvel + 6] = 0.0
         mujoco.mj_forward(self.model, self.data)
+
+    # --- where it is -----------------------------------------------------------------------------------------
+    def pose(self) -> np.ndarray:
+        """Object pose: position [m] and orientation quaternion (w, x, y, z), (7,)."""
+        a = self.object_qpos
+        return self.data.qpos[a : a + 7].copy()
+
+    def speed(self) -> float:
+        """Linear speed of the object [m/s]."""
+        v = self.data.qvel[self.object_qvel : self.object_qvel + 3]
+        return norm(v)
+
+    def angular_speed(self) -> float:
+        """Angular speed of the object [rad/s]."""
+        w = self.data.qvel[self.object_qvel + 3 : self.object_qvel + 6]
+        return norm(w)
+
+    def on_table(self) -> bool:
+        """Whether the object's centre is above the table top and within its extent."""
+        p = self.data.qpos[self.object_qpos : self.object_qpos + 3]
+        return bool(p[2] > self.table_top and np.all(p[:2] >= self.table_low) and np.all(p[:2] <= self.table_high))
+
+    def bottom(self) -> float:
+        """Height of the object's lowest point [m], from its primitive's size and its orientation now."""
+        g, geometry = self.active_geom, self.geometry
+        R = self.data.geom_xmat[g].reshape(3, 3)
+        size, z = geometry.geom_size, float(self.data.geom_xpos[g, 2])
+        if geometry.primitive == "sphere":
+            return z - float(size[0])
+        if geometry.primitive == "box":
+            return z - dot(np.abs(R[2]), size)
+        axis_z = abs(float(R[2, 2]))  # a cylinder: its axis's vertical part, and its rim's
+        return z - axis_z * float(size[1]) - float(size[0]) * float(np.sqrt(max(0.0, 1.0 - axis_z * axis_z)))

@@ -3,12 +3,12 @@
 In the manner of dm_control's ``Physics`` helpers: every index into MuJoCo's arrays is looked up once, by name
 (:mod:`affordance_env.scene_index`), and the rest of the project asks geometric questions (``hand_position()``,
 ``object_pose()``) instead of indexing ``MjData`` itself. :class:`TapPhysics` holds the model and its simulated
-state, answers the named queries of the robot, the object and the table, steps the simulation (with the outcome
-monitor's hook) and takes and restores snapshots; it owns one helper per other job:
+state, answers the named queries of the robot and the table, steps the simulation (with the outcome monitor's
+hook) and takes and restores snapshots; it owns one helper per other job:
 
 - :class:`~affordance_env.servo.Servo`: the position servos and their controller (feedforward, torque limits);
 - :class:`~affordance_env.contacts.ContactQueries`: contacts and clearances of the robot, the object and the table;
-- :class:`~affordance_env.object_slot.ObjectSlot`: swapping the object in the model and placing it.
+- :class:`~affordance_env.object_slot.ObjectSlot`: swapping the object in the model, placing it, where it is.
 
 Positions are in the world frame [m], joint angles [rad], time [s].
 """
@@ -23,7 +23,6 @@ import numpy as np
 
 from affordance_env.contacts import ContactQueries
 from affordance_env.exceptions import IncompatibleStateError
-from affordance_env.linalg import dot, norm
 from affordance_env.object_slot import ObjectSlot
 from affordance_env.objects import ObjectGeometry
 from affordance_env.outcome import ObjectMonitor
@@ -48,9 +47,8 @@ class TapPhysics:
 
     Robot joint vectors (positions, velocities, servo targets) are in the variant's ``active_joints`` order.
 
-    The servo's commands (``set_joint_targets``, ``set_targets_toward``, ``joint_targets``, ...), the contact and
-    clearance queries (``hand_touches_object``, ``arm_near_object``, ``sweep_clearance``, ...) and
-    ``set_object_pose`` are the helpers' own bound methods, made attributes of this object once
+    The servo's commands (``set_joint_targets``, ...), the contact queries (``hand_touches_object``, ...) and the
+    object's (``object_pose``, ...) are the helpers' bound methods, made attributes of this object once
     (:meth:`_bind_helpers`): the calls of every control tick and physics step go straight to them.
     """
 
@@ -65,8 +63,7 @@ class TapPhysics:
         self.object_body, self.object_geoms = index.object_body, index.object_geoms
         self.object_qpos, self.object_qvel = index.object_qpos, index.object_qvel
         self.robot_qpos, self.robot_qvel, self.actuators = index.robot_qpos, index.robot_qvel, index.actuators
-        self.palm_site, self.head_site = index.palm_site, index.head_site
-        self.table_geom, self.home_key, self.body_names = index.table_geom, index.home_key, index.body_names
+        self.palm_site, self.table_geom, self.home_key = index.palm_site, index.table_geom, index.home_key
         self._qpos, self._qvel = index.qpos, index.qvel  # slices where the indices run in order: views
         # The table is static: its top height and extent are fixed once.
         mujoco.mj_kinematics(model, self.scratch)
@@ -76,11 +73,9 @@ class TapPhysics:
         self.table_low, self.table_high = centre[:2] - half[:2], centre[:2] + half[:2]
         self.servo = Servo(model, self.data, index)
         self.contacts = ContactQueries(model, self.data, self.scratch, index)
-        self.object_slot = ObjectSlot(model, self.data, self.scratch, index, self.table_top)
+        self.object_slot = ObjectSlot(model, self.data, self.scratch, index, self.table_top, self.table_low,
+                                      self.table_high)
         self._bind_helpers()
-        #: The object's active primitive (a geom id) and its geometry (None until :meth:`set_object`).
-        self.active_geom = self.contacts.active_geom
-        self.geometry: ObjectGeometry | None = None
         data = self.data
         self._object_p = data.qpos[self.object_qpos : self.object_qpos + 3]
         self._object_v = data.qvel[self.object_qvel : self.object_qvel + 3]
@@ -101,26 +96,21 @@ class TapPhysics:
         self.torque_limit, self.servo_kp, self.servo_lead = servo.torque_limit, servo.kp, servo.lead
         #: A finger's target's largest distance from the finger [rad]; the servos' target ranges [rad].
         self.finger_reach, self.ctrl_low, self.ctrl_high = servo.finger_reach, servo.ctrl_low, servo.ctrl_high
-        self.limit_torques = servo.limit_torques
-        self.set_joint_targets = servo.set_joint_targets
-        self.inertial_lead = servo.inertial_lead
-        self.set_targets_toward = servo.set_targets_toward
-        self.tick_accelerations = servo.tick_accelerations
-        self.set_targets_toward_rows = servo.set_targets_toward_rows
-        self.joint_targets = servo.joint_targets
+        self.limit_torques, self.set_joint_targets = servo.limit_torques, servo.set_joint_targets
+        self.joint_targets, self.set_targets_toward = servo.joint_targets, servo.set_targets_toward
+        self.tick_accelerations, self.set_targets_toward_rows = servo.tick_accelerations, servo.set_targets_toward_rows
         #: The robot's geoms that touch the world (hand, fingers, wrist, forearm).
-        self.hand_geoms = contacts.hand_geoms
-        self.hand_touches_object = contacts.hand_touches_object
-        self.hand_touches_table = contacts.hand_touches_table
+        self.hand_geoms, self.sweep_clearance = contacts.hand_geoms, contacts.sweep_clearance
+        self.hand_touches_object, self.hand_touches_table = contacts.hand_touches_object, contacts.hand_touches_table
         self.object_touches_table = contacts.object_touches_table
-        self.links_touching_object = contacts.links_touching_object
-        self.links_touching_table = contacts.links_touching_table
-        self.hand_object_distance = contacts.hand_object_distance
-        self.arm_object_distance = contacts.arm_object_distance
-        self.arm_near_object = contacts.arm_near_object
-        self.arm_near_or_touching = contacts.arm_near_or_touching
-        self.sweep_clearance = contacts.sweep_clearance
-        self.set_object_pose = self.object_slot.set_pose
+        self.links_touching_object, self.links_touching_table = (contacts.links_touching_object,
+                                                                 contacts.links_touching_table)
+        self.hand_object_distance, self.arm_object_distance = (contacts.hand_object_distance,
+                                                               contacts.arm_object_distance)
+        self.arm_near_object, self.arm_near_or_touching = contacts.arm_near_object, contacts.arm_near_or_touching
+        slot = self.object_slot
+        self.set_object_pose, self.object_pose, self.object_on_table = slot.set_pose, slot.pose, slot.on_table
+        self.object_speed, self.object_angular_speed, self.object_bottom = slot.speed, slot.angular_speed, slot.bottom
 
     # --- the table -------------------------------------------------------------------------------------------
     def table_extent(self) -> tuple[np.ndarray, np.ndarray]:
@@ -155,37 +145,15 @@ class TapPhysics:
         return self.data.site_xpos[self.palm_site].copy()
 
     # --- the object ------------------------------------------------------------------------------------------
-    def object_pose(self) -> np.ndarray:
-        """Object pose: position [m] and orientation quaternion (w, x, y, z), (7,)."""
-        a = self.object_qpos
-        return self.data.qpos[a : a + 7].copy()
+    @property
+    def active_geom(self) -> int:
+        """The object's active primitive (a geom id)."""
+        return self.object_slot.active_geom
 
-    def object_speed(self) -> float:
-        """Linear speed of the object [m/s]."""
-        v = self.data.qvel[self.object_qvel : self.object_qvel + 3]
-        return norm(v)
-
-    def object_angular_speed(self) -> float:
-        """Angular speed of the object [rad/s]."""
-        w = self.data.qvel[self.object_qvel + 3 : self.object_qvel + 6]
-        return norm(w)
-
-    def object_on_table(self) -> bool:
-        """Whether the object's centre is above the table top and within its extent."""
-        p = self.data.qpos[self.object_qpos : self.object_qpos + 3]
-        return bool(p[2] > self.table_top and np.all(p[:2] >= self.table_low) and np.all(p[:2] <= self.table_high))
-
-    def object_bottom(self) -> float:
-        """Height of the object's lowest point [m], from its primitive's size and its orientation now."""
-        g, geometry = self.active_geom, self.geometry
-        R = self.data.geom_xmat[g].reshape(3, 3)
-        size, z = geometry.geom_size, float(self.data.geom_xpos[g, 2])
-        if geometry.primitive == "sphere":
-            return z - float(size[0])
-        if geometry.primitive == "box":
-            return z - dot(np.abs(R[2]), size)
-        axis_z = abs(float(R[2, 2]))  # a cylinder: its axis's vertical part, and its rim's
-        return z - axis_z * float(size[1]) - float(size[0]) * float(np.sqrt(max(0.0, 1.0 - axis_z * axis_z)))
+    @property
+    def geometry(self) -> ObjectGeometry | None:
+        """The object's geometry (None until :meth:`set_object`)."""
+        return self.object_slot.geometry
 
     def set_object(self, geometry: ObjectGeometry, xy: np.ndarray, yaw: float) -> None:
         """Make ``geometry`` the object of interest and place it at rest on the table.
@@ -201,8 +169,7 @@ class TapPhysics:
     def _make_object(self, geometry: ObjectGeometry) -> None:
         """Make ``geometry`` the object of interest in the model (its primitive, size, mass and inertia), without
         touching the state; the contact queries then ask about it."""
-        self.active_geom = self.contacts.active_geom = self.object_slot.make(geometry)
-        self.geometry = geometry
+        self.contacts.active_geom = self.object_slot.make(geometry)
 
     # --- snapshots of the world ------------------------------------------------------------------------------
     def get_state(self) -> tuple[ObjectGeometry | None, mujoco.MjData]:
