@@ -1,4 +1,4 @@
-"""The scene's one object slot: which primitive is the object, its size, mass and inertia, and its resting pose.
+"""The scene's one object slot: which primitive is the object, its size, mass and inertia, and where it is.
 
 The scene holds one body ``object`` with a free joint and one geom per primitive (sphere, box, cylinder,
 :data:`affordance_env.objects.PRIMITIVES`). Making an object (:class:`~affordance_env.objects.ObjectGeometry`)

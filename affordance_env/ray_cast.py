@@ -135,7 +135,7 @@ class RayCaster:
             return geom_ids, dist, bool(np.logical_or.reduce(geom_ids < 0))
         geom, top, low, high = self.support
         if p_world_camera[2] > top:
-            t, on_face = self._meet_face(p_world_camera, d_world)
+            t, on_face = self._meet_face(p_world_camera, d_world, top, low, high)
             # Every ray ends on the face at t, except those cast below, which overwrite their pixels: so the ids
             # and distances start as the face's everywhere (no masked writes), and t is the distances' array.
             geom_ids, dist = np.full(n, geom, np.int32), t
@@ -180,14 +180,15 @@ class RayCaster:
         # only a cast ray can miss (the face's rays end on it): whether one did, from the cast rays alone
         return geom_ids, dist, bool(np.logical_or.reduce(ids < 0))
 
-    def _meet_face(self, p_world_camera: np.ndarray, d_world: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Where each ray meets the support face's plane, from a camera above it: ``(t, on_face)``, its distance t
-        [m] along each ray (n,) and whether the ray ends on the face (n,) bool.
+    def _meet_face(self, p_world_camera: np.ndarray, d_world: np.ndarray, top: float, low: np.ndarray,
+                   high: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Where each ray meets the support face's plane (height ``top`` [m], x-y corners ``low`` and ``high``
+        [m]), from a camera above it: ``(t, on_face)``, its distance t [m] along each ray (n,) and whether the ray
+        ends on the face (n,) bool.
 
         The face's rays are those with 0 < t <= max_range and x, y [m] within the face. The tests are the same
         comparisons of the same floats as ``(t > 0) & (t <= max_range) & (x >= low_x) & ...``, folded into one
         boolean array with scratch buffers instead of nine temporaries."""
-        _, top, low, high = self.support
         x, test = self._scratch, self._scratch_test
         with np.errstate(divide="ignore", invalid="ignore"):  # a ray parallel to the face: t = +-inf, x NaN
             t = (top - p_world_camera[2]) / d_world[2]
