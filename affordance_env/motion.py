@@ -427,7 +427,7 @@ class MotionExecutor:
                         t0, t1, t2 = p_touch.tolist()
                     if touched_yet:
                         # dot(palm - p_touch, direction) in Python floats, bit for bit: the differences, then
-                        # einsum's sum of three contiguous products, (x + z) + y, from +0 (see camera._to_camera)
+                        # einsum's sum of three contiguous products, (x + z) + y, from +0 (see pinhole.to_camera)
                         a0, a1, a2 = palm.tolist()
                         if (((a0 - t0) * e0 + (a2 - t2) * e2) + (a1 - t1) * e1) + 0.0 >= follow_through:
                             self.stop()

@@ -255,7 +255,7 @@ def test_a_window_capture_sees_the_object_as_the_whole_image_does():
         np.testing.assert_array_equal(window.ranges[mask], whole.ranges[mask])
         np.testing.assert_array_equal(window.p_world_points[mask], whole.p_world_points[mask])
         rectangle = np.zeros(mask.shape, bool)
-        rectangle.flat[env.camera._rays_near(np.array([geom]), data, *env.camera.pose(data))] = True
+        rectangle.flat[env.camera.culling.rays_near(np.array([geom]), data, *env.camera.pose(data))] = True
         assert mask[~rectangle].sum() == 0 and np.all(window.geom_ids[~rectangle] == -1)  # nothing cast outside
         assert np.all(window.geom_ids[rectangle] == whole.geom_ids[rectangle])
         seen += mask.sum() > 0
@@ -270,10 +270,10 @@ def test_the_rays_cast_for_a_ball_are_about_its_silhouette():
     env = TapAffordanceEnv()
     env.reset(seed=0, options={"object_type": "sphere", "size": 0.08})
     data, geom = env.physics.data, env.physics.active_geom
-    rays = env.camera._rays_near(np.array([geom]), data, *env.camera.pose(data))
+    rays = env.camera.culling.rays_near(np.array([geom]), data, *env.camera.pose(data))
     mask = env.camera.capture(data, occluded=geom).mask_of(geom)
     assert set(np.flatnonzero(mask).tolist()) <= set(rays.tolist())
-    ((_, u0, u1, v0, v1),) = env.camera._rectangles(np.array([geom]), data, *env.camera.pose(data))
+    ((_, u0, u1, v0, v1),) = env.camera.culling.rectangles(np.array([geom]), data, *env.camera.pose(data))
     assert rays.size < 1.3 * mask.sum() and (u1 - u0) * (v1 - v0) > 1.6 * mask.sum()
 
 
@@ -296,23 +296,21 @@ def test_the_products_in_python_floats_are_linalg_s_bit_for_bit():
     # The camera computes a box's corners, a sphere's centre and distance, and a point's projection in Python
     # floats, in the order of einsum's sums (the loops linalg.matmul runs): the same bits as the array products,
     # signed zeros included, or an image would differ in a pixel at the edge of a rectangle or a cone.
-    import types
-
-    from affordance_env.camera import _CORNERS, _to_camera, project
+    from affordance_env.culling import CORNERS, box_corners_camera
     from affordance_env.linalg import matmul, norm
+    from affordance_env.pinhole import project, to_camera
 
     rng = np.random.default_rng(0)
     K = Intrinsics.from_fovy(33, 25, 57.4)
     for R, R_camera in zip(_rotations(rng, 400), _rotations(rng, 400), strict=True):
         aabb = np.concatenate([rng.normal(size=3) * rng.choice([0.0, 0.01]), rng.uniform(0.0, 0.2, 3)])
         x_geom, p_camera = rng.normal(size=3) * rng.choice([0.0, 0.5]), rng.normal(size=3)
-        arrays = matmul(x_geom + np.einsum("ij,cj->ci", R, aabb[:3] + aabb[3:] * _CORNERS) - p_camera, R_camera)
-        fake = types.SimpleNamespace(model=types.SimpleNamespace(geom_aabb=aabb[None]))
-        data = types.SimpleNamespace(geom_xmat=R.reshape(1, 9), geom_xpos=x_geom[None])
-        floats = RangeCamera._box_corners_camera(fake, 0, data, p_camera.tolist(), R_camera.ravel().tolist())
+        arrays = matmul(x_geom + np.einsum("ij,cj->ci", R, aabb[:3] + aabb[3:] * CORNERS) - p_camera, R_camera)
+        floats = box_corners_camera(aabb.tolist(), R.ravel().tolist(), x_geom.tolist(), p_camera.tolist(),
+                                    R_camera.ravel().tolist())
         np.testing.assert_array_equal(np.array(floats).view(np.int64), arrays.view(np.int64))
         centre = matmul(x_geom - p_camera, R_camera)
-        c = _to_camera(*x_geom.tolist(), p_camera.tolist(), R_camera.ravel().tolist())
+        c = to_camera(*x_geom.tolist(), p_camera.tolist(), R_camera.ravel().tolist())
         np.testing.assert_array_equal(np.array(c).view(np.int64), centre.view(np.int64))
         assert math.sqrt(((c[0] * c[0] + c[2] * c[2]) + c[1] * c[1]) + 0.0) == norm(centre)
         depth = -centre[2]
@@ -395,5 +393,5 @@ def test_the_support_face_gives_mujocos_image_beside_a_fixed_geom_and_from_below
             np.testing.assert_array_equal(a.normals, b.normals)
     assert {ball, post} <= set(np.unique(a.geom_ids).tolist())  # both are in view ...
     on_table = a.p_world_points[a.geom_ids == model.geom("table").id]
-    top = fast._support[1]
+    top = fast.ray_caster.support[1]
     assert (np.abs(on_table[:, 2] - top) < 1e-9).any() == (camera == "above")  # ... and the face only from above

@@ -8,6 +8,7 @@ from affordance_env.objects import OBJECT_TYPES, object_geometry
 from affordance_env.physics import TapPhysics
 from affordance_env.robot_model import ACTIVE_JOINTS, CONTACT_LINKS, HELD_ARM_TORSO_RANGES, get_variant
 from affordance_env.scene import BACK_EMF, build_model, table_extent
+from affordance_env.scene_index import as_slice
 from affordance_env.table import table_extent as table_extent_read
 
 
@@ -198,6 +199,14 @@ def test_joint_queries_follow_the_simulation_in_every_variant(variant):
         np.testing.assert_array_equal(physics.joint_velocities(), physics.data.qvel[physics.robot_qvel])
         np.testing.assert_array_equal(physics.joint_positions(), physics.data.qpos[physics.robot_qpos])
     assert np.abs(physics.joint_velocities()).max() > 0.1  # the robot moves
+
+
+def test_robot_indices_become_a_slice_only_where_they_run_one_after_another_upward():
+    # A slice indexes a view of the data; indices in any other order must stay as they are, or a control tick
+    # would read and write other joints' entries.
+    assert as_slice(np.array([4, 5, 6])) == slice(4, 7)
+    for indices in (np.array([4, 6, 7]), np.array([6, 5, 4]), np.array([3, 3]), np.array([], dtype=int)):
+        assert as_slice(indices) is indices
 
 
 def test_the_held_right_arm_stays_above_the_table_within_the_left_arms_torso_ranges():
