@@ -176,24 +176,27 @@ def _policy_summary(episodes: Sequence[Mapping[str, Any]], **planner_only: Any) 
         success_toward_robot_ci=wilson(kt, len(toward)), n_toward_robot=len(toward), **planner_only)
 
 
+def _episode(e: Mapping[str, Any], reach: Mapping[str, Mapping[str, float]], tolerance: float, most: int
+             ) -> Episode:
+    """One of the planner's episodes (:func:`evaluate_episode`) as the results keep it, with whether its target was
+    within reach of ``most`` interactions (:func:`within_reach`)."""
+    pulls = e["pulls_at_start"]
+    return Episode(type=e["type"], start_xy=tuple(e["start_xy"]), target_xy=tuple(e["target_xy"]),
+                   initial_distance=e["initial_distance"], final_distance=e["final_distance"], steps=e["steps"],
+                   success=e["success"], gave_up=e["gave_up"], reach_failures=e["reach_failures"],
+                   failures=tuple(e["failures"]), toward_robot=e["toward_robot"],
+                   pulls_at_start=None if pulls is None else MappingProxyType(dict(pulls)),
+                   within_reach=e["type"] in reach and within_reach(e["start_xy"], e["target_xy"], reach[e["type"]],
+                                                                    tolerance, most))
+
+
 def _planner_episodes(episodes: Sequence[Mapping[str, Any]], reach: Mapping[str, Mapping[str, float]],
                       tolerance: float, most: int) -> dict[str, Any]:
     """What the report reads of the planner's episodes (:class:`MultiStepOutcome`'s ``planner_*``): success per
-    object type, each episode, and success on the targets within reach of ``most`` interactions
-    (:func:`within_reach`)."""
-    kept = ("type", "start_xy", "target_xy", "initial_distance", "final_distance", "steps", "success", "gave_up",
-            "reach_failures", "failures", "toward_robot", "pulls_at_start")
+    object type, each episode, and success on the targets within reach of ``most`` interactions."""
     by_type = {shape: Rate(len(eps), sum(e["success"] for e in eps) / len(eps))
                for shape in OBJECT_TYPES if (eps := [e for e in episodes if e["type"] == shape])}
-    listed = tuple(Episode(**{k: e[k] for k in kept if k not in ("start_xy", "target_xy", "failures",
-                                                                  "pulls_at_start")},
-                           start_xy=tuple(e["start_xy"]), target_xy=tuple(e["target_xy"]),
-                           failures=tuple(e["failures"]),
-                           pulls_at_start=None if e["pulls_at_start"] is None
-                           else MappingProxyType(e["pulls_at_start"]),
-                           within_reach=e["type"] in reach and within_reach(e["start_xy"], e["target_xy"],
-                                                                            reach[e["type"]], tolerance, most))
-                   for e in episodes)
+    listed = tuple(_episode(e, reach, tolerance, most) for e in episodes)
     inside = [e for e in listed if e.within_reach]
     return {"planner_by_type": by_type, "planner_episodes": listed,
             "planner_within_reach": Rate(len(inside), sum(e.success for e in inside) / len(inside) if inside else None)}
