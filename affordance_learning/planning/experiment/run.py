@@ -194,8 +194,8 @@ def _planner_episodes(episodes: Sequence[Mapping[str, Any]], reach: Mapping[str,
                       tolerance: float, most: int) -> dict[str, Any]:
     """What the report reads of the planner's episodes (:class:`MultiStepOutcome`'s ``planner_*``): success per
     object type, each episode, and success on the targets within reach of ``most`` interactions."""
-    by_type = {shape: Rate(len(eps), sum(e["success"] for e in eps) / len(eps))
-               for shape in OBJECT_TYPES if (eps := [e for e in episodes if e["type"] == shape])}
+    by_type = _view({shape: Rate(len(eps), sum(e["success"] for e in eps) / len(eps))
+                     for shape in OBJECT_TYPES if (eps := [e for e in episodes if e["type"] == shape])})
     listed = tuple(_episode(e, reach, tolerance, most) for e in episodes)
     inside = [e for e in listed if e.within_reach]
     return {"planner_by_type": by_type, "planner_episodes": listed,
@@ -212,7 +212,8 @@ def _multi_step(run: _Stages, by_policy: Sequence[Sequence[Mapping[str, Any]]], 
     details = {"planner": _planner_episodes(episodes, reach, tolerance, GOAL_MAX_EPISODE_STEPS)}
     multi = MultiStep(**{policy: _policy_summary(found, **details.get(policy, {}))
                          for policy, found in zip(MULTI_POLICIES, by_policy, strict=True)},
-                      step_reach_p90_m=reach, tolerance_m=tolerance, max_interactions=GOAL_MAX_EPISODE_STEPS)
+                      step_reach_p90_m=_view({t: _view(r) for t, r in reach.items()}), tolerance_m=tolerance,
+                      max_interactions=GOAL_MAX_EPISODE_STEPS)
     run.say(f"[5/5] multi-step on {run.settings.multi_episodes} episodes (with step 3): "
             + ", ".join(f"{p} {share_text(o.success, o.n, o.success_ci)}" for p, o in multi.policies.items())
             + "; toward the robot: planner " + share_text(multi.planner.success_toward_robot,
@@ -248,28 +249,33 @@ def _results(run: _Stages, frame: pd.DataFrame, frames: Mapping[str, pd.DataFram
     choose_s = [r["decision_s"] for r in records]
     toward_s = [s for e in planner_episodes for s in e["decision_s"]]
     return PlanResults(
-        seed=run.seed, settings=asdict(run.settings),
-        training={b: len(f) for b, f in frames.items()},
+        seed=run.seed, settings=_view(asdict(run.settings)),
+        training=_view({b: len(f) for b, f in frames.items()}),
         training_episodes=int(frame["episode"].nunique()),
         workers=run.workers, cpu_count=os.cpu_count(),
-        oracle={"actions_per_behavior": len(oracle_params()), "levels": list(ORACLE_LEVELS),
-                "objects": n_objects, "goals_per_object": dict(GOALS_PER_OBJECT),
-                "objects_per_shape": {s: len({r["object"] for r in records if r["type"] == s})
-                                      for s in OBJECT_TYPES}},
-        single_step=single,
-        single_step_by_goal={kind: summarize([r for r in records if r["kind"] == kind], POLICIES)
-                             for kind in GOAL_KINDS},
-        best_fixed_behavior=fixed_choice,
+        oracle=_view({"actions_per_behavior": len(oracle_params()), "levels": list(ORACLE_LEVELS),
+                      "objects": n_objects, "goals_per_object": dict(GOALS_PER_OBJECT),
+                      "objects_per_shape": {s: len({r["object"] for r in records if r["type"] == s})
+                                            for s in OBJECT_TYPES}}),
+        single_step=_view(single),
+        single_step_by_goal=_view({kind: _view(summarize([r for r in records if r["kind"] == kind], POLICIES))
+                                   for kind in GOAL_KINDS}),
+        best_fixed_behavior=_view(fixed_choice),
         planner_over_oracle=(single["planner"].success / oracle) if oracle else None,
         single_step_reach_failures=ReachFailures(len(acted), sum(r["planner_reach_failure"] for r in acted)),
-        leave_one_shape_out=loso,
+        leave_one_shape_out=_view({shape: _view(outcomes) for shape, outcomes in loso.items()}),
         multi_step=multi,
         **_placement(records),
         calibration=calibrations(records),
         decision_seconds=seconds_summary(choose_s + toward_s, seconds_summary(choose_s), seconds_summary(toward_s)),
-        timings_s=dict(run.timings),
+        timings_s=_view(run.timings),
         goals=tuple(GoalRecord(**{k: r.get(k) for k in GOAL_FIELDS}) for r in records),
     )
+
+
+def _view(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
+    """A read-only copy of ``mapping``, as the results hold their mappings."""
+    return MappingProxyType(dict(mapping))
 
 
 def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: PlanSettings | None = None,

@@ -50,8 +50,10 @@ def summarize(records: Sequence[Mapping[str, Any]], policies: Sequence[str]) -> 
         n, k = len(values), int(values.sum())
         nf, kf = int(feasible.sum()), int(values[feasible].sum())
         ne, ke = int(either.sum()), int(values[either].sum())
-        out[policy] = PolicyOutcome(k / n if n else None, wilson(k, n), kf / nf if nf else None, wilson(kf, nf), n, nf,
-                                    ke / ne if ne else None, wilson(ke, ne), ne)
+        out[policy] = PolicyOutcome(
+            success=k / n if n else None, success_ci=wilson(k, n), success_feasible=kf / nf if nf else None,
+            success_feasible_ci=wilson(kf, nf), n=n, n_feasible=nf, success_reached=ke / ne if ne else None,
+            success_reached_ci=wilson(ke, ne), n_reached=ne)
     return out
 
 
