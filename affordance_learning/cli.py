@@ -297,14 +297,12 @@ def _plan(args: argparse.Namespace) -> int:
     from affordance_learning.common.verdicts import tally_text
     from affordance_learning.planning.experiment import PlanSettings, record_episode, run_plan
     from affordance_learning.planning.report import write_plan_figures, write_plan_report
-    from affordance_learning.planning.results import PlanResults
     from affordance_learning.planning.targets import evaluate_targets
 
     settings = PlanSettings(**{name: getattr(args, name) for name in PLAN_DEFAULTS
                                if getattr(args, name) is not None})
-    results = run_plan(args.out, seed=args.seed, workers=args.workers, settings=settings)
-    frames = record_episode(args.out, results, seed=args.seed)
-    plan = PlanResults.from_dict(results)
+    plan = run_plan(args.out, seed=args.seed, workers=args.workers, settings=settings)
+    frames = record_episode(args.out, plan, seed=args.seed)
     write_plan_figures(plan, args.out, frames)
     report = write_plan_report(plan, args.out)
     verdicts = list(evaluate_targets(plan).values())

@@ -390,8 +390,8 @@ def test_calibration_is_measured_on_the_chosen_actions_with_pooled_beside_it():
     records.append({"planner_behavior": None, "planner_p": 0.0, "planner": False,
                     "pooled": (np.full(100, 0.01), np.zeros(100, bool))})  # abstained: not a chosen action
     cal = calibrations(records)
-    assert cal["n"] == 40 and cal["ece"] == pytest.approx(0.4) and cal["basis"] == "the planner's chosen actions"
-    assert cal["pooled"]["n"] == 4100 and cal["pooled"]["ece"] < 0.02
+    assert cal.n == 40 and cal.ece == pytest.approx(0.4) and cal.basis == "the planner's chosen actions"
+    assert cal.pooled.n == 4100 and cal.pooled.ece < 0.02
 
 
 def test_success_is_reported_on_feasible_goals_and_on_those_the_oracle_or_the_planner_reached():
@@ -400,11 +400,11 @@ def test_success_is_reported_on_feasible_goals_and_on_those_the_oracle_or_the_pl
     records = ([{"oracle": True, "planner": True}] * 6 + [{"oracle": True, "planner": False}] * 2
                + [{"oracle": False, "planner": True}] * 2 + [{"oracle": False, "planner": False}] * 10)
     planner = summarize(records, ("planner",))["planner"]
-    assert (planner["n"], planner["n_feasible"], planner["n_reached"]) == (20, 8, 10)
-    assert planner["success_feasible"] == 0.75 and planner["success_reached"] == 0.8
+    assert (planner.n, planner.n_feasible, planner.n_reached) == (20, 8, 10)
+    assert planner.success_feasible == 0.75 and planner.success_reached == 0.8
     times = seconds_summary([0.01] * 98 + [0.5, 2.0])
-    assert times["median"] == 0.01 and times["n"] == 100 and 0.5 < times["p99"] < 2.0 and times["max"] == 2.0
-    assert seconds_summary([])["median"] is None
+    assert times.median == 0.01 and times.n == 100 and 0.5 < times.p99 < 2.0 and times.max == 2.0
+    assert seconds_summary([]).median is None
 
 
 def test_calibration_and_wilson_intervals():
@@ -477,11 +477,14 @@ def test_the_evaluation_takes_new_processes_not_those_joblib_kept_from_the_colle
 def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     from affordance_learning.planning.experiment import PlanSettings, oracle_params, run_plan
     from affordance_learning.planning.report import write_plan_figures, write_plan_report
+    from affordance_learning.planning.results import PlanResults
     from affordance_learning.planning.targets import TARGETS
 
     settings = PlanSettings(episodes=40, max_episodes=40, objects=2, multi_episodes=2, candidates=8,
                             som_clusters=2)
-    results = run_plan(tmp_path, seed=1, workers=1, settings=settings, camera=(40, 30), say=lambda text: None)
+    plan = run_plan(tmp_path, seed=1, workers=1, settings=settings, camera=(40, 30), say=lambda text: None)
+    results = json.loads((tmp_path / "results.json").read_text())
+    assert PlanResults.from_dict(results) == plan  # the file reads back as the results it was written from
     for policy in ("planner", "random", "best_fixed", "som_categories", "oracle"):
         entry = results["single_step"][policy]
         assert 0 <= entry["success"] <= 1 and entry["n"] >= 1

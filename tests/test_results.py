@@ -228,6 +228,8 @@ def test_plan_results_count_placements_from_the_goals_when_older() -> None:
      r"plan results\['goals'\]\[0\]\['planner'\] must be true or false, got 'false'"),
     (lambda r: r.update(format="tap-affordance-results"), "results of format 'tap-affordance-results', not "
                                                           "'tap-affordance-plan-results'"),
+    (lambda r: r.update(version=3), "plan results of version 3; this tap-affordance reads versions 1 to 2 of "
+                                    "'tap-affordance-plan-results': upgrade the package"),
 ])
 def test_plan_results_name_what_is_missing_or_wrong(edit, named: str) -> None:
     broken = _plan()

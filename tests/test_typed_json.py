@@ -118,12 +118,14 @@ def test_the_plans_records_read_through_it() -> None:
     goal = {"kind": "roll", "type": "sphere", "object": 3, "planner": True, "planner_p": 0.8,
             "planner_behavior": "tap", "oracle": True, "size": 0.05}
     read = from_json(GoalRecord, goal, name="plan results")
-    assert read == GoalRecord("roll", "sphere", 3, True, 0.8, "tap", True, 0.05)
+    assert read == GoalRecord(kind="roll", type="sphere", object=3, planner=True, planner_p=0.8,
+                              planner_behavior="tap", oracle=True, size=0.05)
     assert to_json(read) == {**goal, "oracle_hits": None, "planner_left_out": None}
     with pytest.raises(InvalidValueError, match=r"plan results\['planner'\] must be true or false, got 'false'"):
         from_json(GoalRecord, {**goal, "planner": "false"}, name="plan results")
-    episode = Episode("box", (-0.3, 0.0), (-0.2, 0.1), False, True, False, ("reach",), True,
-                      MappingProxyType({"draw": True, "grasp": False}))
+    episode = Episode(type="box", start_xy=(-0.3, 0.0), target_xy=(-0.2, 0.1), success=False, within_reach=True,
+                      gave_up=False, failures=("reach",), toward_robot=True,
+                      pulls_at_start=MappingProxyType({"draw": True, "grasp": False}))
     assert from_json(Episode, json.loads(json.dumps(to_json(episode)))) == episode
     assert from_json(Share, to_json(Share(0.5, 20, (0.3, 0.7)))) == Share(0.5, 20, (0.3, 0.7))
     pooled = Calibration(0.1, None, 4, (CalibrationBin(0.5, 0.25, 4),))

@@ -25,6 +25,8 @@ What a field says of its JSON (``field(metadata=json_options(...))``):
   typed queries).
 
 A field with a default may be missing from the JSON; one without must be there. Keys no field names are skipped.
+Fields are written in the order the dataclass declares them (``kw_only`` lets a required field follow one with a
+default, to keep a file's order). Where a dataclass is expected, an instance of it is taken as it is.
 """
 
 from __future__ import annotations
@@ -194,6 +196,8 @@ def _read(hint: Any, value: Any, path: Path, reading: _Reading, optional: bool =
 
 
 def _read_dataclass(cls: type, value: Any, path: Path, reading: _Reading) -> Any:
+    if isinstance(value, cls):  # already built (a producer's part in a dict of JSON values)
+        return value
     found, inline = _fields(cls)
     if inline:
         return cls(**{found[0].name: _read(found[0].hint, value, path, reading)})

@@ -1,5 +1,10 @@
 """The results of ``affordance plan`` (:func:`~affordance_learning.planning.experiment.run_plan`, its ``results.json``):
-:class:`PlanResults`, the typed, read-only view its report, figures and targets read them through.
+:class:`PlanResults`, frozen dataclasses that the experiment's stages build and that mirror ``results.json`` key for
+key, with typed queries on top (a policy's :class:`Share` of its goals, its episodes, ...).
+
+One generic writer and reader (:mod:`affordance_learning.common.typed_json`) goes between them and the JSON:
+``json.dumps(to_json(results), indent=1, default=float)`` is the file, :meth:`PlanResults.from_dict` reads it back.
+Results of an older version are brought to the current one first (:func:`current_plan_results`).
 
 Units: every share is a fraction in [0, 1] (with its Wilson 95 % interval where the results hold one), distances
 are in metres, times in seconds.
@@ -7,27 +12,39 @@ are in metres, times in seconds.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any
+from typing import Annotated, Any
 
 from affordance_learning.common.exceptions import InvalidValueError
-from affordance_learning.common.json_reading import Path as _Path
-from affordance_learning.common.json_reading import Reader, is_number
+from affordance_learning.common.typed_json import from_json, json_options
 
-#: The ``format`` a plan's ``results.json`` names.
-PLAN_RESULTS_FORMAT = "tap-affordance-plan-results"
+#: The ``format`` a plan's ``results.json`` names, and its ``version``: version 1 lacks what later runs recorded
+#: (``placement_error_n``, the goals' sizes, ...); both are read.
+PLAN_RESULTS_FORMAT, PLAN_RESULTS_VERSION = "tap-affordance-plan-results", 2
 _EXPECTED = "expected the results of affordance plan (run_plan)"
+#: The units ``results.json`` declares.
+UNITS = MappingProxyType({"fractions": "[0, 1]", "distances": "m", "times": "s"})
 
-_READ = Reader("plan results", _EXPECTED)
-_where, _mapping, _list, _entry = _READ.where, _READ.mapping, _READ.list, _READ.entry
-_number, _count, _is_number = _READ.number, _READ.count, is_number
+Interval = tuple[float, float]
+Count = Annotated[int, "a count"]
+_EMPTY: Mapping[str, Any] = MappingProxyType({})
+
+
+def _by_default(mapping: Mapping[str, Any]) -> Any:
+    """A mapping field that defaults to ``mapping`` (read-only, so shared)."""
+    return field(default_factory=lambda: mapping)
+
+
+def _omitted() -> Any:
+    """A field the JSON leaves out when None (a section only some entries hold)."""
+    return field(default=None, metadata=json_options(omit_none=True))
 
 
 @dataclass(frozen=True)
 class Share:
-    """A share of ``n`` cases, a fraction in [0, 1].
+    """A share of ``n`` cases, a fraction in [0, 1] (a query on the results, not a part of their JSON).
 
     Attributes:
         value: The share; None for a share of nothing (0 of 0), which is no rate.
@@ -36,8 +53,8 @@ class Share:
     """
 
     value: float | None
-    n: int = 0
-    ci: tuple[float, float] | None = None
+    n: Count = 0
+    ci: Interval | None = None
 
 
 #: A share of nothing: what a policy or goal kind the results do not hold shows.
@@ -46,21 +63,50 @@ NOTHING = Share(None)
 
 @dataclass(frozen=True)
 class PolicyOutcome:
-    """How often one policy reached its goals (:func:`~affordance_learning.planning.experiment.summarize`).
+    """How often one policy reached its goals (:func:`~affordance_learning.planning.experiment.summarize`): its
+    share of all the goals (``success``, ``success_ci``, ``n``), of the feasible ones (those the oracle reached:
+    ``*_feasible``) and of those the oracle or the planner reached (``*_reached``; None and 0 in results written
+    before it was recorded)."""
 
-    Attributes:
-        reached: Its share of all the goals.
-        feasible: Its share of the feasible goals (those the oracle reached).
-        reached_any: Its share of the goals the oracle or the planner reached (:data:`NOTHING` in results written
-            before it was recorded).
-    """
+    success: float | None
+    success_ci: Interval | None
+    success_feasible: float | None
+    success_feasible_ci: Interval | None
+    n: Count
+    n_feasible: Count
+    success_reached: float | None = None
+    success_reached_ci: Interval | None = None
+    n_reached: Count = 0
 
-    reached: Share
-    feasible: Share
-    reached_any: Share = NOTHING
+    @property
+    def reached(self) -> Share:
+        """Its share of all the goals."""
+        return Share(self.success, self.n, self.success_ci)
+
+    @property
+    def feasible(self) -> Share:
+        """Its share of the feasible goals."""
+        return Share(self.success_feasible, self.n_feasible, self.success_feasible_ci)
+
+    @property
+    def reached_any(self) -> Share:
+        """Its share of the goals the oracle or the planner reached (:data:`NOTHING` where not recorded)."""
+        return Share(self.success_reached, self.n_reached, self.success_reached_ci)
 
 
 @dataclass(frozen=True)
+class Rate:
+    """The share of ``n`` cases that succeeded, without an interval: ``{"n": 10, "success": 0.4}``."""
+
+    n: Count
+    success: float | None
+
+    @property
+    def share(self) -> Share:
+        return Share(self.success, self.n)
+
+
+@dataclass(frozen=True, kw_only=True)
 class Episode:
     """One multi-step episode of the planner.
 
@@ -68,56 +114,86 @@ class Episode:
         type: The object type.
         start_xy: Where the object started on the table (x, y) [m].
         target_xy: Where it was to be brought (x, y) [m].
+        initial_distance: Its distance to the target at the start [m] (None where not recorded).
+        final_distance: Its distance to the target at the end [m] (None where not recorded).
+        steps: Its interactions (None where not recorded).
         success: Whether it got there.
-        within_reach: Whether the episode's interactions could take it there at all
-            (:func:`~affordance_learning.planning.experiment.within_reach`).
         gave_up: Whether the planner stopped because none of the candidates it asked ``feasible`` about (at most
             its ``max_checks``) was reachable.
+        reach_failures: Its interactions that failed to reach (None where not recorded).
         failures: The messages of its interactions that failed to reach.
         toward_robot: Whether its target lay toward the robot (within 45 degrees of +x from the object).
         pulls_at_start: For an episode toward the robot: whether each behaviour that brings objects toward it
             (the draw, the grasp) could act on the object where it started (``feasible`` of its canonical action);
             None otherwise (and for the episodes that reached their target, in results of version 2 written before
             it was recorded for them).
+        within_reach: Whether the episode's interactions could take it there at all
+            (:func:`~affordance_learning.planning.experiment.within_reach`).
     """
 
     type: str
     start_xy: tuple[float, float]
     target_xy: tuple[float, float]
+    initial_distance: float | None = None
+    final_distance: float | None = None
+    steps: Count | None = None
     success: bool
-    within_reach: bool
     gave_up: bool
+    reach_failures: Count | None = None
     failures: tuple[str, ...] = ()
     toward_robot: bool = False
     pulls_at_start: Mapping[str, bool] | None = field(default=None, hash=False)  # read-only
+    within_reach: bool
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class MultiStepOutcome:
-    """How one policy did over the multi-step episodes.
+    """How one policy did over the multi-step episodes: the share reached (``success``, ``success_ci``, ``n``),
+    the reach failures per interaction (a fraction), its ``interactions``, the episodes it gave up, the median
+    distance left at the end [m], the share reached toward the robot (``*_toward_robot``; None and 0 in results
+    written before it was recorded), and, for the planner only, ``planner_by_type``, ``planner_episodes`` and
+    ``planner_within_reach`` (read through :attr:`by_type`, :attr:`episodes` and :attr:`within_reach`)."""
 
-    Attributes:
-        reached: Its share of the episodes that reached their target.
-        reach_failures: Interactions that failed to reach although the kinematics said they would, per
-            interaction (a fraction).
-        interactions: The interactions of all its episodes.
-        median_final_distance_m: The median distance left to the target at the end [m].
-        by_type: Its share of the episodes reached, per object type (the planner's only).
-        episodes: Its episodes (the planner's only).
-        within_reach: Its share of the episodes reached among those whose target was within reach (the
-            planner's only; :data:`NOTHING` otherwise).
-        toward_robot: Its share of the episodes reached among those whose target lay toward the robot (within 45
-            degrees of +x; :data:`NOTHING` in results written before it was recorded).
-    """
-
-    reached: Share
+    success: float | None
+    success_ci: Interval | None = None
+    n: Count
     reach_failures: float
-    interactions: int
+    interactions: Count
+    gave_up: Count = 0
     median_final_distance_m: float
-    by_type: Mapping[str, Share]
-    episodes: tuple[Episode, ...] = ()
-    within_reach: Share = NOTHING
-    toward_robot: Share = NOTHING
+    success_toward_robot: float | None = None
+    success_toward_robot_ci: Interval | None = None
+    n_toward_robot: Count = 0
+    planner_by_type: Mapping[str, Rate] | None = field(default=None, metadata=json_options("by_type", True))
+    planner_episodes: tuple[Episode, ...] | None = field(default=None, metadata=json_options("episodes", True))
+    planner_within_reach: Rate | None = field(default=None, metadata=json_options("within_reach", True))
+
+    @property
+    def reached(self) -> Share:
+        """Its share of the episodes that reached their target."""
+        return Share(self.success, self.n, self.success_ci)
+
+    @property
+    def toward_robot(self) -> Share:
+        """Its share of the episodes reached among those whose target lay toward the robot (:data:`NOTHING` where
+        not recorded)."""
+        return Share(self.success_toward_robot, self.n_toward_robot, self.success_toward_robot_ci)
+
+    @property
+    def by_type(self) -> Mapping[str, Share]:
+        """Its share of the episodes reached, per object type (the planner's only)."""
+        return MappingProxyType({t: r.share for t, r in (self.planner_by_type or {}).items()})
+
+    @property
+    def episodes(self) -> tuple[Episode, ...]:
+        """Its episodes (the planner's only)."""
+        return self.planner_episodes or ()
+
+    @property
+    def within_reach(self) -> Share:
+        """Its share of the episodes reached among those whose target was within reach (the planner's only;
+        :data:`NOTHING` otherwise)."""
+        return NOTHING if self.planner_within_reach is None else self.planner_within_reach.share
 
     @property
     def reach_failure_count(self) -> int:
@@ -125,22 +201,25 @@ class MultiStepOutcome:
         return round(self.reach_failures * self.interactions)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class MultiStep:
-    """The multi-step evaluation.
+    """The multi-step evaluation: each policy's outcome (the planner's, the direction heuristic's, random
+    actions'), per object type and direction ("+x", "-x", "+y", "-y") how far 9 in 10 interactions move the object
+    that way [m], how close to its target an object must end [m] (None when the results do not say), and the
+    interactions an episode may take."""
 
-    Attributes:
-        policies: Each policy's outcome, in the order held.
-        step_reach_p90_m: Per object type and direction ("+x", "-x", "+y", "-y"), how far 9 in 10 interactions
-            move the object that way [m].
-        max_interactions: The interactions an episode may take.
-        tolerance_m: How close to its target an object must end [m]; None when the results do not say.
-    """
-
-    policies: Mapping[str, MultiStepOutcome]
-    step_reach_p90_m: Mapping[str, Mapping[str, float]]
-    max_interactions: int
+    planner: MultiStepOutcome
+    direction: MultiStepOutcome | None = _omitted()
+    random: MultiStepOutcome | None = _omitted()
+    step_reach_p90_m: Mapping[str, Mapping[str, float]] = _by_default(_EMPTY)
     tolerance_m: float | None = None
+    max_interactions: Count
+
+    @property
+    def policies(self) -> Mapping[str, MultiStepOutcome]:
+        """Each policy's outcome, of those run."""
+        held = {"planner": self.planner, "direction": self.direction, "random": self.random}
+        return MappingProxyType({name: outcome for name, outcome in held.items() if outcome is not None})
 
     def policy(self, name: str) -> MultiStepOutcome:
         """The outcome of policy ``name``; InvalidValueError naming the policies held when it was not run."""
@@ -157,7 +236,7 @@ class CalibrationBin:
 
     p: float
     observed: float
-    n: int
+    n: Count
 
 
 @dataclass(frozen=True)
@@ -169,13 +248,13 @@ class Calibration:
 
     ece: float | None
     auroc: float | None
-    n: int
+    n: Count
     curve: tuple[CalibrationBin, ...]
     basis: str = "every action executed in the single-step evaluation"
-    pooled: Calibration | None = None
+    pooled: Calibration | None = _omitted()
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class GoalRecord:
     """One goal of the single-step evaluation and how it went.
 
@@ -183,11 +262,12 @@ class GoalRecord:
         kind: The goal's kind ("roll", "lift", "move", "place").
         type: The object type.
         object: The held-out object's index.
+        size: The object's size [m]; None in results written before it was recorded.
+        goal: The goal (:meth:`~affordance_learning.planning.goals.Goal.to_dict`); None where not recorded.
         planner: Whether the planner's action reached the goal.
         planner_p: The P(goal) the planner gave its action (0 where it chose none).
         planner_behavior: The behaviour it chose; None where no candidate it asked about was feasible.
         oracle: Whether some action of the oracle's set reached it (the goal is *feasible*).
-        size: The object's size [m]; None in results written before it was recorded.
         oracle_hits: How many actions of the oracle's set reached it; None in results written before it was
             recorded.
         planner_left_out: Whether the planner fitted without the object's type reached it; None in results
@@ -196,289 +276,175 @@ class GoalRecord:
 
     kind: str
     type: str
-    object: int
+    object: Count
+    size: float | None = None
+    goal: Any = field(default=None, hash=False, metadata=json_options(omit_none=True))
     planner: bool
     planner_p: float
     planner_behavior: str | None
     oracle: bool
-    size: float | None = None
-    oracle_hits: int | None = None
+    oracle_hits: Count | None = None
     planner_left_out: bool | None = None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class DecisionTimes:
-    """How long the planner's decisions took [s], ``feasible``'s calls included: median, 99th percentile and n
-    (None without decisions)."""
+    """How long the planner's decisions took [s], ``feasible``'s calls included: median, 99th percentile, the
+    most, and n (None without decisions); for all of them, the single step's (``choose``) and the multi-step's
+    (``toward``)."""
 
     median: float | None
     p99: float | None
-    n: int
+    max: float | None = None
+    n: Count
+    choose: DecisionTimes | None = _omitted()
+    toward: DecisionTimes | None = _omitted()
 
 
 @dataclass(frozen=True)
+class ReachFailures:
+    """The single-step goals the planner acted on, and how many of its actions failed to reach."""
+
+    n: Count
+    failures: Count
+
+
+@dataclass(frozen=True, kw_only=True)
 class PlanResults:
-    """The results of ``affordance plan``, typed and read-only: build it with :meth:`from_dict`.
+    """The results of ``affordance plan``, typed and read-only, each field a key of ``results.json`` in its order;
+    :meth:`from_dict` reads them.
 
     Attributes:
+        format: :data:`PLAN_RESULTS_FORMAT`.
+        version: :data:`PLAN_RESULTS_VERSION` (what older results were read as).
         seed: The seed of the data and of the evaluation.
         settings: The run's settings (:class:`~affordance_learning.planning.experiment.PlanSettings`), as written.
+        units: The units of its numbers (:data:`UNITS`).
         training: The training interactions per behaviour.
-        timings_s: The time of each stage and the ``total`` [s].
+        training_episodes: The goal episodes they came from (None when not recorded).
+        workers: The worker processes of the run (None when not recorded).
+        cpu_count: The machine's CPUs (None when not recorded).
+        oracle: How the single-step evaluation was made: ``objects``, ``objects_per_shape``, ``goals_per_object``,
+            ``actions_per_behavior``, ``levels`` (empty in results written before it was recorded).
         single_step: Each policy's outcome over the held-out single-step goals.
         single_step_by_goal: The same per goal kind.
         best_fixed_behavior: Per goal kind, the behaviour whose canonical action reached it most often.
         planner_over_oracle: The planner's success over the oracle's (a ratio); None when the oracle reached
             nothing.
+        single_step_reach_failures: The planner's single-step actions that failed to reach (None when not
+            recorded).
         leave_one_shape_out: Per left-out shape, each policy's outcome on goals for it.
         multi_step: The multi-step evaluation.
         placement_error_median_m: The median placement error of the place goals the planner acted on [m]; None
             without any.
         placement_error_n: How many place goals the planner acted on (counted from the goals in results written
             before it was recorded).
-        placement_error_committed: The median placement error [m] and n of the place goals the planner acted on
-            without abstaining (P(goal) at least its threshold); (None, 0) without any, or in results written
+        placement_error_committed_median_m, placement_error_committed_n: The same over the place goals it acted on
+            without abstaining (P(goal) at least its threshold); None and 0 without any, or in results written
             before it was recorded.
         calibration: The calibration of the planner's predicted probabilities.
         decision_seconds: The planner's decision times, single-step and multi-step together (n 0 in results
             written before they were recorded).
-        workers: The worker processes of the run (None when not recorded).
-        oracle: How the single-step evaluation was made: ``objects``, ``objects_per_shape``, ``goals_per_object``,
-            ``actions_per_behavior``, ``levels`` (empty in results written before it was recorded).
+        timings_s: The time of each stage and the ``total`` [s].
         goals: The single-step goals, one record each (empty in results written without them).
     """
 
-    seed: int
+    format: str = PLAN_RESULTS_FORMAT
+    version: Count = PLAN_RESULTS_VERSION
+    seed: Count
     settings: Mapping[str, Any]
-    training: Mapping[str, int]
-    timings_s: Mapping[str, float]
+    units: Mapping[str, str] = _by_default(UNITS)
+    training: Mapping[str, Count]
+    training_episodes: Count | None = None
+    workers: Count | None = None
+    cpu_count: Count | None = None
+    oracle: Mapping[str, Any] = _by_default(_EMPTY)
     single_step: Mapping[str, PolicyOutcome]
     single_step_by_goal: Mapping[str, Mapping[str, PolicyOutcome]]
     best_fixed_behavior: Mapping[str, str]
     planner_over_oracle: float | None
+    single_step_reach_failures: ReachFailures | None = _omitted()
     leave_one_shape_out: Mapping[str, Mapping[str, PolicyOutcome]]
     multi_step: MultiStep
     placement_error_median_m: float | None
-    placement_error_n: int
+    placement_error_n: Count
+    placement_error_committed_median_m: float | None = None
+    placement_error_committed_n: Count = 0
     calibration: Calibration
-    decision_seconds: DecisionTimes = DecisionTimes(None, None, 0)
-    workers: int | None = None
-    oracle: Mapping[str, Any] = field(default_factory=lambda: MappingProxyType({}))
-    placement_error_committed: tuple[float | None, int] = (None, 0)
+    decision_seconds: DecisionTimes = DecisionTimes(median=None, p99=None, n=0)
+    timings_s: Mapping[str, float]
     goals: tuple[GoalRecord, ...] = ()
 
     @classmethod
     def from_dict(cls, results: PlanResults | Mapping[str, Any]) -> PlanResults:
-        """Read the results of ``affordance plan`` (the dict of
-        :func:`~affordance_learning.planning.experiment.run_plan`, or its ``results.json`` read back) and check them.
+        """Read the results of ``affordance plan`` (its ``results.json`` read back, or a dict of that shape) and
+        check them; PlanResults are returned as they are.
 
         Raises:
-            InvalidValueError: ``results`` are not a mapping, name another format, lack a section (naming every
-                one they lack), or hold a part that is not of the format (naming where).
+            InvalidValueError: ``results`` are not a mapping, name another format or a version this package does
+                not read, lack a section (naming every one they lack), or hold a part that is not of the format
+                (naming where).
         """
         if isinstance(results, PlanResults):
             return results
-        if not isinstance(results, Mapping):
-            raise InvalidValueError(f"plan results must be a mapping, got {type(results).__name__}; {_EXPECTED}.")
-        if results.get("format", PLAN_RESULTS_FORMAT) != PLAN_RESULTS_FORMAT:
-            raise InvalidValueError(f"results of format {results['format']!r}, not {PLAN_RESULTS_FORMAT!r}; "
-                                    f"{_EXPECTED}.")
-        top = _entry(results, (), ("seed", "settings", "training", "timings_s", "single_step", "single_step_by_goal",
-                                   "best_fixed_behavior", "planner_over_oracle", "leave_one_shape_out", "multi_step",
-                                   "placement_error_median_m", "calibration"))
-        timings = _entry(top["timings_s"], ("timings_s",), ("total",))
-        return cls(
-            seed=_count(top["seed"], ("seed",)),
-            settings=MappingProxyType(dict(_mapping(top["settings"], ("settings",)))),
-            training=_by_name(top["training"], ("training",), _count),
-            timings_s=_by_name(timings, ("timings_s",), _number),
-            single_step=_outcomes(top["single_step"], ("single_step",)),
-            single_step_by_goal=_by_name(top["single_step_by_goal"], ("single_step_by_goal",), _outcomes),
-            best_fixed_behavior=_by_name(top["best_fixed_behavior"], ("best_fixed_behavior",), _text),
-            planner_over_oracle=_number(top["planner_over_oracle"], ("planner_over_oracle",), True),
-            leave_one_shape_out=_by_name(top["leave_one_shape_out"], ("leave_one_shape_out",), _outcomes),
-            multi_step=_multi_step(top["multi_step"], ("multi_step",)),
-            placement_error_median_m=_number(top["placement_error_median_m"], ("placement_error_median_m",), True),
-            placement_error_n=_placements(top),
-            calibration=_calibration(top["calibration"], ("calibration",)),
-            decision_seconds=_decisions(top.get("decision_seconds"), ("decision_seconds",)),
-            workers=None if top.get("workers") is None else _count(top["workers"], ("workers",)),
-            placement_error_committed=(
-                _number(top.get("placement_error_committed_median_m"), ("placement_error_committed_median_m",), True),
-                _count(top.get("placement_error_committed_n", 0), ("placement_error_committed_n",))),
-            oracle=MappingProxyType(dict(_mapping(top.get("oracle", {}), ("oracle",)))),
-            goals=tuple(_goal(g, ("goals", i)) for i, g in enumerate(_list(top.get("goals", []), ("goals",)))),
-        )
+        read = from_json(cls, current_plan_results(results), name="plan results", expected=_EXPECTED)
+        if "total" not in read.timings_s:
+            raise InvalidValueError(f"plan results['timings_s'] lacks 'total'; {_EXPECTED}.")
+        return read
 
     @property
     def episodes(self) -> int:
         """The goal episodes collected for training (``settings["episodes"]``)."""
-        return _count(self.settings.get("episodes"), ("settings", "episodes"))
+        episodes = self.settings.get("episodes")
+        if isinstance(episodes, bool) or not isinstance(episodes, int | float) or not float(episodes).is_integer():
+            raise InvalidValueError(f"plan results['settings']['episodes'] must be a count (a whole number), got "
+                                    f"{episodes!r}; {_EXPECTED}.")
+        return int(episodes)
 
     @property
     def total_time_s(self) -> float:
         """The run's total time [s]."""
         return self.timings_s["total"]
 
-
-# --- reading and checking -------------------------------------------------------------------------------------
-
-
-def _text(value: Any, path: _Path) -> str:
-    if not isinstance(value, str):
-        raise InvalidValueError(f"{_where(path)} must be a name, got {value!r}; {_EXPECTED}.")
-    return value
+    @property
+    def placement_error_committed(self) -> tuple[float | None, int]:
+        """The median placement error [m] and n of the place goals the planner acted on without abstaining."""
+        return self.placement_error_committed_median_m, self.placement_error_committed_n
 
 
-def _by_name(value: Any, path: _Path, read: Callable[[Any, _Path], Any]) -> Mapping[str, Any]:
-    """A mapping of names (policies, shapes, goal kinds, behaviours) to what ``read`` makes of each value."""
-    return MappingProxyType({str(name): read(v, (*path, name)) for name, v in _mapping(value, path).items()})
+# --- older results ---------------------------------------------------------------------------------------------
+def current_plan_results(results: Any) -> Mapping[str, Any]:
+    """``results`` as the current version holds them, for the generic read: a copy where an older one lacks what
+    the reader cannot default (``placement_error_n``, counted from the goals; ``decision_seconds`` written as
+    None), ``results`` themselves otherwise.
 
-
-def _interval(value: Any, path: _Path) -> tuple[float, float] | None:
-    if value is None:
-        return None
-    low_high = _list(value, path)
-    if len(low_high) != 2:
-        raise InvalidValueError(f"{_where(path)} must be an interval (low, high), got {value!r}; {_EXPECTED}.")
-    return _number(low_high[0], path), _number(low_high[1], path)
-
-
-def _share(value: Any, path: _Path, key: str = "success", n: str = "n", ci: str | None = "success_ci") -> Share:
-    """The share ``key`` of an entry, of its ``n`` cases, with its interval ``ci`` when the entry holds one."""
-    entry = _entry(value, path, (key, n))
-    return Share(_number(entry[key], (*path, key), True), _count(entry[n], (*path, n)),
-                 None if ci is None else _interval(entry.get(ci), (*path, ci)))
-
-
-def _outcomes(value: Any, path: _Path) -> Mapping[str, PolicyOutcome]:
-    """Each policy's outcome over a set of goals."""
-    def outcome(entry: Any, where: _Path) -> PolicyOutcome:
-        entry = _entry(entry, where, ("success", "success_ci", "n", "success_feasible", "success_feasible_ci",
-                                      "n_feasible"))
-        return PolicyOutcome(_share(entry, where),
-                             _share(entry, where, "success_feasible", "n_feasible", "success_feasible_ci"),
-                             _share(entry, where, "success_reached", "n_reached", "success_reached_ci")
-                             if "n_reached" in entry else NOTHING)
-
-    return _by_name(value, path, outcome)
-
-
-def _xy(value: Any, path: _Path) -> tuple[float, float]:
-    xy = _list(value, path)
-    if len(xy) != 2:
-        raise InvalidValueError(f"{_where(path)} must be a point (x, y) [m], got {value!r}; {_EXPECTED}.")
-    return _number(xy[0], path), _number(xy[1], path)
-
-
-def _episode(value: Any, path: _Path) -> Episode:
-    entry = _entry(value, path, ("type", "start_xy", "target_xy", "success", "within_reach", "gave_up"))
-    return Episode(type=_text(entry["type"], (*path, "type")), start_xy=_xy(entry["start_xy"], (*path, "start_xy")),
-                   target_xy=_xy(entry["target_xy"], (*path, "target_xy")), success=bool(entry["success"]),
-                   within_reach=bool(entry["within_reach"]), gave_up=bool(entry["gave_up"]),
-                   failures=tuple(str(f) for f in _list(entry.get("failures", []), (*path, "failures"))),
-                   toward_robot=bool(entry.get("toward_robot", False)),
-                   pulls_at_start=_pulls(entry.get("pulls_at_start"), (*path, "pulls_at_start")))
-
-
-def _pulls(value: Any, path: _Path) -> Mapping[str, bool] | None:
-    if value is None:
-        return None
-    if not isinstance(value, Mapping) or not all(isinstance(v, bool) for v in value.values()):
-        raise InvalidValueError(f"{_where(path)} must map behaviour names to true or false, got {value!r}; "
+    Raises:
+        InvalidValueError: ``results`` are not a mapping, name another format, or a version newer than
+            :data:`PLAN_RESULTS_VERSION`.
+    """
+    if not isinstance(results, Mapping):
+        raise InvalidValueError(f"plan results must be a mapping, got {type(results).__name__}; {_EXPECTED}.")
+    if results.get("format", PLAN_RESULTS_FORMAT) != PLAN_RESULTS_FORMAT:
+        raise InvalidValueError(f"results of format {results['format']!r}, not {PLAN_RESULTS_FORMAT!r}; "
                                 f"{_EXPECTED}.")
-    return MappingProxyType({str(k): v for k, v in value.items()})
+    version = results.get("version", 1)
+    if version not in range(1, PLAN_RESULTS_VERSION + 1) or isinstance(version, bool):
+        raise InvalidValueError(f"plan results of version {version!r}; this tap-affordance reads versions 1 to "
+                                f"{PLAN_RESULTS_VERSION} of {PLAN_RESULTS_FORMAT!r}: upgrade the package.")
+    if "placement_error_n" in results and results.get("decision_seconds", {}) is not None:
+        return results
+    upgraded = dict(results)
+    if upgraded.get("decision_seconds", {}) is None:
+        del upgraded["decision_seconds"]
+    if "placement_error_n" not in upgraded:
+        goals = upgraded.get("goals", [])
+        countable = isinstance(goals, list | tuple) and all(isinstance(g, Mapping) for g in goals)
+        # the goals a reader refuses are named by it; the count then does not matter
+        upgraded["placement_error_n"] = sum(g.get("kind") == "place" and bool(g.get("planner_behavior"))
+                                            for g in goals) if countable else 0
+    return upgraded
 
 
-#: The entries of ``multi_step`` that describe the evaluation, not a policy.
-_MULTI_STEP_SETTINGS = ("step_reach_p90_m", "max_interactions", "tolerance_m")
-
-
-def _multi_step(value: Any, path: _Path) -> MultiStep:
-    section = _entry(value, path, ("planner", "max_interactions"))
-    policies = {}
-    for name, entry in section.items():
-        if name in _MULTI_STEP_SETTINGS:
-            continue
-        where = (*path, name)
-        entry = _entry(entry, where, ("success", "n", "reach_failures", "interactions", "median_final_distance_m"))
-        policies[str(name)] = MultiStepOutcome(
-            reached=_share(entry, where),
-            reach_failures=_number(entry["reach_failures"], (*where, "reach_failures")),
-            interactions=_count(entry["interactions"], (*where, "interactions")),
-            median_final_distance_m=_number(entry["median_final_distance_m"], (*where, "median_final_distance_m")),
-            by_type=_by_name(entry.get("by_type", {}), (*where, "by_type"),
-                             lambda v, p: _share(v, p, ci=None)),
-            episodes=tuple(_episode(e, (*where, "episodes", i))
-                           for i, e in enumerate(_list(entry.get("episodes", []), (*where, "episodes")))),
-            within_reach=(NOTHING if entry.get("within_reach") is None
-                          else _share(entry["within_reach"], (*where, "within_reach"), ci=None)),
-            toward_robot=(_share(entry, where, "success_toward_robot", "n_toward_robot", "success_toward_robot_ci")
-                          if "n_toward_robot" in entry else NOTHING),
-        )
-    reach = _by_name(section.get("step_reach_p90_m", {}), (*path, "step_reach_p90_m"),
-                     lambda v, p: _by_name(v, p, _number))
-    return MultiStep(policies=MappingProxyType(policies), step_reach_p90_m=reach,
-                     max_interactions=_count(section["max_interactions"], (*path, "max_interactions")),
-                     tolerance_m=_number(section.get("tolerance_m"), (*path, "tolerance_m"), True))
-
-
-def _calibration(value: Any, path: _Path) -> Calibration:
-    section = _entry(value, path, ("ece", "auroc", "n", "curve"))
-    curve = []
-    for i, b in enumerate(_list(section["curve"], (*path, "curve"))):
-        where = (*path, "curve", i)
-        entry = _entry(b, where, ("p", "observed", "n"))
-        curve.append(CalibrationBin(_number(entry["p"], (*where, "p")),
-                                    _number(entry["observed"], (*where, "observed")),
-                                    _count(entry["n"], (*where, "n"))))
-    pooled = section.get("pooled")
-    return Calibration(ece=_number(section["ece"], (*path, "ece"), True),
-                       auroc=_number(section["auroc"], (*path, "auroc"), True),
-                       n=_count(section["n"], (*path, "n")), curve=tuple(curve),
-                       basis=_text(section.get("basis", Calibration.basis), (*path, "basis")),
-                       pooled=None if pooled is None else _calibration(pooled, (*path, "pooled")))
-
-
-def _flag(value: Any, path: _Path) -> bool:
-    """``value`` as a bool: true or false (a string such as "false" is neither)."""
-    if isinstance(value, str) or value not in (True, False):
-        raise InvalidValueError(f"{_where(path)} must be true or false, got {value!r}; {_EXPECTED}.")
-    return bool(value)
-
-
-def _goal(value: Any, path: _Path) -> GoalRecord:
-    entry = _entry(value, path, ("kind", "type", "object", "planner", "planner_p", "planner_behavior", "oracle"))
-    behavior, left_out = entry["planner_behavior"], entry.get("planner_left_out")
-    hits = entry.get("oracle_hits")
-    return GoalRecord(kind=_text(entry["kind"], (*path, "kind")), type=_text(entry["type"], (*path, "type")),
-                      object=_count(entry["object"], (*path, "object")),
-                      planner=_flag(entry["planner"], (*path, "planner")),
-                      planner_p=_number(entry["planner_p"], (*path, "planner_p")),
-                      planner_behavior=_text(behavior, (*path, "planner_behavior")) if behavior else None,
-                      oracle=_flag(entry["oracle"], (*path, "oracle")),
-                      size=_number(entry.get("size"), (*path, "size"), True),
-                      oracle_hits=None if hits is None else _count(hits, (*path, "oracle_hits")),
-                      planner_left_out=None if left_out is None else _flag(left_out, (*path, "planner_left_out")))
-
-
-def _decisions(value: Any, path: _Path) -> DecisionTimes:
-    if value is None:
-        return DecisionTimes(None, None, 0)
-    section = _entry(value, path, ("median", "p99", "n"))
-    return DecisionTimes(_number(section["median"], (*path, "median"), True),
-                         _number(section["p99"], (*path, "p99"), True), _count(section["n"], (*path, "n")))
-
-
-def _placements(results: Mapping[str, Any]) -> int:
-    """How many place goals the planner acted on (the n of the median placement error); counted from the goals
-    for results written before ``placement_error_n``."""
-    if "placement_error_n" in results:
-        return _count(results["placement_error_n"], ("placement_error_n",))
-    goals = _list(results.get("goals", []), ("goals",))
-    return sum(_mapping(g, ("goals", i)).get("kind") == "place" and bool(g.get("planner_behavior"))
-               for i, g in enumerate(goals))
-
-
-__all__ = ["NOTHING", "PLAN_RESULTS_FORMAT", "Calibration", "CalibrationBin", "DecisionTimes", "Episode", "GoalRecord",
-           "MultiStep", "MultiStepOutcome", "PlanResults", "PolicyOutcome", "Share"]
+__all__ = ["NOTHING", "PLAN_RESULTS_FORMAT", "PLAN_RESULTS_VERSION", "UNITS", "Calibration", "CalibrationBin",
+           "DecisionTimes", "Episode", "GoalRecord", "MultiStep", "MultiStepOutcome", "PlanResults", "PolicyOutcome",
+           "Rate", "ReachFailures", "Share", "current_plan_results"]

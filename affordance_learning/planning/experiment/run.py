@@ -12,6 +12,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from types import MappingProxyType
 from typing import Any
 
 import numpy as np
@@ -21,6 +22,7 @@ from affordance_env.goal_env import TapAffordanceGoalEnv
 from affordance_env.objects import OBJECT_TYPES
 from affordance_env.workers import map_in_processes
 from affordance_learning.common.statistics import share_text
+from affordance_learning.common.typed_json import to_json
 from affordance_learning.planning.experiment.baselines import SomBaseline, best_fixed
 from affordance_learning.planning.experiment.multi_step import evaluate_episode, step_reach, within_reach
 from affordance_learning.planning.experiment.settings import (
@@ -37,9 +39,21 @@ from affordance_learning.planning.experiment.single_step import evaluate_object
 from affordance_learning.planning.experiment.statistics import calibrations, seconds_summary, summarize, wilson
 from affordance_learning.planning.experiment.training import collect_training, fit_models, training_frames
 from affordance_learning.planning.planner import Planner
+from affordance_learning.planning.results import (
+    PLAN_RESULTS_FORMAT,
+    PLAN_RESULTS_VERSION,
+    Episode,
+    GoalRecord,
+    MultiStep,
+    MultiStepOutcome,
+    PlanResults,
+    PolicyOutcome,
+    Rate,
+    ReachFailures,
+)
 
 #: The format ``results.json`` of ``affordance plan`` declares, and its version.
-RESULTS_FORMAT, RESULTS_VERSION = "tap-affordance-plan-results", 2
+RESULTS_FORMAT, RESULTS_VERSION = PLAN_RESULTS_FORMAT, PLAN_RESULTS_VERSION
 #: Where in its output directory ``affordance plan`` collects its training data.
 DATASET_DIR = "dataset"
 
@@ -117,83 +131,94 @@ def _evaluate_all(run: _Stages, planner: Planner, shape_planners: Mapping[str, P
     return objects, [multi_done[i * n: (i + 1) * n] for i in range(len(MULTI_POLICIES))]
 
 
-def _single_step(run: _Stages, objects: list) -> tuple[list[dict], dict[str, Any], dict[str, str]]:
+def _single_step(run: _Stages, objects: list) -> tuple[list[dict], dict[str, PolicyOutcome], dict[str, str]]:
     """Step 3's summary: every goal's record, each policy's success, and the best fixed behaviour per goal kind."""
     records = [r for rs in objects if rs is not None for r in rs]
     fixed_choice = best_fixed(records)
     single = summarize(records, POLICIES)
     run.say(f"[3/5] single step: {len(records)} goals on {sum(rs is not None for rs in objects)} held-out objects "
             f"(with step 5: {run.timings['evaluate']:.0f} s): "
-            + ", ".join(f"{p} {share_text(single[p]['success'], single[p]['n'], single[p]['success_ci'])}"
+            + ", ".join(f"{p} {share_text(single[p].success, single[p].n, single[p].success_ci)}"
                         for p in POLICIES)
-            + f"; {single['oracle']['n_feasible']} goals feasible")
+            + f"; {single['oracle'].n_feasible} goals feasible")
     return records, single, fixed_choice
 
 
-def _leave_one_shape_out(run: _Stages, records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+def _leave_one_shape_out(run: _Stages, records: Sequence[Mapping[str, Any]]
+                         ) -> dict[str, dict[str, PolicyOutcome]]:
     """Step 4: on each shape's goals, the planner fitted without it, beside the baselines."""
-    loso: dict[str, Any] = {}
+    loso: dict[str, dict[str, PolicyOutcome]] = {}
     for shape in OBJECT_TYPES:
         shape_records = [{**r, "planner": r.get("planner_left_out", False)} for r in records if r["type"] == shape]
         loso[shape] = summarize(shape_records, ("planner", "best_fixed", "random", "oracle"))
     run.say("[4/5] leaving each shape out (judged in step 3): "
-            + ", ".join(f"{s} " + share_text(loso[s]["planner"]["success_feasible"], loso[s]["planner"]["n_feasible"],
-                                             loso[s]["planner"]["success_feasible_ci"], "feasible")
+            + ", ".join(f"{s} " + share_text(loso[s]["planner"].success_feasible, loso[s]["planner"].n_feasible,
+                                             loso[s]["planner"].success_feasible_ci, "feasible")
                         for s in OBJECT_TYPES))
     return loso
 
 
-def _policy_summary(episodes: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
+def _policy_summary(episodes: Sequence[Mapping[str, Any]], **planner_only: Any) -> MultiStepOutcome:
     """One policy's multi-step episodes: success (and toward the robot) with Wilson intervals, reach failures per
-    interaction, episodes given up, the median final distance [m]."""
+    interaction, episodes given up, the median final distance [m]; ``planner_only``: the planner's details
+    (:func:`_planner_episodes`)."""
     n = len(episodes)
     k = sum(e["success"] for e in episodes)
     toward = [e for e in episodes if e["toward_robot"]]
     kt = sum(e["success"] for e in toward)
     interactions = sum(e["steps"] for e in episodes)
-    return {"success": k / n if n else None, "success_ci": wilson(k, n), "n": n,
-            "reach_failures": sum(e["reach_failures"] for e in episodes) / max(interactions, 1),
-            "interactions": interactions, "gave_up": sum(e["gave_up"] for e in episodes),
-            "median_final_distance_m": float(np.median([e["final_distance"] for e in episodes])),
-            "success_toward_robot": kt / len(toward) if toward else None,
-            "success_toward_robot_ci": wilson(kt, len(toward)), "n_toward_robot": len(toward)}
+    return MultiStepOutcome(
+        success=k / n if n else None, success_ci=wilson(k, n), n=n,
+        reach_failures=sum(e["reach_failures"] for e in episodes) / max(interactions, 1),
+        interactions=interactions, gave_up=sum(e["gave_up"] for e in episodes),
+        median_final_distance_m=float(np.median([e["final_distance"] for e in episodes])),
+        success_toward_robot=kt / len(toward) if toward else None,
+        success_toward_robot_ci=wilson(kt, len(toward)), n_toward_robot=len(toward), **planner_only)
+
+
+def _episode(e: Mapping[str, Any], reach: Mapping[str, Mapping[str, float]], tolerance: float, most: int
+             ) -> Episode:
+    """One of the planner's episodes (:func:`evaluate_episode`) as the results keep it, with whether its target was
+    within reach of ``most`` interactions (:func:`within_reach`)."""
+    pulls = e["pulls_at_start"]
+    return Episode(type=e["type"], start_xy=tuple(e["start_xy"]), target_xy=tuple(e["target_xy"]),
+                   initial_distance=e["initial_distance"], final_distance=e["final_distance"], steps=e["steps"],
+                   success=e["success"], gave_up=e["gave_up"], reach_failures=e["reach_failures"],
+                   failures=tuple(e["failures"]), toward_robot=e["toward_robot"],
+                   pulls_at_start=None if pulls is None else MappingProxyType(dict(pulls)),
+                   within_reach=e["type"] in reach and within_reach(e["start_xy"], e["target_xy"], reach[e["type"]],
+                                                                    tolerance, most))
 
 
 def _planner_episodes(episodes: Sequence[Mapping[str, Any]], reach: Mapping[str, Mapping[str, float]],
                       tolerance: float, most: int) -> dict[str, Any]:
-    """What the report reads of the planner's episodes: success per object type, each episode, and success on the
-    targets within reach of ``most`` interactions (:func:`within_reach`)."""
-    kept = ("type", "start_xy", "target_xy", "initial_distance", "final_distance", "steps", "success", "gave_up",
-            "reach_failures", "failures", "toward_robot", "pulls_at_start")
-    by_type = {shape: {"n": len(eps), "success": sum(e["success"] for e in eps) / len(eps)}
-               for shape in OBJECT_TYPES if (eps := [e for e in episodes if e["type"] == shape])}
-    listed = [{**{k: e[k] for k in kept},
-               "within_reach": e["type"] in reach and within_reach(e["start_xy"], e["target_xy"], reach[e["type"]],
-                                                                   tolerance, most)}
-              for e in episodes]
-    inside = [e for e in listed if e["within_reach"]]
-    return {"by_type": by_type, "episodes": listed,
-            "within_reach": {"n": len(inside),
-                             "success": sum(e["success"] for e in inside) / len(inside) if inside else None}}
+    """What the report reads of the planner's episodes (:class:`MultiStepOutcome`'s ``planner_*``): success per
+    object type, each episode, and success on the targets within reach of ``most`` interactions."""
+    by_type = _view({shape: Rate(len(eps), sum(e["success"] for e in eps) / len(eps))
+                     for shape in OBJECT_TYPES if (eps := [e for e in episodes if e["type"] == shape])})
+    listed = tuple(_episode(e, reach, tolerance, most) for e in episodes)
+    inside = [e for e in listed if e.within_reach]
+    return {"planner_by_type": by_type, "planner_episodes": listed,
+            "planner_within_reach": Rate(len(inside), sum(e.success for e in inside) / len(inside) if inside else None)}
 
 
 def _multi_step(run: _Stages, by_policy: Sequence[Sequence[Mapping[str, Any]]], frame: pd.DataFrame
-                ) -> dict[str, Any]:
+                ) -> MultiStep:
     """Step 5's summary: each policy's episodes, and the planner's in detail."""
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
 
-    multi = {policy: _policy_summary(episodes) for policy, episodes in zip(MULTI_POLICIES, by_policy, strict=True)}
-    run.say(f"[5/5] multi-step on {run.settings.multi_episodes} episodes (with step 3): "
-            + ", ".join(f"{p} {share_text(multi[p]['success'], multi[p]['n'], multi[p]['success_ci'])}"
-                        for p in MULTI_POLICIES)
-            + "; toward the robot: planner " + share_text(multi["planner"]["success_toward_robot"],
-                                                           multi["planner"]["n_toward_robot"],
-                                                           multi["planner"]["success_toward_robot_ci"]))
     episodes = by_policy[MULTI_POLICIES.index("planner")]
     reach, tolerance = step_reach(frame), episodes[0]["tolerance"]  # the goal env's
-    multi["planner"].update(_planner_episodes(episodes, reach, tolerance, GOAL_MAX_EPISODE_STEPS))
-    multi["step_reach_p90_m"], multi["tolerance_m"], multi["max_interactions"] = (reach, tolerance,
-                                                                                  GOAL_MAX_EPISODE_STEPS)
+    details = {"planner": _planner_episodes(episodes, reach, tolerance, GOAL_MAX_EPISODE_STEPS)}
+    multi = MultiStep(**{policy: _policy_summary(found, **details.get(policy, {}))
+                         for policy, found in zip(MULTI_POLICIES, by_policy, strict=True)},
+                      step_reach_p90_m=_view({t: _view(r) for t, r in reach.items()}), tolerance_m=tolerance,
+                      max_interactions=GOAL_MAX_EPISODE_STEPS)
+    run.say(f"[5/5] multi-step on {run.settings.multi_episodes} episodes (with step 3): "
+            + ", ".join(f"{p} {share_text(o.success, o.n, o.success_ci)}" for p, o in multi.policies.items())
+            + "; toward the robot: planner " + share_text(multi.planner.success_toward_robot,
+                                                           multi.planner.n_toward_robot,
+                                                           multi.planner.success_toward_robot_ci))
     return multi
 
 
@@ -214,46 +239,49 @@ GOAL_FIELDS = ("kind", "type", "object", "size", "goal", "planner", "planner_p",
 
 
 def _results(run: _Stages, frame: pd.DataFrame, frames: Mapping[str, pd.DataFrame], objects: list,
-             single: dict[str, Any], fixed_choice: dict[str, str], loso: dict[str, Any], multi: dict[str, Any],
-             planner_episodes: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
-    """The results of the run, as ``results.json`` holds them (``objects``: each object's records, None for one
-    not seen)."""
+             single: dict[str, PolicyOutcome], fixed_choice: dict[str, str], loso: dict[str, dict[str, PolicyOutcome]],
+             multi: MultiStep, planner_episodes: Sequence[Mapping[str, Any]]) -> PlanResults:
+    """The results of the run (``objects``: each object's records, None for one not seen)."""
     records = [r for rs in objects if rs is not None for r in rs]
     n_objects = sum(rs is not None for rs in objects)
     acted = [r for r in records if r["planner_behavior"]]
-    oracle = single["oracle"]["success"] or 0.0
+    oracle = single["oracle"].success or 0.0
     choose_s = [r["decision_s"] for r in records]
     toward_s = [s for e in planner_episodes for s in e["decision_s"]]
-    return {
-        "format": RESULTS_FORMAT, "version": RESULTS_VERSION, "seed": run.seed, "settings": asdict(run.settings),
-        "units": {"fractions": "[0, 1]", "distances": "m", "times": "s"},
-        "training": {b: len(f) for b, f in frames.items()},
-        "training_episodes": int(frame["episode"].nunique()),
-        "workers": run.workers, "cpu_count": os.cpu_count(),
-        "oracle": {"actions_per_behavior": len(oracle_params()), "levels": list(ORACLE_LEVELS),
-                   "objects": n_objects, "goals_per_object": dict(GOALS_PER_OBJECT),
-                   "objects_per_shape": {s: len({r["object"] for r in records if r["type"] == s})
-                                         for s in OBJECT_TYPES}},
-        "single_step": single,
-        "single_step_by_goal": {kind: summarize([r for r in records if r["kind"] == kind], POLICIES)
-                                for kind in GOAL_KINDS},
-        "best_fixed_behavior": fixed_choice,
-        "planner_over_oracle": (single["planner"]["success"] / oracle) if oracle else None,
-        "single_step_reach_failures": {"n": len(acted), "failures": sum(r["planner_reach_failure"] for r in acted)},
-        "leave_one_shape_out": loso,
-        "multi_step": multi,
+    return PlanResults(
+        seed=run.seed, settings=_view(asdict(run.settings)),
+        training=_view({b: len(f) for b, f in frames.items()}),
+        training_episodes=int(frame["episode"].nunique()),
+        workers=run.workers, cpu_count=os.cpu_count(),
+        oracle=_view({"actions_per_behavior": len(oracle_params()), "levels": list(ORACLE_LEVELS),
+                      "objects": n_objects, "goals_per_object": dict(GOALS_PER_OBJECT),
+                      "objects_per_shape": {s: len({r["object"] for r in records if r["type"] == s})
+                                            for s in OBJECT_TYPES}}),
+        single_step=_view(single),
+        single_step_by_goal=_view({kind: _view(summarize([r for r in records if r["kind"] == kind], POLICIES))
+                                   for kind in GOAL_KINDS}),
+        best_fixed_behavior=_view(fixed_choice),
+        planner_over_oracle=(single["planner"].success / oracle) if oracle else None,
+        single_step_reach_failures=ReachFailures(len(acted), sum(r["planner_reach_failure"] for r in acted)),
+        leave_one_shape_out=_view({shape: _view(outcomes) for shape, outcomes in loso.items()}),
+        multi_step=multi,
         **_placement(records),
-        "calibration": calibrations(records),
-        "decision_seconds": {**seconds_summary(choose_s + toward_s), "choose": seconds_summary(choose_s),
-                             "toward": seconds_summary(toward_s)},
-        "timings_s": run.timings,
-        "goals": [{k: r.get(k) for k in GOAL_FIELDS} for r in records],
-    }
+        calibration=calibrations(records),
+        decision_seconds=seconds_summary(choose_s + toward_s, seconds_summary(choose_s), seconds_summary(toward_s)),
+        timings_s=_view(run.timings),
+        goals=tuple(GoalRecord(**{k: r.get(k) for k in GOAL_FIELDS}) for r in records),
+    )
+
+
+def _view(mapping: Mapping[str, Any]) -> Mapping[str, Any]:
+    """A read-only copy of ``mapping``, as the results hold their mappings."""
+    return MappingProxyType(dict(mapping))
 
 
 def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: PlanSettings | None = None,
-             camera: tuple[int, int] = (160, 120), say: Callable[[str], None] = print) -> dict[str, Any]:
-    """Run the whole experiment into ``out`` (``dataset/``, ``results.json``); returns the results."""
+             camera: tuple[int, int] = (160, 120), say: Callable[[str], None] = print) -> PlanResults:
+    """Run the whole experiment into ``out`` (``dataset/``, ``results.json``: ``to_json`` of the results); returns
+    the results."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     run = _Stages(out, settings or PlanSettings(), seed, workers, camera, say, time.perf_counter(), {})
@@ -266,17 +294,17 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
     run.timings["total"] = time.perf_counter() - run.start
     results = _results(run, frame, frames, objects, single, fixed_choice, loso, multi,
                        by_policy[MULTI_POLICIES.index("planner")])
-    (out / "results.json").write_text(json.dumps(results, indent=1, default=float))
+    (out / "results.json").write_text(json.dumps(to_json(results), indent=1, default=float))
     return results
 
 
-def record_episode(out: str | os.PathLike, results: Mapping[str, Any], seed: int = 0
+def record_episode(out: str | os.PathLike, results: PlanResults | Mapping[str, Any], seed: int = 0
                    ) -> list[tuple[str, np.ndarray]]:
     """Pictures of one multi-step planner episode (the first of the evaluation's), with the models refitted from
     ``out/dataset``: the start, then the scene after each interaction, titled with the behaviour."""
     from affordance_env.dataset import load_dataset
 
-    settings = PlanSettings(**results["settings"])
+    settings = PlanSettings(**PlanResults.from_dict(results).settings)
     frames = training_frames(load_dataset(Path(out) / DATASET_DIR), settings.max_per_behavior)
     planner = Planner(fit_models(frames, seed), n_candidates=settings.candidates, threshold=settings.threshold,
                       random_state=seed)
