@@ -80,7 +80,10 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     parser.add_argument("--out", type=Path, required=True, help="dataset directory (resumed if it exists)")
     parser.add_argument("--seed", type=non_negative_int, default=0, help="dataset seed (default 0)")
     parser.add_argument("--workers", type=positive_int, default=1,
-                        help="worker processes, or workers of the local Dask cluster (default 1)")
+                        help="worker processes, or workers of the local Dask cluster (default 1): at most one "
+                             "per chunk to collect and, without --oversubscribe, one per core")
+    parser.add_argument("--oversubscribe", action="store_true",
+                        help="start --workers processes even where they are more than this machine's cores")
     parser.add_argument("--env", default=ENV_ID, choices=ENV_IDS,
                         dest="env_id",
                         help="TapAffordance-v2: one interaction per episode; TapAffordanceGoal-v2: goal episodes of "
@@ -185,7 +188,8 @@ def run_collect(args: argparse.Namespace) -> int:
     out = collect(args.out, args.episodes, seed=args.seed, workers=args.workers, action=args.action,
                   env_options=env_options_from_args(args), chunk_size=args.chunk_size, scheduler=scheduler,
                   dask_address=args.dask_address, save_images=args.save_images,
-                  max_failure_share=args.max_failure_share, env_id=args.env_id)
+                  max_failure_share=args.max_failure_share, env_id=args.env_id,
+                  oversubscribe=args.oversubscribe)
     elapsed = time.perf_counter() - start
     manifest = read_manifest(out)
     failures = manifest["failures"]
