@@ -13,6 +13,7 @@ from affordance_learning.cli import PLAN_DEFAULTS, build_parser, main
 COLLECT = ["collect", "--out", "OUT", "--episodes", "3"]
 PLAN = ["plan", "--out", "OUT"]
 SIZE = "a size in metres in [0.02, 0.15] (what the hand can tap)"
+DASK = "PROTOCOL://HOST:PORT with PROTOCOL one of tcp, tls, ws, wss, ucx (e.g. tcp://scheduler:8786)"
 
 # argv (OUT: a path in the test's directory), the option, the value given, what is expected of it
 BAD_VALUES = [
@@ -47,6 +48,10 @@ BAD_VALUES = [
     ([*COLLECT, "--roll-threshold", "0"], "--roll-threshold", "0", "a positive distance in metres"),
     ([*COLLECT, "--settle-timeout", "-1"], "--settle-timeout", "-1", "a positive duration in seconds"),
     ([*COLLECT, "--settle-timeout", "inf"], "--settle-timeout", "inf", "a positive duration in seconds"),
+    ([*COLLECT, "--dask-address", "127.0.0.1"], "--dask-address", "127.0.0.1", DASK),
+    ([*COLLECT, "--dask-address", "notanaddress"], "--dask-address", "notanaddress", DASK),
+    ([*COLLECT, "--dask-address", "ftp://host:8786"], "--dask-address", "ftp://host:8786", DASK),
+    ([*COLLECT, "--dask-address", "tcp://host:0"], "--dask-address", "tcp://host:0", DASK),
 ]
 
 
@@ -73,6 +78,8 @@ def test_the_values_at_the_bounds_are_accepted(tmp_path):
     assert (args.episodes, args.max_failure_share, args.size_range, args.camera_width) == (1, 1.0, [0.05, 0.05], 2)
     assert parse(["reproduce", "--episodes", "20"]).episodes == 20
     assert parse(["collect", "--out", out, "--episodes", "1", "--max-failure-share", "0"]).max_failure_share == 0
+    for address in ("tcp://127.0.0.1:8786", "tls://scheduler.example:8786", "127.0.0.1:8786", "tcp://[::1]:8786"):
+        assert parse(["collect", "--out", out, "--episodes", "1", "--dask-address", address]).dask_address == address
 
 
 class WorkStarted(Exception):

@@ -632,3 +632,10 @@ def test_worker_processes_are_at_most_the_chunks_and_the_cores(tmp_path, monkeyp
     assert started.pop() == ("dask", 4)
     collect(tmp_path / "remote", 40, workers=1000, chunk_size=2, progress=False, dask_address="tcp://h:8786")
     assert started.pop() == ("dask", 1000)  # another machine's cluster: its workers are its own
+
+
+@pytest.mark.parametrize("address", ["127.0.0.1", "notanaddress", "tcp://host", "http://host:8786", 8786])
+def test_a_malformed_dask_address_is_refused_before_anything_is_written(address, tmp_path):
+    with pytest.raises(ValueError, match="PROTOCOL://HOST:PORT"):
+        collect(tmp_path / "d", 2, dask_address=address, progress=False)
+    assert not (tmp_path / "d").exists()

@@ -65,7 +65,7 @@ from affordance_env.exceptions import InvalidValueError, MissingDependencyError
 from affordance_env.options import EnvOptions
 from affordance_env.progress import progress_bar, show_progress  # noqa: F401  (show_progress: re-exported)
 from affordance_env.registry import BEHAVIOR_NAMES
-from affordance_env.values import is_integer
+from affordance_env.values import check_dask_address, is_integer
 from affordance_env.workers import worker_env
 
 ACTIONS = ("canonical", "random")
@@ -299,6 +299,7 @@ def collect(
     """
     _check_collect_arguments(episodes, seed, workers, action, chunk_size, scheduler, max_failure_share, env_id)
     if dask_address is not None:
+        check_dask_address(dask_address)  # before anything is written: Dask's own error is a long traceback
         scheduler = "dask"
     options = _full_options(dict(env_options or {}), env_id)
     if scheduler == "joblib" and workers == 1:  # this process collects: build its env now, before any work
