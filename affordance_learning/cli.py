@@ -86,15 +86,28 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
-    """``--dataset`` values, ``BEHAVIOR=PATH`` or (with one behaviour) ``PATH``, as a directory per behaviour."""
+    """``--dataset`` values, ``BEHAVIOR=PATH`` or (with one behaviour) ``PATH``, as a directory per behaviour.
+
+    Text before an ``=`` that could be a name (no path separator) is a behaviour, which must be one the
+    environment has, and its PATH must not be empty: ``kick=taps`` or ``=taps`` is refused, not taken for a
+    folder of that name (a path that holds ``=`` is given as ``./kick=taps``)."""
     datasets: dict[str, Path] = {}
+    known = sorted({*behaviors, *BEHAVIOR_NAMES})
     for item in items:
-        name, _, path = item.partition("=")
-        if not path or name not in {*behaviors, *BEHAVIOR_NAMES}:  # a bare path (which may hold "=" itself)
+        name, equals, path = item.partition("=")
+        if equals and "/" not in name and os.sep not in name:
+            if name not in known:
+                raise InvalidValueError(
+                    f"--dataset {item}: {'no behaviour before =' if not name else f'unknown behaviour {name!r}'}; "
+                    f"give BEHAVIOR=PATH with BEHAVIOR one of {', '.join(known)} (a path that holds '=' is "
+                    "given as ./PATH).")
+            if not path:
+                raise InvalidValueError(f"--dataset {item}: no PATH after '{name}='; give {name}=PATH.")
+        else:  # a bare path
             if len(behaviors) != 1:
                 raise InvalidValueError(
                     f"--dataset {item}: say whose dataset it is, as BEHAVIOR=PATH with BEHAVIOR one "
-                                 f"of {', '.join(behaviors)} (a bare PATH is for a single --behavior).")
+                    f"of {', '.join(behaviors)} (a bare PATH is for a single --behavior).")
             name, path = behaviors[0], item
         if name in datasets:
             raise InvalidValueError(f"--dataset given twice for {name!r}.")

@@ -5,6 +5,7 @@ import itertools
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -290,3 +291,27 @@ for argv in {mistakes!r}:
     assert done.stdout.split() == ["2"] * len(mistakes)
     assert len(done.stderr.splitlines()) == len(mistakes)  # one line each
     assert not (tmp_path / "p").exists() and not (tmp_path / "c").exists()
+
+
+@pytest.mark.parametrize(("item", "fragment"), [("kick=taps", "unknown behaviour 'kick'"),
+                                                ("=taps", "no behaviour before ="), ("tap=", "no PATH after 'tap='")])
+def test_reproduce_refuses_a_dataset_of_no_known_behaviour(item, fragment, tmp_path, capsys, monkeypatch):
+    # --dataset kick=taps once collected into a folder named "kick=taps"
+    import affordance_learning.paper.reproduce as reproduce
+
+    def started(*args, **kwargs):
+        raise WorkStarted(args, kwargs)
+
+    monkeypatch.setattr(reproduce, "reproduce", started)
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "out"
+    err = _refused(["reproduce", "--behavior", "tap", "--dataset", item, "--out", out], capsys, fragment)
+    if "behaviour" in fragment:  # the valid ones named
+        assert all(name in err for name in ("tap", "push", "grasp", "draw", "tap_back"))
+    assert not out.exists() and not list(tmp_path.iterdir())
+    with pytest.raises(WorkStarted) as accepted:  # a path that holds "=" is given as one
+        main(["reproduce", "--behavior", "tap", "--dataset", "./kick=taps", "--out", str(out)])
+    assert accepted.value.args[1]["datasets"] == {"tap": Path("kick=taps")}
+    with pytest.raises(WorkStarted) as accepted:
+        main(["reproduce", "--dataset", "tap=taps", "--dataset", "grasp=grasps", "--out", str(out)])
+    assert accepted.value.args[1]["datasets"] == {"tap": Path("taps"), "grasp": Path("grasps")}
