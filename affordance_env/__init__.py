@@ -12,7 +12,9 @@
 or, without the import, ``gym.make("affordance_env:TapAffordance-v2")``.
 """
 
+import importlib
 import importlib.metadata as _metadata
+import importlib.util
 
 from affordance_env.features import FEATURE_GROUPS, FEATURE_NAMES
 from affordance_env.objects import OBJECT_TYPES
@@ -33,6 +35,10 @@ def __getattr__(name: str):
         from affordance_env.dataset.load import load_dataset
 
         return load_dataset
+    # A submodule (affordance_env.tap_env, affordance_env.workspace, ...) is loaded when first named, so that
+    # ``help(affordance_env.tap_env.TapAffordanceEnv)`` works after ``import affordance_env`` alone.
+    if not name.startswith("_") and importlib.util.find_spec(f"{__name__}.{name}") is not None:
+        return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 __all__ = [

@@ -15,6 +15,7 @@ from affordance_env.objects import OBJECT_TYPES, SIZE_LIMITS
 from affordance_env.options import POSITION_RANGES, EnvOptions
 from affordance_env.range_noise import RANGE_NOISE_MODELS
 from affordance_env.registry import BEHAVIOR_NAMES, ENV_ID, ENV_IDS, GOAL_ENV_ID
+from affordance_env.values import DASK_PROTOCOLS, check_dask_address
 
 #: Command-line flags that are env options, and the env keyword each one sets.
 #: The environment options a collection takes on the command line: every field of EnvOptions, one flag each.
@@ -61,6 +62,18 @@ def real_within(low: float, high: float = math.inf, *, open_low: bool = False,
     return parse
 
 
+def dask_address(text: str) -> str:
+    """An argparse ``type``: a Dask scheduler's address, ``[PROTOCOL://]HOST:PORT``; any other form is an error."""
+    try:
+        return check_dask_address(text)
+    except InvalidValueError:
+        raise argparse.ArgumentTypeError(f"expected PROTOCOL://HOST:PORT with PROTOCOL one of "
+                                         f"{', '.join(DASK_PROTOCOLS)} (e.g. tcp://scheduler:8786), got "
+                                         f"{text!r}") from None
+
+
+dask_address.__name__ = "Dask scheduler address"
+
 #: A share, as of failed interactions: 0 to 1.
 share = real_within(0.0, 1.0, expected="a share in [0, 1]")
 
@@ -80,7 +93,10 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     parser.add_argument("--out", type=Path, required=True, help="dataset directory (resumed if it exists)")
     parser.add_argument("--seed", type=non_negative_int, default=0, help="dataset seed (default 0)")
     parser.add_argument("--workers", type=positive_int, default=1,
-                        help="worker processes, or workers of the local Dask cluster (default 1)")
+                        help="worker processes, or workers of the local Dask cluster (default 1): at most one "
+                             "per chunk to collect and, without --oversubscribe, one per core")
+    parser.add_argument("--oversubscribe", action="store_true",
+                        help="start --workers processes even where they are more than this machine's cores")
     parser.add_argument("--env", default=ENV_ID, choices=ENV_IDS,
                         dest="env_id",
                         help="TapAffordance-v2: one interaction per episode; TapAffordanceGoal-v2: goal episodes of "
@@ -99,7 +115,7 @@ def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.Argum
     parser.add_argument("--scheduler", choices=("joblib", "dask"), default=None,
                         help="joblib: processes on this machine (default); dask: Dask distributed, a local "
                              "cluster of --workers processes or the one at --dask-address")
-    parser.add_argument("--dask-address", default=None, metavar="ADDRESS",
+    parser.add_argument("--dask-address", type=dask_address, default=None, metavar="ADDRESS",
                         help="Dask scheduler to run on (e.g. tcp://host:8786); implies --scheduler dask. Its "
                              "workers must see --out and have the same tap-affordance version")
     low, high = SIZE_LIMITS
@@ -185,7 +201,8 @@ def run_collect(args: argparse.Namespace) -> int:
     out = collect(args.out, args.episodes, seed=args.seed, workers=args.workers, action=args.action,
                   env_options=env_options_from_args(args), chunk_size=args.chunk_size, scheduler=scheduler,
                   dask_address=args.dask_address, save_images=args.save_images,
-                  max_failure_share=args.max_failure_share, env_id=args.env_id)
+                  max_failure_share=args.max_failure_share, env_id=args.env_id,
+                  oversubscribe=args.oversubscribe)
     elapsed = time.perf_counter() - start
     manifest = read_manifest(out)
     failures = manifest["failures"]

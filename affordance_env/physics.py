@@ -22,7 +22,7 @@ import mujoco
 import numpy as np
 
 from affordance_env.contacts import ContactQueries
-from affordance_env.exceptions import IncompatibleStateError
+from affordance_env.exceptions import IncompatibleStateError, InvalidValueError
 from affordance_env.object_slot import ObjectSlot
 from affordance_env.objects import ObjectGeometry
 from affordance_env.outcome import ObjectMonitor
@@ -35,6 +35,16 @@ MONITOR_PERIOD = 0.01
 #: MuJoCo's warnings that mean the simulation has failed (:meth:`TapPhysics.unstable`), in the order checked.
 FAULT_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQVEL, mujoco.mjtWarning.mjWARN_BADQPOS,
                   mujoco.mjtWarning.mjWARN_CONTACTFULL, mujoco.mjtWarning.mjWARN_CNSTRFULL)
+
+
+#: The parts of MuJoCo's data that a step integrates from (mjSTATE_INTEGRATION): a snapshot's must be finite.
+_STATE_FIELDS = ("time", "qpos", "qvel", "act", "qacc_warmstart", "ctrl", "qfrc_applied", "xfrc_applied", "mocap_pos",
+                "mocap_quat", "userdata", "plugin_state")
+
+
+def _not_finite(data: mujoco.MjData) -> list[str]:
+    """The fields of :data:`_STATE_FIELDS` in ``data`` that hold NaN or an infinity."""
+    return [name for name in _STATE_FIELDS if not np.all(np.isfinite(getattr(data, name)))]
 
 
 class TapPhysics:
@@ -188,6 +198,10 @@ class TapPhysics:
                 f"the snapshot's MuJoCo data has {data.qpos.size} positions, {data.qvel.size} velocities and "
                 f"{data.act.size} actuator states, this model {self.model.nq}, {self.model.nv} and {self.model.na}: "
                 "it was taken of another model.")
+        bad = _not_finite(data)
+        if bad:  # the next step would fail, and until then the world would answer questions about NaN
+            raise InvalidValueError(f"the state is damaged: its MuJoCo data are not finite in {', '.join(bad)}; "
+                                    "nothing was restored.")
         current = self.geometry
         if geometry is not None and (current is None or (geometry.object_type, geometry.size)
                                      != (current.object_type, current.size)):

@@ -226,10 +226,10 @@ class TapAffordanceEnv(gym.Env):
       ``"workspace"``: uniform over the behaviour's workspace (:mod:`affordance_env.workspace`, where its canonical
       action is within the arm's reach for every type and size), to learn how the place changes the effect |
     | ``reward_fn`` | displacement | ``callable(info) -> float`` |
-    | ``render_mode`` | None | ``"rgb_array"``: a picture from an outside camera (headless EGL/OSMesa);
-      ``"rgb_array_list"``: every frame of the interaction, for a video (Gymnasium's ``RecordVideo`` keeps one
-      frame per step, so for one-step episodes use this mode and write the frames yourself); any other mode
-      (``"human"`` too) is refused with a ValueError naming these |
+    | ``render_mode`` | None | ``"rgb_array"``: a picture from an outside camera (headless EGL/OSMesa), drawn
+      only when ``render()`` is called; ``"rgb_array_list"``: every frame of the interaction, for a video
+      (Gymnasium's ``RecordVideo`` keeps one frame per step, so for one-step episodes use this mode and write the
+      frames yourself); any other mode (``"human"`` too) is refused with a ValueError naming these |
     | ``render_width``, ``render_height`` | 480, 360 | size of those pictures [pixels] (240 x 180 has a quarter of
       the pixels, for a cheaper render without a GPU) |
     | ``two_arms`` | False | the scene with both arms (:data:`affordance_env.robot_model.VARIANTS` ``"two_arms"``):
@@ -308,11 +308,12 @@ class TapAffordanceEnv(gym.Env):
                            settle_timeout=options.settle_timeout, typical_size=float(np.mean(options.size_range)),
                            final_snapshot="paper")
         self._render_size = (render_width, render_height)
-        #: With a render mode: pictures taken every 1/render_fps s of simulated time since the last ``reset``
-        #: (the whole interaction: placing, attention, the behaviour, the wait for the outcome).
+        #: With ``render_mode="rgb_array_list"``: pictures taken every 1/render_fps s of simulated time since the
+        #: last ``reset`` (the whole interaction: placing, attention, the behaviour, the wait for the outcome).
+        #: ``"rgb_array"`` draws only when :meth:`render` is called, so its steps cost what they cost without one.
         self.frames: list[np.ndarray] = []
         self._next_frame_time = 0.0
-        if render_mode is not None:
+        if render_mode == "rgb_array_list":
             self.world.on_step(self._record_frame)
         self._last: InteractionResult | None = None
 
@@ -374,7 +375,7 @@ class TapAffordanceEnv(gym.Env):
         if self.world.seen is None:
             raise RuntimeError("step() called before reset() or after the interaction ended; call reset() first.")
         result = self._last = self.world.interact(self.behavior.name, action, self.np_random)
-        if self.render_mode is not None:
+        if self.render_mode == "rgb_array_list":
             self.frames.append(self._picture())  # the scene as the final snapshot sees it
         if result.final is None:  # a fault: nothing of the state reaches obs
             obs = observation(self.world.blank_snapshot())

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import copy
 import numbers
+import re
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -23,6 +24,24 @@ def _shown(value: Any) -> str:
     """``repr(value)``, cut to :data:`_SHOWN` characters."""
     shown = repr(value)
     return shown if len(shown) <= _SHOWN else shown[: _SHOWN - 3] + "..."
+
+
+#: The protocols of a Dask scheduler's address that reach another process.
+DASK_PROTOCOLS = ("tcp", "tls", "ws", "wss", "ucx")
+_DASK_ADDRESS = re.compile(r"(?:(?P<protocol>[a-z]+)://)?(?P<host>\[[0-9A-Fa-f:.]+\]|[^\s:/\[\]]+):(?P<port>[0-9]+)")
+
+
+def check_dask_address(address: Any) -> str:
+    """``address`` if it has the form of a Dask scheduler's address, ``[PROTOCOL://]HOST:PORT`` (``tcp://host:8786``,
+    ``tls://10.0.0.1:8786``, ``[::1]:8786``; tcp when no protocol is given); otherwise InvalidValueError saying the
+    form. Whether a scheduler answers there is found when it is reached."""
+    match = _DASK_ADDRESS.fullmatch(address) if isinstance(address, str) else None
+    if (match is None or (match["protocol"] is not None and match["protocol"] not in DASK_PROTOCOLS)
+            or not 0 < int(match["port"]) < 65536):
+        raise InvalidValueError(f"dask_address must be a Dask scheduler's address, PROTOCOL://HOST:PORT with PROTOCOL "
+                                f"one of {', '.join(DASK_PROTOCOLS)} (e.g. tcp://scheduler:8786), got "
+                                f"{_shown(address)}.")
+    return address
 
 
 def is_integer(value: Any) -> bool:

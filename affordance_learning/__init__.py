@@ -15,17 +15,23 @@
 """
 
 import importlib
-import importlib.metadata as _metadata
 import importlib.util
 
-try:  # the version has one source, the package's metadata (pyproject.toml)
-    __version__ = _metadata.version("tap-affordance")
-except _metadata.PackageNotFoundError:  # a source tree that was never installed
-    __version__ = "0+unknown"
+
+def _version() -> str:
+    """The version, from its one source, the package's metadata (pyproject.toml). Read when first asked for:
+    importlib.metadata takes a tenth of a second to load, which ``import affordance_learning`` (and so the
+    command, before it can say anything of a Ctrl-C) does not wait for."""
+    import importlib.metadata as metadata
+
+    try:
+        return metadata.version("tap-affordance")
+    except metadata.PackageNotFoundError:  # a source tree that was never installed
+        return "0+unknown"
 
 
 def __dir__() -> list[str]:
-    return sorted({*globals(), *_LAZY})
+    return sorted({*globals(), *_LAZY, "__version__"})
 
 #: The public names, each loaded from its module on first use: ``import affordance_learning`` (and so the
 #: ``affordance`` command, which checks its arguments before any work) stays light, with no scikit-learn, SciPy,
@@ -51,6 +57,9 @@ _LAZY = {
 
 
 def __getattr__(name: str) -> object:
+    if name == "__version__":
+        globals()[name] = value = _version()
+        return value
     if name in _LAZY:
         value = getattr(importlib.import_module(_LAZY[name]), name)
         globals()[name] = value  # found directly from now on

@@ -6,26 +6,59 @@ that a command-line mistake is a one-line error at once, before any work starts 
 
 from __future__ import annotations
 
-import argparse
-import contextlib
-import json
+import atexit
 import os
+import signal
 import sys
-import time
-import warnings
-from pathlib import Path
-from typing import TYPE_CHECKING, NoReturn
+import threading
 
-from affordance_env.collect_cli import (
-    add_collect_parser,
-    add_export_parser,
-    int_at_least,
-    non_negative_int,
-    positive_int,
-)
-from affordance_env.registry import BEHAVIOR_NAMES, ENV_ID
-from affordance_learning.common.exceptions import AffordanceError, InvalidValueError
-from affordance_learning.planning.results import PLAN_RESULTS_FORMAT
+#: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as a shell reports it.
+INTERRUPTED = 130
+#: What Ctrl-C says, at whatever moment of a command it comes.
+INTERRUPTED_LINE = ("affordance: interrupted; what was finished is kept (the same command resumes a collection from "
+                    "its last finished chunk)")
+
+
+def _was_interrupted(exc: BaseException) -> bool:
+    """Whether ``exc`` is Ctrl-C's KeyboardInterrupt, or an error raised because of one (a compiled module whose
+    initialisation it interrupted raises ImportError("initialization failed") from it)."""
+    seen: set[int] = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
+def _say_interrupted() -> None:
+    print(INTERRUPTED_LINE, file=sys.stderr, flush=True)
+
+
+try:  # Ctrl-C while the command's own modules load is the same one line, not a traceback
+    import argparse
+    import contextlib
+    import json
+    import time
+    import warnings
+    from pathlib import Path
+    from typing import TYPE_CHECKING, NoReturn
+
+    from affordance_env.collect_cli import (
+        add_collect_parser,
+        add_export_parser,
+        int_at_least,
+        non_negative_int,
+        positive_int,
+    )
+    from affordance_env.registry import BEHAVIOR_NAMES, ENV_ID
+    from affordance_learning.common.exceptions import AffordanceError, InvalidValueError
+    from affordance_learning.planning.results import PLAN_RESULTS_FORMAT
+except BaseException as exc:
+    if not _was_interrupted(exc):
+        raise
+    _say_interrupted()
+    raise SystemExit(INTERRUPTED) from None
 
 if TYPE_CHECKING:
     from affordance_learning.paper.results import Results
@@ -86,15 +119,28 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
-    """``--dataset`` values, ``BEHAVIOR=PATH`` or (with one behaviour) ``PATH``, as a directory per behaviour."""
+    """``--dataset`` values, ``BEHAVIOR=PATH`` or (with one behaviour) ``PATH``, as a directory per behaviour.
+
+    Text before an ``=`` that could be a name (no path separator) is a behaviour, which must be one the
+    environment has, and its PATH must not be empty: ``kick=taps`` or ``=taps`` is refused, not taken for a
+    folder of that name (a path that holds ``=`` is given as ``./kick=taps``)."""
     datasets: dict[str, Path] = {}
+    known = sorted({*behaviors, *BEHAVIOR_NAMES})
     for item in items:
-        name, _, path = item.partition("=")
-        if not path or name not in {*behaviors, *BEHAVIOR_NAMES}:  # a bare path (which may hold "=" itself)
+        name, equals, path = item.partition("=")
+        if equals and "/" not in name and os.sep not in name:
+            if name not in known:
+                raise InvalidValueError(
+                    f"--dataset {item}: {'no behaviour before =' if not name else f'unknown behaviour {name!r}'}; "
+                    f"give BEHAVIOR=PATH with BEHAVIOR one of {', '.join(known)} (a path that holds '=' is "
+                    "given as ./PATH).")
+            if not path:
+                raise InvalidValueError(f"--dataset {item}: no PATH after '{name}='; give {name}=PATH.")
+        else:  # a bare path
             if len(behaviors) != 1:
                 raise InvalidValueError(
                     f"--dataset {item}: say whose dataset it is, as BEHAVIOR=PATH with BEHAVIOR one "
-                                 f"of {', '.join(behaviors)} (a bare PATH is for a single --behavior).")
+                    f"of {', '.join(behaviors)} (a bare PATH is for a single --behavior).")
             name, path = behaviors[0], item
         if name in datasets:
             raise InvalidValueError(f"--dataset given twice for {name!r}.")
@@ -449,10 +495,6 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-#: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as a shell reports it.
-INTERRUPTED = 130
-
-
 def _one_line(exc: BaseException) -> str:
     """What went wrong, for a person, on one line: a file system error names the path and the reason."""
     if isinstance(exc, OSError) and exc.strerror and exc.filename is not None:
@@ -467,10 +509,30 @@ def main(argv: list[str] | None = None) -> int:
     extended, a missing optional package: an error of the packages' ``exceptions`` modules or an ``OSError``) is
     one line on stderr and exit status 2; a command-line mistake is
     found before any work starts (a value that cannot be used at all raises SystemExit(2) as it is parsed, the
-    others are checked before the subcommand imports what it runs). Ctrl-C is one line and status 130, and what
-    was finished is kept (a dataset's chunks: the same command resumes it). Anything else is a bug and keeps its
-    traceback.
+    others are checked before the subcommand imports what it runs). Ctrl-C is one line and status 130 at any
+    moment, the imports of the command's modules included, and what was finished is kept (a dataset's chunks: the
+    same command resumes it). Anything else is a bug and keeps its traceback. Run as the command (``argv`` None),
+    a Ctrl-C after the command's work, as the process ends, is that line and status 130 too, or, once the
+    interpreter tears its modules down, nothing: the process ends as it would have.
     """
+    if argv is None and threading.current_thread() is threading.main_thread():
+        # registered before the command's work loads modules that register their own: called after theirs, once
+        # no Python code of the command is left to run, and before the interpreter puts back the default handling
+        # of SIGINT (an exit by the signal, without a word)
+        atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
+    try:
+        return _run(argv)
+    except BaseException as exc:
+        if not _was_interrupted(exc):
+            raise
+        _say_interrupted()
+        return INTERRUPTED
+    finally:
+        if argv is None:
+            _interrupt_ends_the_process()
+
+
+def _run(argv: list[str] | None) -> int:
     args = build_parser().parse_args(argv)
     # joblib's resource tracker, a process of its own that inherits this environment, lists on Ctrl-C the
     # semaphores of the workers it stopped as it cleans them up: two warnings after the line below, not for people
@@ -483,13 +545,26 @@ def main(argv: list[str] | None = None) -> int:
                                 category=UserWarning)
         try:
             return args.func(args)
-        except KeyboardInterrupt:
-            print("affordance: interrupted; what was finished is kept (the same command resumes a collection "
-                  "from its last finished chunk)", file=sys.stderr)
-            return INTERRUPTED
         except (AffordanceError, OSError) as exc:  # FileNotFoundError: an OSError
+            if _was_interrupted(exc):
+                raise
             print(f"affordance: error: {_one_line(exc)}", file=sys.stderr)
             return 2
+
+
+def _interrupt_ends_the_process() -> None:
+    """From now on Ctrl-C ends this process at once with the one line and status 130: the command's work is over
+    and only the interpreter's shutdown (its threads, its exit handlers) is left, where a KeyboardInterrupt would
+    be a traceback."""
+    def stop(signum: int, frame: object) -> None:
+        with contextlib.suppress(Exception):
+            sys.stdout.flush()
+        _say_interrupted()
+        os._exit(INTERRUPTED)
+
+    if (threading.current_thread() is threading.main_thread()
+            and signal.getsignal(signal.SIGINT) is signal.default_int_handler):
+        signal.signal(signal.SIGINT, stop)
 
 
 if __name__ == "__main__":

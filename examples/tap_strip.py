@@ -28,10 +28,10 @@ def main() -> None:
     parser.add_argument("--out", default="tap")
     args = parser.parse_args()
 
-    env = TapAffordanceEnv(render_mode="rgb_array", object_types=(args.object,), behavior=args.behavior)
+    env = TapAffordanceEnv(render_mode="rgb_array_list", object_types=(args.object,), behavior=args.behavior)
     obs0, info0 = env.reset(seed=args.seed)
     obs1, _, _, _, info = env.step(np.zeros(3))
-    frames = env.frames
+    frames = env.render()
     picks = np.linspace(0, len(frames) - 1, 6).round().astype(int)
 
     fig, axes = plt.subplots(2, 6, figsize=(18, 6))

@@ -203,3 +203,31 @@ def test_ctrl_c_exits_130_in_one_line_and_keeps_the_finished_chunks(tmp_path):
     from affordance_env.dataset import load_dataset
 
     assert len(load_dataset(out, allow_incomplete=True)) >= 1  # what was finished reads back, checked
+
+
+@pytest.mark.parametrize("delay", [0.15, 0.4, 0.8, 1.5])
+def test_ctrl_c_during_export_is_one_line_and_130_at_any_moment(delay, tmp_path):
+    # Ctrl-C once gave a traceback while the command's modules were imported (mujoco's raised ImportError from it)
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    pytest.importorskip("minari")
+    dataset = tmp_path / "taps"
+    assert main(["collect", "--episodes", "2", "--out", str(dataset), "--camera-width", "32", "--camera-height",
+                 "24"]) == 0
+    env = {**os.environ, "MINARI_DATASETS_PATH": str(tmp_path / "minari")}
+    command = [sys.executable, "-c", "from affordance_learning.cli import main; raise SystemExit(main())", "export",
+               str(dataset), "--minari", "tap-affordance/interrupted-v0"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env,
+                               preexec_fn=lambda: (os.setpgrp(), signal.signal(signal.SIGINT, signal.SIG_DFL)))
+    time.sleep(delay)
+    os.killpg(process.pid, signal.SIGINT)
+    out, err = process.communicate(timeout=120)
+    if process.returncode == 0:  # the export was over before Ctrl-C came
+        assert err == "" and "Minari dataset" in out
+    else:
+        assert process.returncode == 130, err
+        assert err.splitlines() == [err.strip()] and err.startswith("affordance: interrupted"), err

@@ -5,6 +5,7 @@ import itertools
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -13,6 +14,7 @@ from affordance_learning.cli import PLAN_DEFAULTS, build_parser, main
 COLLECT = ["collect", "--out", "OUT", "--episodes", "3"]
 PLAN = ["plan", "--out", "OUT"]
 SIZE = "a size in metres in [0.02, 0.15] (what the hand can tap)"
+DASK = "PROTOCOL://HOST:PORT with PROTOCOL one of tcp, tls, ws, wss, ucx (e.g. tcp://scheduler:8786)"
 
 # argv (OUT: a path in the test's directory), the option, the value given, what is expected of it
 BAD_VALUES = [
@@ -47,6 +49,10 @@ BAD_VALUES = [
     ([*COLLECT, "--roll-threshold", "0"], "--roll-threshold", "0", "a positive distance in metres"),
     ([*COLLECT, "--settle-timeout", "-1"], "--settle-timeout", "-1", "a positive duration in seconds"),
     ([*COLLECT, "--settle-timeout", "inf"], "--settle-timeout", "inf", "a positive duration in seconds"),
+    ([*COLLECT, "--dask-address", "127.0.0.1"], "--dask-address", "127.0.0.1", DASK),
+    ([*COLLECT, "--dask-address", "notanaddress"], "--dask-address", "notanaddress", DASK),
+    ([*COLLECT, "--dask-address", "ftp://host:8786"], "--dask-address", "ftp://host:8786", DASK),
+    ([*COLLECT, "--dask-address", "tcp://host:0"], "--dask-address", "tcp://host:0", DASK),
 ]
 
 
@@ -73,6 +79,8 @@ def test_the_values_at_the_bounds_are_accepted(tmp_path):
     assert (args.episodes, args.max_failure_share, args.size_range, args.camera_width) == (1, 1.0, [0.05, 0.05], 2)
     assert parse(["reproduce", "--episodes", "20"]).episodes == 20
     assert parse(["collect", "--out", out, "--episodes", "1", "--max-failure-share", "0"]).max_failure_share == 0
+    for address in ("tcp://127.0.0.1:8786", "tls://scheduler.example:8786", "127.0.0.1:8786", "tcp://[::1]:8786"):
+        assert parse(["collect", "--out", out, "--episodes", "1", "--dask-address", address]).dask_address == address
 
 
 class WorkStarted(Exception):
@@ -283,3 +291,27 @@ for argv in {mistakes!r}:
     assert done.stdout.split() == ["2"] * len(mistakes)
     assert len(done.stderr.splitlines()) == len(mistakes)  # one line each
     assert not (tmp_path / "p").exists() and not (tmp_path / "c").exists()
+
+
+@pytest.mark.parametrize(("item", "fragment"), [("kick=taps", "unknown behaviour 'kick'"),
+                                                ("=taps", "no behaviour before ="), ("tap=", "no PATH after 'tap='")])
+def test_reproduce_refuses_a_dataset_of_no_known_behaviour(item, fragment, tmp_path, capsys, monkeypatch):
+    # --dataset kick=taps once collected into a folder named "kick=taps"
+    import affordance_learning.paper.reproduce as reproduce
+
+    def started(*args, **kwargs):
+        raise WorkStarted(args, kwargs)
+
+    monkeypatch.setattr(reproduce, "reproduce", started)
+    monkeypatch.chdir(tmp_path)
+    out = tmp_path / "out"
+    err = _refused(["reproduce", "--behavior", "tap", "--dataset", item, "--out", out], capsys, fragment)
+    if "behaviour" in fragment:  # the valid ones named
+        assert all(name in err for name in ("tap", "push", "grasp", "draw", "tap_back"))
+    assert not out.exists() and not list(tmp_path.iterdir())
+    with pytest.raises(WorkStarted) as accepted:  # a path that holds "=" is given as one
+        main(["reproduce", "--behavior", "tap", "--dataset", "./kick=taps", "--out", str(out)])
+    assert accepted.value.args[1]["datasets"] == {"tap": Path("kick=taps")}
+    with pytest.raises(WorkStarted) as accepted:
+        main(["reproduce", "--dataset", "tap=taps", "--dataset", "grasp=grasps", "--out", str(out)])
+    assert accepted.value.args[1]["datasets"] == {"tap": Path("taps"), "grasp": Path("grasps")}

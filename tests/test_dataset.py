@@ -606,3 +606,36 @@ def test_without_a_terminal_progress_is_a_plain_line_every_10_s(tmp_path, monkey
     assert lines[-1].startswith("d: 100%") and "4/4" in lines[-1]
     collect(tmp_path / "e", 2, **{**RUN, "chunk_size": 2, "progress": False})
     assert capsys.readouterr().err == ""
+
+
+def test_worker_processes_are_at_most_the_chunks_and_the_cores(tmp_path, monkeypatch, capsys):
+    # --workers 1000 for one chunk once started 850 processes: now one per chunk to collect at most, and one per
+    # core unless asked for more (oversubscribe), the cap said in one line on stderr.
+    import importlib
+
+    module = importlib.import_module("affordance_env.dataset.collect")
+    started = []
+    monkeypatch.setattr(module, "_run", lambda tasks, scheduler, workers, address: started.append(
+        (scheduler, workers)) or iter(()))
+    monkeypatch.setattr(module.os, "cpu_count", lambda: 4)
+    collect(tmp_path / "one", 4, workers=1000, progress=False)  # one chunk
+    assert started.pop() == ("joblib", 1) and capsys.readouterr().err == ""
+    collect(tmp_path / "three", 6, workers=3, chunk_size=2, progress=False)  # within the cores: as asked
+    assert started.pop() == ("joblib", 3) and capsys.readouterr().err == ""
+    collect(tmp_path / "many", 40, workers=1000, chunk_size=2, progress=False)  # 20 chunks, 4 cores
+    assert started.pop() == ("joblib", 4)
+    note = capsys.readouterr().err
+    assert note.count("\n") == 1 and "4 cores" in note and "oversubscribe" in note
+    collect(tmp_path / "over", 40, workers=1000, chunk_size=2, progress=False, oversubscribe=True)
+    assert started.pop() == ("joblib", 20) and capsys.readouterr().err == ""
+    collect(tmp_path / "dask", 40, workers=1000, chunk_size=2, progress=False, scheduler="dask")  # local cluster
+    assert started.pop() == ("dask", 4)
+    collect(tmp_path / "remote", 40, workers=1000, chunk_size=2, progress=False, dask_address="tcp://h:8786")
+    assert started.pop() == ("dask", 1000)  # another machine's cluster: its workers are its own
+
+
+@pytest.mark.parametrize("address", ["127.0.0.1", "notanaddress", "tcp://host", "http://host:8786", 8786])
+def test_a_malformed_dask_address_is_refused_before_anything_is_written(address, tmp_path):
+    with pytest.raises(ValueError, match="PROTOCOL://HOST:PORT"):
+        collect(tmp_path / "d", 2, dask_address=address, progress=False)
+    assert not (tmp_path / "d").exists()

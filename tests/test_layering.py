@@ -109,3 +109,14 @@ def test_importing_the_planner_loads_neither_mujoco_nor_pinocchio():
             "print(sorted(m for m in ('mujoco', 'pinocchio') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
+
+
+def test_the_documented_submodules_resolve_after_importing_the_package_alone():
+    # help(affordance_env.tap_env.TapAffordanceEnv) and affordance_env.workspace.WORKSPACES, as the README names
+    # them, after nothing but ``import affordance_env``; the import itself still loads no simulator.
+    code = ("import sys, affordance_env; light = 'mujoco' not in sys.modules; "
+            "print(light, affordance_env.tap_env.TapAffordanceEnv.__name__, "
+            "affordance_env.goal_env.FlatActionWrapper.__name__, bool(affordance_env.workspace.WORKSPACES), "
+            "hasattr(affordance_env, 'no_such_module'))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.split() == ["True", "TapAffordanceEnv", "FlatActionWrapper", "True", "False"]

@@ -43,8 +43,48 @@ def test_rgb_array_pictures_and_frames_of_a_tap():
     sky, floor = picture[:10].mean(), picture[-10:].mean()
     assert floor > sky  # upright: the lit floor and table are at the bottom, the dark background on top
     env.step(np.zeros(3))
-    assert len(env.frames) > 10
-    assert not np.array_equal(env.frames[0], env.frames[-1])  # the arm moved
+    assert env.frames == []  # rgb_array draws only when asked
+    after = env.render()
+    assert after.shape == (120, 160, 3) and not np.array_equal(picture, after)  # the arm moved
+    env.close()
+
+
+class CountingWorld:
+    """Counts the pictures the env asks its world for, and draws a plain one (no OpenGL needed)."""
+
+    def __init__(self, env):
+        self.calls = 0
+
+        def picture(width, height):
+            self.calls += 1
+            value = int(env.physics.data.time * 1000) % 256  # of the current scene: changes as it moves
+            return np.full((height, width, 3), value, np.uint8)
+
+        env.world.picture = picture
+
+
+def test_rgb_array_draws_only_when_render_is_called():
+    # rgb_array once drew a picture every 1/30 s of every reset and step, as rgb_array_list does: a reset and a
+    # step took about 20 s instead of 0.013 s without OpenGL hardware.
+    env = TapAffordanceEnv(render_mode="rgb_array", render_width=64, render_height=48, camera_width=32,
+                           camera_height=24)
+    counter = CountingWorld(env)
+    env.reset(seed=0)
+    env.step(np.zeros(3))
+    assert counter.calls == 0 and env.frames == []
+    picture = env.render()
+    assert counter.calls == 1 and picture.shape == (48, 64, 3) and picture.dtype == np.uint8
+    assert picture[0, 0, 0] == int(env.physics.data.time * 1000) % 256  # the scene as it is now
+    env.close()
+
+
+def test_rgb_array_list_still_records_the_frames_of_the_interaction():
+    env = TapAffordanceEnv(render_mode="rgb_array_list", camera_width=32, camera_height=24)
+    counter = CountingWorld(env)
+    env.reset(seed=0)
+    env.step(np.zeros(3))
+    frames = env.render()
+    assert counter.calls == len(frames) > 10 and len({f[0, 0, 0] for f in frames}) > 10
     env.close()
 
 

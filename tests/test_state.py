@@ -50,3 +50,33 @@ def test_a_restore_takes_only_a_snapshot_of_this_env():
     env.set_state(state)  # a snapshot taken mid-episode can be used again
     assert env.step(np.zeros(3))[2]
     env.close()
+
+
+@pytest.mark.parametrize("field", ["qpos", "qvel", "ctrl", "qacc_warmstart", "time"])
+def test_a_state_whose_mujoco_data_are_not_finite_is_refused_and_restores_nothing(field):
+    # Such a state was restored: the next step failed, and until then the world answered questions about NaN.
+    import copy
+    import dataclasses
+
+    from affordance_env.exceptions import InvalidValueError
+
+    env = TapAffordanceEnv(camera_width=32, camera_height=24)
+    env.reset(seed=0)
+    saved = env.get_state()
+    geometry, data = saved.world.physics
+    data = copy.copy(data)
+    if field == "time":
+        data.time = np.inf
+    else:
+        getattr(data, field)[0] = np.nan
+    damaged = dataclasses.replace(saved, world=dataclasses.replace(saved.world, physics=(geometry, data)))
+    env.reset(seed=1)  # elsewhere: the refused state must leave this world and generator as they are
+    before = env.get_state()
+    with pytest.raises(InvalidValueError, match=f"not finite in {field}"):
+        env.set_state(damaged)
+    after = env.get_state()
+    np.testing.assert_array_equal(after.world.physics[1].qpos, before.world.physics[1].qpos)
+    assert after.rng == before.rng and after.world.physics[0] == before.world.physics[0]
+    env.set_state(saved)  # an intact state still restores
+    assert np.isfinite(env.step(np.zeros(3))[1])
+    env.close()

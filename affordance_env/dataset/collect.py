@@ -25,6 +25,7 @@ import dataclasses
 import json
 import os
 import signal
+import sys
 import warnings
 from collections.abc import Iterator, Mapping
 from pathlib import Path
@@ -64,7 +65,7 @@ from affordance_env.exceptions import InvalidValueError, MissingDependencyError
 from affordance_env.options import EnvOptions
 from affordance_env.progress import progress_bar, show_progress  # noqa: F401  (show_progress: re-exported)
 from affordance_env.registry import BEHAVIOR_NAMES
-from affordance_env.values import is_integer
+from affordance_env.values import check_dask_address, is_integer
 from affordance_env.workers import worker_env
 
 ACTIONS = ("canonical", "random")
@@ -257,6 +258,7 @@ def collect(
     save_images: bool = False,
     max_failure_share: float = 0.2,
     env_id: str = ENV_IDS[0],
+    oversubscribe: bool = False,
 ) -> Path:
     """Collect ``episodes`` interactions into the dataset directory ``out``, resuming it if it exists.
 
@@ -265,8 +267,9 @@ def collect(
             extended if ``episodes`` is larger; one made with other settings is refused.
         episodes: Number of interactions.
         seed: Seed of the dataset (>= 0); interaction ``i`` depends only on ``(seed, i)``.
-        workers: Processes on this machine (joblib), or in the local Dask cluster of ``scheduler="dask"``.
-            The data do not depend on it.
+        workers: Processes on this machine (joblib), or in the local Dask cluster of ``scheduler="dask"``: at
+            most one per chunk to collect, and at most one per core (``os.cpu_count()``) unless ``oversubscribe``
+            (a one-line note on stderr says when fewer are started than asked). The data do not depend on it.
         action: ``"canonical"`` (the paper's tap, all zeros) or ``"random"`` (uniform in the action box).
         env_options: Keyword arguments of ``TapAffordance-v2`` (behavior, object_types, size_range,
             camera_width, camera_height, camera_fovy, roll_threshold, settle_timeout); the others keep the
@@ -289,12 +292,14 @@ def collect(
             episodes end early as the module docstring says (truncated: ``"infeasible: ..."`` or ``"lost: ..."`` in
             the chunk's metadata; or at a failed interaction, left out). The rule is part of the dataset's settings
             (``goal_episodes``): a dataset collected otherwise is not resumed with it.
+        oversubscribe: Start ``workers`` processes even where they are more than this machine's cores.
 
     Returns:
         The dataset directory.
     """
     _check_collect_arguments(episodes, seed, workers, action, chunk_size, scheduler, max_failure_share, env_id)
     if dask_address is not None:
+        check_dask_address(dask_address)  # before anything is written: Dask's own error is a long traceback
         scheduler = "dask"
     options = _full_options(dict(env_options or {}), env_id)
     if scheduler == "joblib" and workers == 1:  # this process collects: build its env now, before any work
@@ -320,9 +325,25 @@ def collect(
         _check_failure_share(done, max_failure_share, out)
         tasks = [(str(out), i, start, stop, header)
                  for i, (start, stop) in enumerate(ranges) if i not in done]
+        if dask_address is None:  # a cluster of its own: processes of this machine
+            workers = _worker_count(workers, len(tasks), oversubscribe)
         _collect_chunks(out, tasks, done, header, episodes, progress, max_failure_share,
                         (scheduler, workers, dask_address))
     return out
+
+
+def _worker_count(workers: int, chunks: int, oversubscribe: bool = False) -> int:
+    """The processes to start for ``chunks`` chunks when ``workers`` are asked: no more than the chunks (a process
+    without a chunk only costs its start), and no more than this machine's cores unless ``oversubscribe`` (more
+    processes than cores slow each other down and can exhaust the memory: each builds its own environment). The
+    cap by the cores is said in one line on stderr."""
+    count = max(1, min(workers, chunks))
+    cores = os.cpu_count() or 1
+    if count > cores and not oversubscribe:
+        print(f"affordance: note: {count} worker processes asked, more than this machine's {cores} cores: "
+              f"starting {cores} (--oversubscribe, or oversubscribe=True, starts {count})", file=sys.stderr)
+        count = cores
+    return count
 
 
 def _check_collect_arguments(episodes: int, seed: int, workers: int, action: str, chunk_size: int, scheduler: str,
