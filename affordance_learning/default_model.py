@@ -44,8 +44,11 @@ from numpy.typing import ArrayLike
 from affordance_env.values import float_array
 from affordance_learning.common.behaviors import check_behavior
 from affordance_learning.common.exceptions import DefaultModelError, DefaultModelMissingError, InvalidValueError
+from affordance_learning.common.schema import frame_behavior
 from affordance_learning.common.validation import check_float32_range, first_non_finite
 from affordance_learning.paper.model import AffordanceModel, EffectPrediction
+from affordance_learning.planning.effect_model import ActionEffectModel, behavior_model
+from affordance_learning.planning.outcomes import model_inputs, outcome_table
 
 #: Where the package's own default models are, one file per behaviour (read only).
 MODEL_DIR = Path(__file__).resolve().parent / "data"
@@ -155,8 +158,6 @@ def train_default_model(
     Raises:
         ValueError: An unknown behaviour, a frame of another behaviour or of several, or missing columns.
     """
-    from affordance_learning.common.schema import frame_behavior
-
     path = user_model_path(behavior) if path is None else path
     frame_behavior(df, check_behavior(behavior))
     names = _feature_names()
@@ -391,9 +392,6 @@ def train_action_models(frame: pd.DataFrame, out: str | Path | None = None, *,
     Raises:
         ValueError: A behaviour without interactions in the frame, or a frame without the goal dataset's columns.
     """
-    from affordance_learning.planning.effect_model import behavior_model
-    from affordance_learning.planning.outcomes import model_inputs, outcome_table
-
     out = user_model_dir() if out is None else Path(out)
     held = [str(b) for b in dict.fromkeys(frame["behavior"].astype(str))] if "behavior" in frame else []
     behaviors = [check_behavior(b) for b in (behaviors or held)]
@@ -430,8 +428,6 @@ def _action_problem(path: Path | str, problem: str) -> str:
 @functools.lru_cache(maxsize=8)
 def _load_action(path: str, size: int, mtime_ns: int, behavior: str):
     """Load and check a stored action-conditioned model of ``behavior``; ``size`` and ``mtime_ns`` key the cache."""
-    from affordance_learning.planning.effect_model import ActionEffectModel
-
     try:
         bundle: Any = joblib.load(path)
     except Exception as exc:  # unpickling a damaged file can raise almost anything

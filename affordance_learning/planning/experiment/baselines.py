@@ -11,7 +11,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from affordance_env.dataset import learning_data
 from affordance_env.registry import BEHAVIOR_NAMES
+from affordance_learning.paper.model import AffordanceModel
 from affordance_learning.planning.experiment.settings import GOAL_KINDS
 from affordance_learning.planning.goals import Goal
 from affordance_learning.planning.outcomes import outcome_table
@@ -28,9 +30,6 @@ class SomBaseline:
 
     @classmethod
     def fit(cls, frames: Mapping[str, pd.DataFrame], n_clusters: int, random_state: int) -> SomBaseline:
-        from affordance_env.dataset import learning_data
-        from affordance_learning.paper.model import AffordanceModel
-
         models, outcomes, labels = {}, {}, {}
         for b, f in frames.items():
             X, E, _ = learning_data(f, b)

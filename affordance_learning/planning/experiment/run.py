@@ -18,8 +18,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from affordance_env.dataset import load_dataset
 from affordance_env.goal_env import TapAffordanceGoalEnv
 from affordance_env.objects import OBJECT_TYPES
+from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
 from affordance_env.workers import map_in_processes
 from affordance_learning.common.statistics import share_text
 from affordance_learning.common.typed_json import to_json
@@ -205,8 +207,6 @@ def _planner_episodes(episodes: Sequence[Mapping[str, Any]], reach: Mapping[str,
 def _multi_step(run: _Stages, by_policy: Sequence[Sequence[Mapping[str, Any]]], frame: pd.DataFrame
                 ) -> MultiStep:
     """Step 5's summary: each policy's episodes, and the planner's in detail."""
-    from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
-
     episodes = by_policy[MULTI_POLICIES.index("planner")]
     reach, tolerance = step_reach(frame), episodes[0]["tolerance"]  # the goal env's
     details = {"planner": _planner_episodes(episodes, reach, tolerance, GOAL_MAX_EPISODE_STEPS)}
@@ -302,8 +302,6 @@ def record_episode(out: str | os.PathLike, results: PlanResults | Mapping[str, A
                    ) -> list[tuple[str, np.ndarray]]:
     """Pictures of one multi-step planner episode (the first of the evaluation's), with the models refitted from
     ``out/dataset``: the start, then the scene after each interaction, titled with the behaviour."""
-    from affordance_env.dataset import load_dataset
-
     settings = PlanSettings(**PlanResults.from_dict(results).settings)
     frames = training_frames(load_dataset(Path(out) / DATASET_DIR), settings.max_per_behavior)
     planner = Planner(fit_models(frames, seed), n_candidates=settings.candidates, threshold=settings.threshold,
