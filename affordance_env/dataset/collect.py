@@ -309,12 +309,7 @@ def collect(
         header["settings"]["goal_episodes"] = GOAL_EPISODE_RULE
     out, episodes = Path(out), int(episodes)
 
-    stored: dict = {}
-    if (out / MANIFEST).exists():
-        stored = _check_resumable(out, header, episodes)
-    elif out.exists() and (not out.is_dir() or any(p.name != ".lock" for p in out.iterdir())):
-        raise DatasetError(f"{out} exists and is not a TapAffordance dataset (no {MANIFEST}); choose an "
-                           "empty or new directory.")
+    stored = _stored_or_new(out, header, episodes)
     out.mkdir(parents=True, exist_ok=True)
     with _exclusive(out):
         for stale in out.glob(".*.tmp"):  # left by a run that was killed while writing
@@ -323,8 +318,7 @@ def collect(
         done = _chunks_done(out, ranges, header, stored)
         write_manifest(out, header, episodes, done)
         _check_failure_share(done, max_failure_share, out)
-        tasks = [(str(out), i, start, stop, header)
-                 for i, (start, stop) in enumerate(ranges) if i not in done]
+        tasks = [(str(out), i, start, stop, header) for i, (start, stop) in enumerate(ranges) if i not in done]
         if dask_address is None:  # a cluster of its own: processes of this machine
             workers = _worker_count(workers, len(tasks), oversubscribe)
         _collect_chunks(out, tasks, done, header, episodes, progress, max_failure_share,
@@ -344,6 +338,17 @@ def _worker_count(workers: int, chunks: int, oversubscribe: bool = False) -> int
               f"starting {cores} (--oversubscribe, or oversubscribe=True, starts {count})", file=sys.stderr)
         count = cores
     return count
+
+
+def _stored_or_new(out: Path, header: dict, episodes: int) -> dict:
+    """The manifest of the dataset in ``out`` that these settings resume or extend (DatasetError where they cannot),
+    or an empty one where ``out`` is new or empty; DatasetError where it holds something else."""
+    if (out / MANIFEST).exists():
+        return _check_resumable(out, header, episodes)
+    if out.exists() and (not out.is_dir() or any(p.name != ".lock" for p in out.iterdir())):
+        raise DatasetError(f"{out} exists and is not a TapAffordance dataset (no {MANIFEST}); choose an "
+                           "empty or new directory.")
+    return {}
 
 
 def _check_collect_arguments(episodes: int, seed: int, workers: int, action: str, chunk_size: int, scheduler: str,
