@@ -26,22 +26,26 @@ def test_affordance_env_never_imports_affordance_learning():
     assert not {k: v for k, v in offenders.items() if v}
 
 
+def _loaded_after(code: str, watched: str) -> list[str]:
+    """The modules of ``watched`` (a Python expression over ``sys.modules``' names ``m``, e.g. ``m in ('mujoco',)``)
+    loaded in a fresh interpreter after running ``code``."""
+    probe = f"{code}; import sys; print(sorted(m for m in sys.modules if {watched}))"
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    return eval(out.stdout.strip())  # a printed list of names
+
+
 def test_using_the_environment_loads_nothing_of_the_learning_package():
-    code = ("import sys, numpy as np, affordance_env, affordance_env.dataset, affordance_env.collect_cli; "
+    code = ("import numpy as np, affordance_env, affordance_env.dataset, affordance_env.collect_cli; "
             "from affordance_env.tap_env import TapAffordanceEnv; e = TapAffordanceEnv(camera_width=32, "
-            "camera_height=24); e.reset(seed=0); e.step(np.zeros(3)); "
-            "print(sorted(m for m in sys.modules if m.startswith('affordance_learning')))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "[]"
+            "camera_height=24); e.reset(seed=0); e.step(np.zeros(3))")
+    assert _loaded_after(code, "m.startswith('affordance_learning')") == []
 
 
 def test_checking_a_collections_options_loads_neither_mujoco_nor_pinocchio():
     # The coordinating process of a collection checks the options, then only schedules workers.
-    code = ("import sys; from affordance_env.dataset.collect import _full_options; "
-            "_full_options({'behavior': 'push', 'size_range': (0.05, 0.08)}); "
-            "print(sorted(m for m in ('mujoco', 'pinocchio', 'affordance_env.tap_env') if m in sys.modules))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "[]"
+    code = ("from affordance_env.dataset.collect import _full_options; "
+            "_full_options({'behavior': 'push', 'size_range': (0.05, 0.08)})")
+    assert _loaded_after(code, "m in ('mujoco', 'pinocchio', 'affordance_env.tap_env')") == []
 
 
 def test_motion_imports_no_behaviour():
@@ -105,10 +109,7 @@ def test_learning_rooms_are_layered_common_below_paper_below_planning():
 def test_importing_the_planner_loads_neither_mujoco_nor_pinocchio():
     # A planner runs where its effect models are, not the simulator: its goals and the table top's extent are
     # plain numbers, read without compiling a scene.
-    code = ("import sys; import affordance_learning.planning.planner; "
-            "print(sorted(m for m in ('mujoco', 'pinocchio') if m in sys.modules))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "[]"
+    assert _loaded_after("import affordance_learning.planning.planner", "m in ('mujoco', 'pinocchio')") == []
 
 
 def test_the_documented_submodules_resolve_after_importing_the_package_alone():
