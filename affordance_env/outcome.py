@@ -64,7 +64,8 @@ class ObjectMonitor:
 
     Args:
         table_top: Height of the table top [m].
-        table_low, table_high: Corners of the table top in world x, y [m], (2,) each.
+        table_low: Lower corner of the table top in world x, y [m], (2,).
+        table_high: Upper corner of the table top in world x, y [m], (2,).
         p_world_start: Object centre when the interaction starts [m], (3,).
         time: Simulation time when the interaction starts [s].
     """

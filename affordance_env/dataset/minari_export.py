@@ -182,11 +182,16 @@ def export_minari(dataset: str | os.PathLike, dataset_id: str, *, data_format: s
         dataset: Directory of a dataset made by :func:`affordance_env.dataset.collect` (complete).
         dataset_id: Minari's id, ``(namespace/)name-v(version)``, e.g. ``"tap-affordance/canonical-taps-v0"``.
         data_format: ``"arrow"`` (default) or ``"hdf5"`` (needs h5py).
-        description, author, author_email, code_permalink: Recorded in the Minari metadata; an e-mail or a
-            permalink not given is left out (Minari's reminders about them are not shown).
+        description: Recorded in the Minari metadata (by default, where the dataset was exported from), followed
+            by what the observations leave out and what the infos hold.
+        author: Recorded in the Minari metadata.
+        author_email: Recorded in the Minari metadata; left out if not given (Minari's reminder about it is not
+            shown).
+        code_permalink: Recorded in the Minari metadata; left out if not given (Minari's reminder about it is not
+            shown).
 
     Returns:
-        The ``minari.MinariDataset``.
+        dataset (minari.MinariDataset): The dataset as Minari loads it.
 
     Raises:
         ImportError: minari is not installed (the message says how to install it).
