@@ -92,3 +92,13 @@ def test_every_guide_is_in_the_site_navigation():
     nav = (ROOT / "mkdocs.yml").read_text(encoding="utf-8")
     for page in sorted(DOCS.glob("*.md")):
         assert f": {page.name}\n" in nav, f"docs/{page.name} is missing from mkdocs.yml's nav"
+
+
+def test_readme_links_lead_somewhere():
+    # The site's build checks the guides' links (mkdocs build --strict); the README is read on its own, so its
+    # relative links are checked here: each names a file or folder of the repository.
+    targets = re.findall(r"\]\(([^)#\s]+)[^)]*\)", README.read_text(encoding="utf-8"))
+    relative = [target for target in targets if "://" not in target]
+    assert relative
+    missing = [target for target in relative if not (ROOT / target).exists()]
+    assert not missing, f"README.md links to what is not there: {missing}"
