@@ -11,7 +11,8 @@ Run from anywhere; it writes into the docs/ folder beside this script:
 - ``hand_mount.png``: the fingered hand over the V2.5 hand mesh it replaces (``python examples/hand_mount.py``).
 
 The strips render every frame of the interaction with OpenGL (``MUJOCO_GL``: EGL or OSMesa, chosen automatically
-when unset); without a GPU a strip takes one to two minutes. The reference reproductions under
+when unset), 30 per simulated second: the tap's 82, the grasp's 341, so without a GPU the grasp's strip takes
+several times the tap's (85 s and 793 s on a busy 2-core machine without a GPU). The reference reproductions under
 ``docs/reproduction/`` have figures of their own, which ``affordance reproduce`` draws (their README gives the
 commands); this script leaves them as they are.
 """
