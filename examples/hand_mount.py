@@ -40,6 +40,7 @@ def overlay_model(offset: np.ndarray) -> mujoco.MjModel:
     """The V2.5 robot, frozen, showing only its left hand, with the mk3 hand mounted at ``offset``."""
     spec = mujoco.MjSpec.from_string(icub_urdf())
     spec.compiler.fusestatic = False
+    spec.compiler.discardvisual = False  # keep the phalanges' meshes, which collide with nothing (their capsules do)
     spec.visual.global_.offwidth = spec.visual.global_.offheight = SIZE
     for joint in list(spec.joints):
         spec.delete(joint)
