@@ -19,7 +19,7 @@ from affordance_env.options import EnvOptions
 from affordance_env.placement import RESET_OPTIONS, draw_placement
 from affordance_env.registry import BEHAVIOR_NAMES, check_behavior_name
 from affordance_env.results import InteractionResult, Snapshot
-from affordance_env.values import float_array, restore_with_generator
+from affordance_env.values import float_array, is_integer, restore_with_generator
 from affordance_env.workspace import WORKSPACES, in_any_workspace, sample_in_workspace
 from affordance_env.world import World, WorldState
 
@@ -68,12 +68,15 @@ class GoalEnvState:
         rng: The state of the env's random generator.
         goal: The episode's goal (x, y) [m].
         obs: The last observation, or None once the episode ended.
+        steps: The interactions since the episode's reset; :func:`affordance_env.snapshots.set_state` puts
+            Gymnasium's ``TimeLimit`` wrappers back to it.
     """
 
     world: WorldState
     rng: dict[str, Any]
     goal: np.ndarray
     obs: dict[str, Any] | None
+    steps: int = 0
 
 
 class TapAffordanceGoalEnv(gym.Env):
@@ -163,10 +166,13 @@ class TapAffordanceGoalEnv(gym.Env):
 
     ## Snapshots
     ``get_state()`` and ``set_state(state)``: the world (both arms' scenes and which one acts), the episode's goal
-    and observation and the random generator; the same action after a restore gives the same interaction, bit for
-    bit. ``feasible(behavior, params, state=None)``: whether the arm can reach every pose of that interaction with
-    the object where it is (or where it is in ``state``, a snapshot of ``get_state()``, the env left as it was),
-    from the kinematics alone (no physics step).
+    and observation, the interactions since the reset and the random generator; the same action after a restore
+    gives the same interaction, bit for bit. Through ``gym.make``'s env, whose ``TimeLimit`` wrapper counts the
+    steps out of the env's reach, ``affordance_env.snapshots.set_state(env, state)`` also puts that count back, so
+    that actions tried from one snapshot do not bring the truncation nearer (``env.unwrapped.set_state(state)``
+    leaves the count where it was). ``feasible(behavior, params, state=None)``: whether the arm can reach every
+    pose of that interaction with the object where it is (or where it is in ``state``, a snapshot of
+    ``get_state()``, the env left as it was), from the kinematics alone (no physics step).
 
     ## Version History
     * v2: five behaviours: ``draw`` (the right hand drags the object toward the robot) is new, and the grasp is pick
@@ -255,6 +261,7 @@ class TapAffordanceGoalEnv(gym.Env):
                                          "params": spaces.Box(-1.0, 1.0, (ACTION_DIM,), np.float32)})
         self._goal = np.zeros(2)
         self._obs: dict[str, Any] | None = None
+        self._steps = 0  # interactions since the reset
         self._last: InteractionResult | None = None
 
     @property
@@ -328,7 +335,7 @@ class TapAffordanceGoalEnv(gym.Env):
         obs["desired_goal"] = self._goal.copy()
         info["distance"] = float(goal_distance(obs["achieved_goal"], self._goal))
         info["true_position"] = self.world.object_pose()[:2].copy()
-        self._obs = obs
+        self._obs, self._steps = obs, 0
         return obs, info
 
     def _check_action(self, action: Any) -> tuple[str, np.ndarray]:
@@ -389,13 +396,14 @@ class TapAffordanceGoalEnv(gym.Env):
         reward = self.compute_reward(obs["achieved_goal"], self._goal, info)
         terminated = bool(info["is_success"] or result.outcome in ("off_table", "fault"))
         self._obs = None if terminated else obs
+        self._steps += 1
         return obs, float(reward), terminated, False, info
 
     # --- snapshots -----------------------------------------------------------------------------------------------
     def get_state(self) -> GoalEnvState:
         """A snapshot of the world and the episode; :meth:`set_state` puts it back (treat it as opaque)."""
         return GoalEnvState(self.world.get_state(), copy.deepcopy(self.np_random.bit_generator.state),
-                            self._goal.copy(), self._obs)
+                            self._goal.copy(), self._obs, self._steps)
 
     def set_state(self, state: GoalEnvState) -> None:
         """Put back the world and the episode as :meth:`get_state` saw them."""
@@ -404,10 +412,13 @@ class TapAffordanceGoalEnv(gym.Env):
         goal = float_array("the state's goal", state.goal, (2,), expected="a place on the table (x, y) [m]")
         if state.obs is not None and not isinstance(state.obs, Mapping):
             raise InvalidValueError(f"the state is damaged: its observation is {state.obs!r:.80}.")
+        if not is_integer(state.steps) or state.steps < 0:
+            raise InvalidValueError(f"the state is damaged: its step count is {state.steps!r:.80}, not the "
+                                    "interactions since the reset (an integer >= 0).")
         # the generator's state checked first: a damaged one restores nothing
         restore_with_generator(self.np_random, state.rng, lambda: self.world.set_state(state.world))
         self._goal = goal.copy()
-        self._obs = state.obs
+        self._obs, self._steps = state.obs, int(state.steps)
 
     def render(self):
         """A picture of the scene from the ``overview`` camera (``render_mode="rgb_array"``), else None."""

@@ -6,6 +6,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import affordance_env  # noqa: F401 (registers the envs)
+from affordance_env import snapshots
 from affordance_env.centre import visible_top_centre
 from affordance_env.features import FEATURE_NAMES
 from affordance_env.goal_env import FlatActionWrapper, TapAffordanceGoalEnv, goal_distance
@@ -215,6 +216,24 @@ def test_achieved_goal_is_where_the_object_stands_though_an_arm_hides_part_of_it
     top = visible_top_centre(env.world.seen.snapshot.object_points)
     assert goal_distance(top, truth) > 0.015  # the visible top's centre is centimetres off ...
     assert goal_distance(obs["achieved_goal"], truth) < 0.003  # ... where the object stands is not
+
+
+def test_trying_actions_from_a_snapshot_does_not_bring_the_time_limit_nearer():
+    env = gym.make("TapAffordanceGoal-v2", max_episode_steps=2, **SMALL)
+    env.reset(seed=0, options={"object_type": "box", "size": 0.05, "position": (-0.3, 0.05), "goal": (-0.45, -0.2)})
+    tap = {"behavior": "tap", "params": np.zeros(3, np.float32)}
+    start = snapshots.get_state(env)
+    assert start.steps == 0
+    for _ in range(2):  # two actions tried from the start: each the episode's first step
+        snapshots.set_state(env, start)
+        assert env.step(tap)[3] is False
+    after_one = snapshots.get_state(env)
+    assert after_one.steps == 1
+    snapshots.set_state(env, after_one)
+    assert env.step(tap)[3] is True  # the second step of the episode: truncated, as without the snapshot
+    env.unwrapped.set_state(start)  # the env alone: the TimeLimit's count stays where it was
+    assert env.step(tap)[3] is True
+    env.close()
 
 
 def test_feasible_agrees_with_the_interactions_ik(env):
