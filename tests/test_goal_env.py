@@ -8,6 +8,7 @@ from gymnasium.utils.env_checker import check_env
 import affordance_env  # noqa: F401 (registers the envs)
 from affordance_env import snapshots
 from affordance_env.centre import visible_top_centre
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.features import FEATURE_NAMES
 from affordance_env.goal_env import FlatActionWrapper, TapAffordanceGoalEnv, goal_distance
 from affordance_env.objects import as_resting, object_geometry
@@ -234,6 +235,17 @@ def test_trying_actions_from_a_snapshot_does_not_bring_the_time_limit_nearer():
     env.unwrapped.set_state(start)  # the env alone: the TimeLimit's count stays where it was
     assert env.step(tap)[3] is True
     env.close()
+
+
+@pytest.mark.parametrize("steps", [-1, 1.5, True, "2"])
+def test_a_state_whose_step_count_is_not_a_count_is_refused_and_restores_nothing(env, steps):
+    import dataclasses
+
+    env.reset(seed=0)
+    before = env.get_state()
+    with pytest.raises(InvalidValueError, match="its step count is"):
+        env.set_state(dataclasses.replace(before, steps=steps, goal=np.array([-0.4, 0.1])))
+    assert env.get_state().goal.tolist() == before.goal.tolist()
 
 
 def test_feasible_agrees_with_the_interactions_ik(env):
