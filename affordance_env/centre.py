@@ -124,11 +124,17 @@ def _fit(residuals: Residuals, points: np.ndarray, start: np.ndarray, table_top:
         Jw = J * weights[:, None]
         A, g = matmul(Jw.T, J), matmul(Jw.T, r)
         diagonal = np.diag(A).copy()
+        if not np.max(diagonal) > 0.0:  # no parameter moves a residual: nothing to fit
+            break
         improved = False
         while damping < 1e6:
             A_damped = A + np.diag(damping * np.maximum(diagonal, 1e-9 * np.max(diagonal)))
             trial = params.copy()
-            trial[:free] -= solve_spd(A_damped, g)
+            try:
+                trial[:free] -= solve_spd(A_damped, g)
+            except np.linalg.LinAlgError:  # singular still: damp more
+                damping *= 10
+                continue
             trial[2] = min(max(trial[2], SIZE_LIMITS[0] / 2), SIZE_LIMITS[1] * 2)
             r_trial = residuals(points, trial, table_top)
             cost_trial = _cost(r_trial)
@@ -175,7 +181,8 @@ def object_centre(points: np.ndarray, primitive: str, table_top: float) -> np.nd
         raise InvalidValueError(f"points must be finite points (k, 3) [m] with k >= 1, got shape {p.shape}.")
     if primitive not in PRIMITIVES:
         raise InvalidValueError(f"primitive must be one of {PRIMITIVES}, got {primitive!r}.")
-    if not np.isfinite(table_top):
+    number = isinstance(table_top, int | float | np.floating) and not isinstance(table_top, bool)
+    if not (number and np.isfinite(table_top)):
         raise InvalidValueError(f"table_top must be a finite height [m], got {table_top!r}.")
     top = visible_top_centre(p)
     if len(p) < MIN_POINTS:

@@ -128,6 +128,7 @@ def test_a_few_points_are_placed_at_their_top():
     (np.full((5, 3), np.nan), "sphere", 0.0, "points must be finite"),
     (np.zeros((5, 3)), "cone", 0.0, "primitive must be one of .* got 'cone'"),
     (np.zeros((5, 3)), "box", float("nan"), "table_top must be a finite height"),
+    (np.zeros((5, 3)), "box", "0.7", "table_top must be a finite height .* got '0.7'"),
 ])
 def test_bad_input_is_refused_naming_it(points, primitive, table_top, match):
     with pytest.raises(InvalidValueError, match=match):
