@@ -52,6 +52,9 @@ def seen_whole(env: TapAffordanceGoalEnv, world_camera: RangeCamera) -> bool:
 
 def table(errors: dict[str, list[float]], title: str) -> None:
     print(f"\n{title}")
+    if not errors:
+        print("none")
+        return
     print(f"{'object':18s} {'median':>7s} {'p95':>7s} {'max':>7s} {'<=1 cm':>7s} {'n':>4s}   [mm]")
     rows = sorted(errors.items()) + [("all", [e for v in errors.values() for e in v])]
     for name, values in rows:
