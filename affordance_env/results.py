@@ -35,16 +35,16 @@ class Snapshot:
         mask: 1 on pixels of the object of interest, (H, W) int8.
         features: The paper's 49 features of the object.
         joints: The robot's joint angles [rad], float32, in the order of the robot variant's active joints.
-        seen_position: Where the camera saw the object on the table: the centre (x, y) [m] of its top, the visible
-            points within :data:`~affordance_env.world.TOP_DEPTH` of its highest one; NaN when not seen. Every
-            object's top lies over its centre.
+        object_points: The points of the object the camera saw [m], world frame, (k, 3) (k = the mask's pixels,
+            row-major); (0, 3) when not seen. :func:`affordance_env.centre.object_centre` places the object from
+            them.
     """
 
     ranges: np.ndarray
     mask: np.ndarray
     features: Features
     joints: np.ndarray
-    seen_position: np.ndarray
+    object_points: np.ndarray
 
     @property
     def visible(self) -> bool:

@@ -42,8 +42,6 @@ from affordance_env.results import IKReport, InitialSnapshot, InteractionResult,
 from affordance_env.robot_model import HAND_JOINTS
 from affordance_env.scene import build_model
 
-#: Depth of the object's top, whose centre is where the object is seen on the table [m].
-TOP_DEPTH = 0.003
 #: The placed object is at rest for the initial snapshot when slower than these [m/s], [rad/s]: ten and thirty
 #: times stricter than the outcome's rest (:func:`affordance_env.motion.object_at_rest`).
 REST_SPEED, REST_ANGULAR_SPEED = 1e-3, 1e-2
@@ -260,13 +258,9 @@ class World:
         features = object_features(pixels, mask.shape[1], p_world_obj, image.ranges.reshape(-1).take(pixels),
                                    image.p_world_camera, p_world_hand, uv_hand)
         points = p_world_obj.T.copy()  # p_world_points[mask]: (k, 3), row-major
-        # the highest points' mean x, y: what .max() and .mean(axis=0) compute (the same reductions of the same
-        # arrays, the sum divided by the count), without their Python layers
-        top = points[points[:, 2] >= np.maximum.reduce(points[:, 2]) - TOP_DEPTH] if len(points) else points
-        seen = np.add.reduce(top[:, :2], axis=0) / len(top) if len(top) else np.full(2, np.nan)
         ranges = np.where(np.isfinite(image.ranges), image.ranges, 0.0).astype(np.float32)
         return Snapshot(frozen_array(ranges), frozen_array(mask.astype(np.int8)), features,
-                        frozen_array(physics.joint_positions().astype(np.float32)), frozen_array(seen))
+                        frozen_array(physics.joint_positions().astype(np.float32)), frozen_array(points))
 
     def blank_snapshot(self) -> Snapshot:
         """What nothing seen looks like: no ranges, no object, the not-visible features, the joints at home."""
@@ -274,7 +268,7 @@ class World:
         shape = (camera.intrinsics.height, camera.intrinsics.width)
         features = Features(NOT_VISIBLE_VALUES.copy(), False, 0)
         return Snapshot(frozen_array(np.zeros(shape, np.float32)), frozen_array(np.zeros(shape, np.int8)), features,
-                        frozen_array(self._q_home.astype(np.float32)), frozen_array(np.full(2, np.nan)))
+                        frozen_array(self._q_home.astype(np.float32)), frozen_array(np.empty((0, 3))))
 
     def place(self, placement: Placement, rng: np.random.Generator) -> Observation:
         """Put the robot at home and the object where ``placement`` says, let it settle, and observe it."""

@@ -6,6 +6,9 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import affordance_env  # noqa: F401 (registers the envs)
+from affordance_env import snapshots
+from affordance_env.centre import visible_top_centre
+from affordance_env.exceptions import InvalidValueError
 from affordance_env.features import FEATURE_NAMES
 from affordance_env.goal_env import FlatActionWrapper, TapAffordanceGoalEnv, goal_distance
 from affordance_env.objects import as_resting, object_geometry
@@ -198,6 +201,51 @@ def test_a_restore_gives_the_same_interaction_bit_for_bit(env):
     np.testing.assert_array_equal(first[0]["observation"]["range"], again[0]["observation"]["range"])
     np.testing.assert_array_equal(first[4]["effect"], again[4]["effect"])
     np.testing.assert_array_equal(first[4]["object"]["final_pose"], again[4]["object"]["final_pose"])
+
+
+@pytest.mark.parametrize(("object_type", "size", "position", "yaw"), [
+    ("horizontal_cylinder", 0.092, (-0.221, 0.186), -0.166),  # the left arm hides the part toward +y
+    ("sphere", 0.07, (-0.211, 0.186), 0.0),
+    ("box", 0.084, (-0.227, 0.192), -0.249),
+])
+def test_achieved_goal_is_where_the_object_stands_though_an_arm_hides_part_of_it(env, object_type, size, position,
+                                                                                    yaw):
+    obs, info = env.reset(seed=0, options={"object_type": object_type, "size": size, "position": position,
+                                           "yaw": yaw})
+    truth = info["true_position"]
+    np.testing.assert_array_equal(truth, info["object"]["pose"][:2])
+    top = visible_top_centre(env.world.seen.snapshot.object_points)
+    assert goal_distance(top, truth) > 0.015  # the visible top's centre is centimetres off ...
+    assert goal_distance(obs["achieved_goal"], truth) < 0.003  # ... where the object stands is not
+
+
+def test_trying_actions_from_a_snapshot_does_not_bring_the_time_limit_nearer():
+    env = gym.make("TapAffordanceGoal-v2", max_episode_steps=2, **SMALL)
+    env.reset(seed=0, options={"object_type": "box", "size": 0.05, "position": (-0.3, 0.05), "goal": (-0.45, -0.2)})
+    tap = {"behavior": "tap", "params": np.zeros(3, np.float32)}
+    start = snapshots.get_state(env)
+    assert start.steps == 0
+    for _ in range(2):  # two actions tried from the start: each the episode's first step
+        snapshots.set_state(env, start)
+        assert env.step(tap)[3] is False
+    after_one = snapshots.get_state(env)
+    assert after_one.steps == 1
+    snapshots.set_state(env, after_one)
+    assert env.step(tap)[3] is True  # the second step of the episode: truncated, as without the snapshot
+    env.unwrapped.set_state(start)  # the env alone: the TimeLimit's count stays where it was
+    assert env.step(tap)[3] is True
+    env.close()
+
+
+@pytest.mark.parametrize("steps", [-1, 1.5, True, "2"])
+def test_a_state_whose_step_count_is_not_a_count_is_refused_and_restores_nothing(env, steps):
+    import dataclasses
+
+    env.reset(seed=0)
+    before = env.get_state()
+    with pytest.raises(InvalidValueError, match="its step count is"):
+        env.set_state(dataclasses.replace(before, steps=steps, goal=np.array([-0.4, 0.1])))
+    assert env.get_state().goal.tolist() == before.goal.tolist()
 
 
 def test_feasible_agrees_with_the_interactions_ik(env):
