@@ -47,6 +47,7 @@ try:  # Ctrl-C while the command's own modules load is the same one line, not a 
     from affordance_env.collect_cli import (
         add_collect_parser,
         add_export_parser,
+        check_writable,
         int_at_least,
         non_negative_int,
         positive_int,
@@ -148,30 +149,10 @@ def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
     return datasets
 
 
-def _check_writable_directory(directory: Path, what: str) -> None:
-    """Refuse, before any work, a directory that cannot be made or written into (``what`` names it: the option and
-    the path given); what the check makes (the directory, a probe file) is removed again."""
-    if directory.exists() and not directory.is_dir():
-        raise InvalidValueError(f"{what} is a file, not a directory.")
-    missing = [d for d in (directory, *directory.parents) if not d.exists()]
-    probe = directory / f".affordance-write-test-{os.getpid()}"
-    try:
-        directory.mkdir(parents=True, exist_ok=True)
-        with open(probe, "w"):
-            pass
-    except OSError as exc:
-        raise InvalidValueError(f"{what} cannot be written: {directory} ({exc.strerror}).") from None
-    finally:
-        probe.unlink(missing_ok=True)
-        for made in missing:  # deepest first: only what the check made, and only if still empty
-            with contextlib.suppress(OSError):
-                made.rmdir()
-
-
 def _reproduce(args: argparse.Namespace) -> int:
+    check_writable(args.out, f"--out {args.out}")
     from affordance_learning.paper.reproduce import DEFAULT_BEHAVIORS, reproduce
 
-    _check_writable_directory(args.out, f"--out {args.out}")
     behaviors = args.behavior or list(DEFAULT_BEHAVIORS)
     reproduce(args.out, behaviors=behaviors, episodes=args.episodes, trials=args.trials, seed=args.seed,
               workers=args.workers, datasets=_datasets(args.dataset, behaviors), range_noise=args.range_noise,
@@ -183,13 +164,16 @@ def _train_action_models(args: argparse.Namespace) -> int:
     """``affordance train-default --action-conditioned``: goal episodes with random actions (collected into
     ``--dataset`` or reused from there) until every behaviour has 1000 interactions, then an action-conditioned
     model per behaviour."""
-    from affordance_learning.default_model import ACTION_INTERACTIONS, DATA_ENV, train_action_models, user_model_dir
-    from affordance_learning.planning.experiment import PlanSettings, collect_training
+    from affordance_learning.user_models import DATA_ENV, user_model_dir
 
     dataset = args.dataset or Path("default-actions")
     out = args.out or user_model_dir()
-    _check_writable_directory(out, f"--out {out}" if args.out else f"the models' directory {out} (set it with --out "
-                              f"or ${DATA_ENV})")
+    check_writable(out, f"--out {out}" if args.out else f"the models' directory {out} (set it with --out or "
+                   f"${DATA_ENV})")
+    check_writable(dataset, f"--dataset {dataset}")
+    from affordance_learning.default_model import ACTION_INTERACTIONS, train_action_models
+    from affordance_learning.planning.experiment import PlanSettings, collect_training
+
     settings = PlanSettings(max_per_behavior=ACTION_INTERACTIONS)
     frame = collect_training(dataset, settings, seed=0, workers=args.workers, camera=(160, 120))
     written = train_action_models(frame, out)
@@ -202,23 +186,27 @@ def _train_default(args: argparse.Namespace) -> int:
     if args.action_conditioned:
         return _train_action_models(args)
     from affordance_learning.common.behaviors import check_behavior, check_env_offers
+    from affordance_learning.user_models import DATA_ENV, user_model_path
 
     behavior = check_behavior(args.behavior)
-    from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
-    from affordance_learning.default_model import DATA_ENV, train_default_model, user_model_path
-
     dataset = args.dataset or Path("default-taps" if behavior == "tap" else f"default-{behavior}")
     out = args.out or user_model_path(behavior)
     what = f"--out {out}" if args.out else f"the model's place {out} (set it with --out or ${DATA_ENV})"
     if out.is_dir():
         raise InvalidValueError(f"{what} is a directory, not a model file.")
-    _check_writable_directory(out.parent, what)
+    check_writable(out, what, directory=False)
+    check_writable(dataset, f"--dataset {dataset}")
+    from affordance_env.dataset.format import MANIFEST, read_manifest
+
     if (dataset / MANIFEST).exists():  # say so plainly, before the collection refuses its other settings
         found = read_manifest(dataset)["settings"].get("env_options", {}).get("behavior", "tap")
         if found != behavior:
             raise InvalidValueError(f"{dataset} holds {found!r} interactions, not {behavior!r} ones: give --dataset a "
                              f"dataset of {behavior} interactions, or a new directory to collect them into.")
     check_env_offers([behavior])
+    from affordance_env.dataset import collect, load_dataset
+    from affordance_learning.default_model import train_default_model
+
     collect(dataset, 1000, seed=0, workers=args.workers, env_options={"behavior": behavior})
     model = train_default_model(load_dataset(dataset), out, behavior=behavior)
     print(f"default {behavior} model ({model.n_clusters} categories, {len(model.selected_features_)} features "
@@ -292,10 +280,9 @@ def _dataset_kind(manifest: object) -> str:
 def _check_plan_out(out: Path, seed: int) -> None:
     """Refuse an ``--out`` of ``affordance plan`` that holds anything but an earlier plan's output (its dataset is
     resumed, its results rewritten), before anything is written."""
+    check_writable(out, f"--out {out}")
     if not out.exists():
         return
-    if not out.is_dir():
-        raise InvalidValueError(f"--out {out} is a file, not a directory.")
     from affordance_env.dataset.format import GOAL_ENV_ID, MANIFEST
 
     hint = (f"affordance plan writes its goal episodes into OUT/{PLAN_DATASET} and results.json, REPORT.md and "

@@ -145,12 +145,22 @@ def test_paths_that_cannot_be_used_are_one_line_errors(tmp_path, capsys, monkeyp
     a_file = tmp_path / "notes.txt"
     a_file.write_text("mine")
     small = ["--camera-width", "32", "--camera-height", "32"]
-    assert main(["collect", "--episodes", "2", "--out", str(a_file / "taps"), *small]) == 2
-    assert capsys.readouterr().err == f"affordance: error: {a_file / 'taps'}: Not a directory\n"
+    # each names the option whose path it is
+    for command in (["collect", "--episodes", "2"], ["plan"], ["reproduce"]):
+        assert main([*command, "--out", str(a_file / "taps"), *(small if command[0] == "collect" else [])]) == 2
+        assert capsys.readouterr().err == (f"affordance: error: --out {a_file / 'taps'} cannot be written: {a_file} "
+                                           "is a file, not a directory.\n")
+    assert main(["train-default", "--out", str(a_file / "m.joblib")]) == 2
+    assert capsys.readouterr().err == (f"affordance: error: --out {a_file / 'm.joblib'} cannot be written: {a_file} "
+                                       "is a file, not a directory.\n")
     read_only = tmp_path / "read-only"
     _read_only(monkeypatch, read_only)
     assert main(["collect", "--episodes", "2", "--out", str(read_only / "taps"), *small]) == 2
-    assert capsys.readouterr().err == f"affordance: error: {read_only / 'taps'}: Read-only file system\n"
+    assert capsys.readouterr().err == (f"affordance: error: --out {read_only / 'taps'} cannot be written: "
+                                       f"{read_only / 'taps'} (Read-only file system).\n")
+    assert main(["plan", "--out", str(read_only / "plan")]) == 2
+    assert capsys.readouterr().err == (f"affordance: error: --out {read_only / 'plan'} cannot be written: "
+                                       f"{read_only / 'plan'} (Read-only file system).\n")
     assert main(["reproduce", "--behavior", "tap", "--episodes", "20", "--out", str(read_only / "repro")]) == 2
     assert capsys.readouterr().err == (f"affordance: error: --out {read_only / 'repro'} cannot be written: "
                                        f"{read_only / 'repro'} (Read-only file system).\n")
