@@ -14,9 +14,13 @@ import threading
 
 #: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as a shell reports it.
 INTERRUPTED = 130
-#: What Ctrl-C says, at whatever moment of a command it comes.
-INTERRUPTED_LINE = ("affordance: interrupted; what was finished is kept (the same command resumes a collection from "
-                    "its last finished chunk)")
+#: What Ctrl-C says, at whatever moment of a command it comes: that it stopped, and what the command leaves.
+INTERRUPTED_LINE = "affordance: interrupted"
+#: What a command that collects leaves when Ctrl-C stops it, and what one that does not leaves.
+INTERRUPTED_KEPT = "what was finished is kept (the same command resumes a collection from its last finished chunk)"
+INTERRUPTED_LEFT = {"export": "an unfinished export leaves no Minari dataset"}
+#: The commands that collect interactions into a dataset, which the same command resumes.
+COLLECTING = ("collect", "reproduce", "plan", "train-default")
 
 
 def _was_interrupted(exc: BaseException) -> bool:
@@ -31,8 +35,10 @@ def _was_interrupted(exc: BaseException) -> bool:
     return False
 
 
-def _say_interrupted() -> None:
-    print(INTERRUPTED_LINE, file=sys.stderr, flush=True)
+def _say_interrupted(command: str | None = None) -> None:
+    """The line of Ctrl-C, with what ``command`` leaves (before the command is known, nothing has been done)."""
+    left = INTERRUPTED_KEPT if command in COLLECTING else INTERRUPTED_LEFT.get(command or "")
+    print(INTERRUPTED_LINE + (f"; {left}" if left else ""), file=sys.stderr, flush=True)
 
 
 try:  # Ctrl-C while the command's own modules load is the same one line, not a traceback
@@ -497,8 +503,9 @@ def main(argv: list[str] | None = None) -> int:
     one line on stderr and exit status 2; a command-line mistake is
     found before any work starts (a value that cannot be used at all raises SystemExit(2) as it is parsed, the
     others are checked before the subcommand imports what it runs). Ctrl-C is one line and status 130 at any
-    moment, the imports of the command's modules included, and what was finished is kept (a dataset's chunks: the
-    same command resumes it). Anything else is a bug and keeps its traceback. Run as the command (``argv`` None),
+    moment, the imports of the command's modules included; the line says what the command leaves (a command that
+    collects keeps the dataset's finished chunks, and the same command resumes it). A warning is one line too
+    (``affordance: warning: ...``). Anything else is a bug and keeps its traceback. Run as the command (``argv`` None),
     a Ctrl-C after the command's work, as the process ends, is that line and status 130 too, or, once the
     interpreter tears its modules down, nothing: the process ends as it would have.
     """
@@ -507,26 +514,36 @@ def main(argv: list[str] | None = None) -> int:
         # no Python code of the command is left to run, and before the interpreter puts back the default handling
         # of SIGINT (an exit by the signal, without a word)
         atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
+    command = None
     try:
-        return _run(argv)
+        args = build_parser().parse_args(argv)
+        command = args.command
+        return _run(args)
     except BaseException as exc:
         if not _was_interrupted(exc):
             raise
-        _say_interrupted()
+        _say_interrupted(command)
         return INTERRUPTED
     finally:
         if argv is None:
-            _interrupt_ends_the_process()
+            _interrupt_ends_the_process(command)
 
 
-def _run(argv: list[str] | None) -> int:
-    args = build_parser().parse_args(argv)
+def _one_line_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                      file: object = None, line: str | None = None) -> None:
+    """``warnings.showwarning`` of the command: a warning is one line on stderr, as its notes and errors are, not
+    the source line that raised it."""
+    print(f"affordance: warning: {' '.join(str(message).split())}", file=sys.stderr, flush=True)
+
+
+def _run(args: argparse.Namespace) -> int:
     # joblib's resource tracker, a process of its own that inherits this environment, lists on Ctrl-C the
     # semaphores of the workers it stopped as it cleans them up: two warnings after the line below, not for people
     tracker = "ignore::UserWarning:joblib.externals.loky.backend.resource_tracker"
     if tracker not in os.environ.get("PYTHONWARNINGS", ""):
         os.environ["PYTHONWARNINGS"] = ",".join(w for w in (os.environ.get("PYTHONWARNINGS"), tracker) if w)
     with warnings.catch_warnings():
+        warnings.showwarning = _one_line_warning  # put back as the block ends
         # joblib's note, on Ctrl-C, that the chunks its workers held were cancelled: the line below says it
         warnings.filterwarnings("ignore", message=".*tasks which were still being processed by the workers",
                                 category=UserWarning)
@@ -539,14 +556,14 @@ def _run(argv: list[str] | None) -> int:
             return 2
 
 
-def _interrupt_ends_the_process() -> None:
-    """From now on Ctrl-C ends this process at once with the one line and status 130: the command's work is over
-    and only the interpreter's shutdown (its threads, its exit handlers) is left, where a KeyboardInterrupt would
-    be a traceback."""
+def _interrupt_ends_the_process(command: str | None) -> None:
+    """From now on Ctrl-C ends this process at once with the one line of ``command`` and status 130: the command's
+    work is over and only the interpreter's shutdown (its threads, its exit handlers) is left, where a
+    KeyboardInterrupt would be a traceback."""
     def stop(signum: int, frame: object) -> None:
         with contextlib.suppress(Exception):
             sys.stdout.flush()
-        _say_interrupted()
+        _say_interrupted(command)
         os._exit(INTERRUPTED)
 
     if (threading.current_thread() is threading.main_thread()

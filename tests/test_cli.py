@@ -89,6 +89,35 @@ def test_collect_command(tmp_path, capsys):
     assert "6 interactions" in capsys.readouterr().out
     assert main([*args[:5], "--seed", "9", *args[5:]]) == 2  # other settings: refused, not mixed in
     assert "other settings" in capsys.readouterr().err
+    damaged = out / "chunk-00001.parquet"
+    damaged.write_bytes(damaged.read_bytes()[:-100])
+    assert main(args) == 0  # the damaged chunk is collected again, and said so in one line, not a raw warning
+    said = [line for line in capsys.readouterr().err.splitlines() if not line.startswith("d: ")]  # no progress
+    assert len(said) == 1 and said[0].startswith("affordance: warning: collecting chunk-00001.parquet again: "), said
+
+
+@pytest.mark.parametrize(("argv", "line"), [
+    (["demo"], "affordance: interrupted"),
+    (["export", "taps", "--minari", "tap-affordance/taps-v0"],
+     "affordance: interrupted; an unfinished export leaves no Minari dataset"),
+    (["compare", "a", "b"], "affordance: interrupted"),
+    (["collect", "--episodes", "2", "--out", "taps"], "affordance: interrupted; what was finished is kept (the same "
+     "command resumes a collection from its last finished chunk)"),
+])
+def test_ctrl_c_says_what_the_command_leaves(argv, line, tmp_path, capsys, monkeypatch):
+    # export and demo once said that the same command resumes a collection, though they collect nothing
+    import affordance_env.collect_cli as collect_cli
+    import affordance_learning.cli as cli
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    for module, name in ((cli, "_demo"), (cli, "_compare"), (collect_cli, "run_export"),
+                         (collect_cli, "run_collect")):
+        monkeypatch.setattr(module, name, interrupted)
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 130
+    assert capsys.readouterr().err == line + "\n"
 
 
 def test_train_default_checks_the_behaviour_before_collecting(tmp_path, capsys, monkeypatch):
