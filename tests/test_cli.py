@@ -96,6 +96,18 @@ def test_collect_command(tmp_path, capsys):
     assert len(said) == 1 and said[0].startswith("affordance: warning: collecting chunk-00001.parquet again: "), said
 
 
+def test_an_unreachable_dask_scheduler_is_one_line_and_leaves_nothing(tmp_path, capsys):
+    pytest.importorskip("distributed")
+    import dask
+
+    out = tmp_path / "d"
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        assert main(["collect", "--episodes", "2", "--out", str(out), "--dask-address", "tcp://127.0.0.1:1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("affordance: error: ") and err.count("\n") == 1 and "tcp://127.0.0.1:1" in err, err
+    assert not out.exists()
+
+
 @pytest.mark.parametrize(("argv", "line"), [
     (["demo"], "affordance: interrupted"),
     (["export", "taps", "--minari", "tap-affordance/taps-v0"],

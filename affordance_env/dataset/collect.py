@@ -310,19 +310,20 @@ def collect(
     out, episodes = Path(out), int(episodes)
 
     stored = _stored_or_new(out, header, episodes)
-    out.mkdir(parents=True, exist_ok=True)
-    with _exclusive(out):
-        for stale in out.glob(".*.tmp"):  # left by a run that was killed while writing
-            stale.unlink(missing_ok=True)
-        ranges = chunk_ranges(episodes, chunk_size)
-        done = _chunks_done(out, ranges, header, stored)
-        write_manifest(out, header, episodes, done)
-        _check_failure_share(done, max_failure_share, out)
-        tasks = [(str(out), i, start, stop, header) for i, (start, stop) in enumerate(ranges) if i not in done]
-        if dask_address is None:  # a cluster of its own: processes of this machine
-            workers = _worker_count(workers, len(tasks), oversubscribe)
-        _collect_chunks(out, tasks, done, header, episodes, progress, max_failure_share,
-                        (scheduler, workers, dask_address))
+    with _dask_client(scheduler, dask_address) as client:  # the scheduler at dask_address answers: now write
+        out.mkdir(parents=True, exist_ok=True)
+        with _exclusive(out):
+            for stale in out.glob(".*.tmp"):  # left by a run that was killed while writing
+                stale.unlink(missing_ok=True)
+            ranges = chunk_ranges(episodes, chunk_size)
+            done = _chunks_done(out, ranges, header, stored)
+            write_manifest(out, header, episodes, done)
+            _check_failure_share(done, max_failure_share, out)
+            tasks = [(str(out), i, start, stop, header) for i, (start, stop) in enumerate(ranges) if i not in done]
+            if dask_address is None:  # a cluster of its own: processes of this machine
+                workers = _worker_count(workers, len(tasks), oversubscribe)
+            _collect_chunks(out, tasks, done, header, episodes, progress, max_failure_share,
+                            (scheduler, workers, client))
     return out
 
 
@@ -383,8 +384,9 @@ def _chunks_done(out: Path, ranges: list[tuple[int, int]], header: dict, stored:
 
 
 def _collect_chunks(out: Path, tasks: list, done: dict[int, ChunkResult], header: dict, episodes: int,
-                    progress: bool | None, max_failure_share: float, how: tuple[str, int, str | None]) -> None:
-    """Run the missing chunks' ``tasks`` (``how``: scheduler, workers, Dask address), recording each in ``done`` and
+                    progress: bool | None, max_failure_share: float, how: tuple[str, int, Any]) -> None:
+    """Run the missing chunks' ``tasks`` (``how``: scheduler, workers, the client of the Dask scheduler at
+    ``dask_address`` or None), recording each in ``done`` and
     the manifest as it comes, with a progress bar over all ``episodes``."""
     n_failed = sum(len(chunk.failures) for chunk in done.values())
     with progress_bar(progress, total=episodes, initial=sum(chunk.episodes for chunk in done.values()),
@@ -468,12 +470,13 @@ def _existing_chunk(path: Path, header: dict, start: int, stop: int, stored: dic
         return None
 
 
-def _run(tasks: list[tuple], scheduler: str, workers: int, address: str | None) -> Iterator[ChunkResult]:
-    """Run chunk tasks, yielding each chunk as it is written."""
+def _run(tasks: list[tuple], scheduler: str, workers: int, client: Any) -> Iterator[ChunkResult]:
+    """Run chunk tasks, yielding each chunk as it is written (``client``: of the Dask scheduler at ``dask_address``;
+    None for joblib or a local Dask cluster of ``workers`` processes)."""
     if not tasks:
         return
     if scheduler == "dask":
-        yield from _run_dask(tasks, workers, address)
+        yield from _run_dask(tasks, workers, client)
     elif workers == 1:
         for task in tasks:
             yield _collect_chunk(*task)
@@ -493,19 +496,43 @@ def _collect_chunk_in_worker(*task) -> ChunkResult:
     return _collect_chunk(*task)
 
 
-def _run_dask(tasks: list[tuple], workers: int, address: str | None) -> Iterator[tuple]:
+def _distributed():
+    """Dask distributed; MissingDependencyError (saying how to install it) without it."""
     try:
-        from distributed import Client, LocalCluster, as_completed
+        import distributed
     except ImportError as exc:
         raise MissingDependencyError("scheduler='dask' needs Dask distributed: pip install "
                                      "'tap-affordance[dask]'") from exc
+    return distributed
+
+
+@contextlib.contextmanager
+def _dask_client(scheduler: str, address: str | None) -> Iterator[Any]:
+    """With ``scheduler="dask"``, Dask distributed checked to be installed and, with ``address``, a client of the
+    scheduler there, connected (an OSError naming the address where none answers: Dask tries for its
+    ``distributed.comm.timeouts.connect``, 30 s by default); None otherwise. Entered before anything is written, so
+    that a scheduler that cannot be reached leaves nothing behind."""
+    if scheduler != "dask":
+        yield None
+        return
+    distributed = _distributed()
+    if address is None:
+        yield None
+        return
+    with distributed.Client(address) as client:
+        yield client
+
+
+def _run_dask(tasks: list[tuple], workers: int, client: Any) -> Iterator[tuple]:
+    """The chunks of ``tasks`` run by ``client``'s scheduler, or by a local cluster of ``workers`` processes
+    started now (``client`` None)."""
+    distributed = _distributed()
     with contextlib.ExitStack() as stack:
-        if address is None:
-            address = stack.enter_context(
-                LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
-            )
-        client = stack.enter_context(Client(address))
+        if client is None:
+            cluster = stack.enter_context(distributed.LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None))
+            client = stack.enter_context(distributed.Client(cluster))
         futures = [client.submit(_collect_chunk, *task, pure=False, retries=1) for task in tasks]
-        for future in as_completed(futures):
+        for future in distributed.as_completed(futures):
             yield future.result()
             future.release()
