@@ -387,10 +387,11 @@ def _collect_chunks(out: Path, tasks: list, done: dict[int, ChunkResult], header
                     progress: bool | None, max_failure_share: float, how: tuple[str, int, Any]) -> None:
     """Run the missing chunks' ``tasks`` (``how``: scheduler, workers, the client of the Dask scheduler at
     ``dask_address`` or None), recording each in ``done`` and
-    the manifest as it comes, with a progress bar over all ``episodes``."""
+    the manifest as it comes, with a progress bar over all ``episodes`` (goal episodes, or interactions)."""
     n_failed = sum(len(chunk.failures) for chunk in done.values())
+    unit = "episode" if is_goal_dataset(header) else "interaction"
     with progress_bar(progress, total=episodes, initial=sum(chunk.episodes for chunk in done.values()),
-                      unit="interaction", desc=out.name, smoothing=0.05) as bar:
+                      unit=unit, desc=out.name, smoothing=0.05) as bar:
         bar.set_postfix(failed=n_failed, refresh=False)
         for chunk in _run(tasks, *how):
             if not (out / chunk_name(chunk.index)).exists():
