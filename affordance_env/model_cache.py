@@ -14,7 +14,8 @@ cache keeps the compiled model of each robot variant in a file named by a hash o
 
 Any change to any of these gives another name, so a cached model is always the one that compiling would give
 (``tests/test_model_cache.py`` checks byte for byte). A file that cannot be read is compiled again and replaced;
-a directory that cannot be written to only means compiling every time.
+a directory that cannot be written to only means compiling every time, which a warning naming it says once per
+process.
 
 The directory is ``$TAP_AFFORDANCE_CACHE``, else ``$XDG_CACHE_HOME/tap-affordance``, else
 ``~/.cache/tap-affordance``; ``TAP_AFFORDANCE_CACHE=off`` turns the cache off. A model takes 45-55 MB. The cache
@@ -30,6 +31,7 @@ import hashlib
 import os
 import re
 import time
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -107,9 +109,21 @@ def cached_model(variant: str, urdfs: tuple[str, ...], compile_model: Callable[[
     model = compile_model()
     try:
         _store(model, path)
-    except OSError:  # read-only or full: the cache only saves time
-        pass
+    except OSError as exc:  # read-only or full: the cache only saves time
+        _warn_unwritable(directory, exc)
     return model
+
+
+#: The cache directories this process was told it cannot write, each said once.
+_unwritable: set[Path] = set()
+
+
+def _warn_unwritable(directory: Path, exc: OSError) -> None:
+    if directory in _unwritable:
+        return
+    _unwritable.add(directory)
+    warnings.warn(f"the model cache {directory} cannot be written ({exc.strerror or exc}): each new process compiles "
+                  f"the scene again; set {CACHE_ENV} to a directory that can be written, or to off", stacklevel=3)
 
 
 def _store(model: mujoco.MjModel, path: Path) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import warnings
 
 import mujoco
 import numpy as np
@@ -122,7 +123,12 @@ def test_without_a_usable_cache_the_model_is_compiled(tmp_path, monkeypatch, com
     blocker = tmp_path / "a-file"  # the cache directory cannot be made: a file is in the way
     blocker.write_text("")
     monkeypatch.setenv(model_cache.CACHE_ENV, str(blocker / "cache"))
-    assert _bytes(scene.build_model("tap")) == compiled
+    monkeypatch.setattr(model_cache, "_unwritable", set(), raising=False)  # what this process was told
+    with pytest.warns(UserWarning, match=f"the model cache {blocker / 'cache'} cannot be written"):
+        assert _bytes(scene.build_model("tap")) == compiled
+    with warnings.catch_warnings():  # said once per process, not at every env
+        warnings.simplefilter("error")
+        assert _bytes(scene.build_model("tap")) == compiled
 
 
 def test_the_default_directory_follows_xdg(tmp_path, monkeypatch):
