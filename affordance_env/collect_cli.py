@@ -211,6 +211,8 @@ def check_collect_args(args: argparse.Namespace) -> None:
             message = message.replace(f"{name} must", f"{flag} must")
         raise InvalidValueError(message) from None
     out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise InvalidValueError(f"--out {out} is a file, not a dataset directory.")
     if out.is_dir():
         from affordance_env.dataset.format import MANIFEST
 
