@@ -322,6 +322,10 @@ def collect(
             tasks = [(str(out), i, start, stop, header) for i, (start, stop) in enumerate(ranges) if i not in done]
             if dask_address is None:  # a cluster of its own: processes of this machine
                 workers = _worker_count(workers, len(tasks), oversubscribe)
+                if tasks and (workers > 1 or scheduler == "dask"):
+                    from affordance_env.model_cache import check_cache
+
+                    check_cache()  # a cache that cannot be written is said here, not by every worker
             _collect_chunks(out, tasks, done, header, episodes, progress, max_failure_share,
                             (scheduler, workers, client))
     return out
