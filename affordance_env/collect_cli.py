@@ -190,9 +190,9 @@ def env_options_from_args(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def check_collect_args(args: argparse.Namespace) -> None:
-    """What the options of ``affordance collect`` say together, and its ``--out``, checked without the simulator
-    and before anything is built or written: ValueError naming the options. (Each value alone is checked as it is
-    parsed.)"""
+    """What the options of ``affordance collect`` say together, and its ``--out`` (a dataset or a new directory,
+    which can be written: :func:`check_writable`), checked without the simulator and before anything is built or
+    written: ValueError naming the options. (Each value alone is checked as it is parsed.)"""
 
     if args.scheduler == "joblib" and args.dask_address is not None:
         raise InvalidValueError("--dask-address runs on Dask: drop --scheduler joblib (or use --scheduler dask).")

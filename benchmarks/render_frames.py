@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from typing import Any
 
 import gymnasium as gym
 import numpy as np
@@ -49,7 +50,7 @@ def _timed(call) -> tuple[float, float]:
 def _time(n: int, width: int, height: int) -> None:
     from affordance_env.rendering import choose_gl_backend
 
-    size = {"render_width": width, "render_height": height}
+    size: dict[str, Any] = {"render_width": width, "render_height": height}
     env = gym.make(ENV_ID, render_mode="rgb_array", **size)
     env.reset(seed=0)
     first, _ = _timed(env.render)
@@ -70,7 +71,9 @@ def _time(n: int, width: int, height: int) -> None:
             costs[mode].append(_timed(lambda env=env, seed=seed: (env.reset(seed=seed),
                                                                   env.step(np.zeros(3, np.float32)))))
             if mode == "rgb_array_list":
-                frames.append(len(env.render()))
+                pictures_of_it = env.render()
+                assert isinstance(pictures_of_it, list)
+                frames.append(len(pictures_of_it))
     for env in envs.values():
         env.close()
     (plain_wall, plain_cpu), (listed_wall, listed_cpu) = (np.median(costs[mode], axis=0) for mode in envs)

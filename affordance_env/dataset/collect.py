@@ -280,7 +280,9 @@ def collect(
         scheduler: ``"joblib"`` (processes on this machine) or ``"dask"`` (Dask distributed: the cluster at
             ``dask_address``, or a local cluster of ``workers`` processes).
         dask_address: A Dask scheduler (``"tcp://host:8786"``); implies ``scheduler="dask"``. Its workers need
-            the same tap-affordance version and must see ``out`` (a shared file system).
+            the same tap-affordance version and must see ``out`` (a shared file system). It is connected to before
+            anything is written: where none answers (OSError naming it, after Dask's connect timeout, 30 s by
+            default), nothing is left behind.
         save_images: Also store the initial and final range images (float16) and object masks (bit-packed),
             zstd-compressed; read them with ``load_dataset(out, with_images=True)`` and :func:`images`.
         max_failure_share: Stop with :class:`FailureShareError` once more than this share of the interactions
@@ -528,7 +530,7 @@ def _dask_client(scheduler: str, address: str | None) -> Iterator[Any]:
         yield client
 
 
-def _run_dask(tasks: list[tuple], workers: int, client: Any) -> Iterator[tuple]:
+def _run_dask(tasks: list[tuple], workers: int, client: Any) -> Iterator[ChunkResult]:
     """The chunks of ``tasks`` run by ``client``'s scheduler, or by a local cluster of ``workers`` processes
     started now (``client`` None)."""
     distributed = _distributed()
