@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import math
+import os
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -76,6 +78,34 @@ dask_address.__name__ = "Dask scheduler address"
 
 #: A share, as of failed interactions: 0 to 1.
 share = real_within(0.0, 1.0, expected="a share in [0, 1]")
+
+
+def check_writable(path: Path, what: str, *, directory: bool = True) -> None:
+    """Refuse, before any work, a path that a command cannot write: a ``directory`` to make or write into, or (not
+    ``directory``) a file to write, whose folder must be one. InvalidValueError whose message starts with ``what``,
+    the option and the path given (``--out taps``). What the check makes (folders, a probe file) is removed again."""
+    if not directory and path.is_dir():
+        raise InvalidValueError(f"{what} is a directory, not a file.")
+    folder = path if directory else path.parent
+    blocker = next((p for p in (folder, *folder.parents) if p.exists() and not p.is_dir()), None)
+    if blocker == path:
+        raise InvalidValueError(f"{what} is a file, not a directory.")
+    if blocker is not None:
+        raise InvalidValueError(f"{what} cannot be written: {blocker} is a file, not a directory.")
+    missing = [d for d in (folder, *folder.parents) if not d.exists()]
+    probe = folder / f".affordance-write-test-{os.getpid()}"
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        with open(probe, "w"):
+            pass
+    except OSError as exc:
+        raise InvalidValueError(f"{what} cannot be written: {folder} ({exc.strerror}).") from None
+    finally:
+        with contextlib.suppress(OSError):
+            probe.unlink(missing_ok=True)
+        for made in missing:  # deepest first: only what the check made, and only if still empty
+            with contextlib.suppress(OSError):
+                made.rmdir()
 
 
 def add_collect_parser(subparsers: argparse._SubParsersAction) -> argparse.ArgumentParser:
@@ -160,9 +190,9 @@ def env_options_from_args(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def check_collect_args(args: argparse.Namespace) -> None:
-    """What the options of ``affordance collect`` say together, and its ``--out``, checked without the simulator
-    and before anything is built or written: ValueError naming the options. (Each value alone is checked as it is
-    parsed.)"""
+    """What the options of ``affordance collect`` say together, and its ``--out`` (a dataset or a new directory,
+    which can be written: :func:`check_writable`), checked without the simulator and before anything is built or
+    written: ValueError naming the options. (Each value alone is checked as it is parsed.)"""
 
     if args.scheduler == "joblib" and args.dask_address is not None:
         raise InvalidValueError("--dask-address runs on Dask: drop --scheduler joblib (or use --scheduler dask).")
@@ -189,6 +219,7 @@ def check_collect_args(args: argparse.Namespace) -> None:
         if not (out / MANIFEST).exists() and any(p.name != ".lock" for p in out.iterdir()):
             raise InvalidValueError(f"--out {out} exists and is not a TapAffordance dataset (no {MANIFEST}): choose an "
                              "empty or new directory, or a dataset to resume or extend.")
+    check_writable(out, f"--out {out}")
 
 
 def run_collect(args: argparse.Namespace) -> int:

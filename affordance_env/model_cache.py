@@ -14,7 +14,9 @@ cache keeps the compiled model of each robot variant in a file named by a hash o
 
 Any change to any of these gives another name, so a cached model is always the one that compiling would give
 (``tests/test_model_cache.py`` checks byte for byte). A file that cannot be read is compiled again and replaced;
-a directory that cannot be written to only means compiling every time.
+a directory that cannot be written to only means compiling every time: a warning names it once, and the cache is
+turned off for the rest of the process and the processes it starts (:func:`check_cache`, which a process calls
+before it starts workers, so that they do not each say it again).
 
 The directory is ``$TAP_AFFORDANCE_CACHE``, else ``$XDG_CACHE_HOME/tap-affordance``, else
 ``~/.cache/tap-affordance``; ``TAP_AFFORDANCE_CACHE=off`` turns the cache off. A model takes 45-55 MB. The cache
@@ -30,6 +32,7 @@ import hashlib
 import os
 import re
 import time
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -107,9 +110,39 @@ def cached_model(variant: str, urdfs: tuple[str, ...], compile_model: Callable[[
     model = compile_model()
     try:
         _store(model, path)
-    except OSError:  # read-only or full: the cache only saves time
-        pass
+    except OSError as exc:  # read-only or full: the cache only saves time
+        _turn_off(directory, exc)
     return model
+
+
+def check_cache() -> Path | None:
+    """The cache directory if a model can be written there (it is made if missing); else None, after a warning
+    that names it and with the cache turned off for this process and the ones it starts from now on. A process
+    calls it before starting workers that build environments: they inherit the setting, and compile without
+    trying the cache or saying so again."""
+    directory = cache_dir()
+    if directory is None:
+        return None
+    probe = directory / f".write-test-{os.getpid()}.tmp"
+    try:
+        directory.mkdir(parents=True, exist_ok=True)
+        probe.write_bytes(b"")
+    except OSError as exc:
+        _turn_off(directory, exc)
+        return None
+    finally:
+        with contextlib.suppress(OSError):
+            probe.unlink(missing_ok=True)
+    return directory
+
+
+def _turn_off(directory: Path, exc: OSError) -> None:
+    """Say that ``directory`` cannot be written, and set :data:`CACHE_ENV` to ``off`` in this process's
+    environment: its later envs, and the processes it starts, compile without trying the cache again."""
+    os.environ[CACHE_ENV] = "off"
+    warnings.warn(f"the model cache {directory} cannot be written ({exc.strerror or exc}): it is off for this "
+                  "process and the ones it starts, which compile the scene instead; set "
+                  f"{CACHE_ENV} to a directory that can be written, or to off", stacklevel=3)
 
 
 def _store(model: mujoco.MjModel, path: Path) -> None:

@@ -60,11 +60,15 @@ def _call(function: Callable[..., Any], item: Any) -> Any:
 
 def map_in_processes(function: Callable[..., Any], items: Iterable[Any], workers: int, **shared: Any) -> list[Any]:
     """``[function(item, **shared) for item in items]`` on ``workers`` new processes (in this one for a single worker
-    or item). The processes are started for this call ("spawn": nothing of this process's state but ``shared``
-    reaches them) and end with it."""
+    or item). The processes are started for this call ("spawn": nothing of this process's state but ``shared`` and
+    its environment variables reaches them; the cache of compiled models is checked first,
+    :func:`~affordance_env.model_cache.check_cache`) and end with it."""
     items = list(items)
     if workers == 1 or len(items) <= 1:
         return [function(item, **shared) for item in items]
+    from affordance_env.model_cache import check_cache
+
+    check_cache()  # a cache of compiled models that cannot be written is said here, not by every process
     context = multiprocessing.get_context("spawn")
     with ProcessPoolExecutor(max_workers=min(workers, len(items)), mp_context=context, initializer=_keep,
                              initargs=(shared,)) as pool:

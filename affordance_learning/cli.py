@@ -14,9 +14,13 @@ import threading
 
 #: Exit status of a run stopped by Ctrl-C (128 + SIGINT), as a shell reports it.
 INTERRUPTED = 130
-#: What Ctrl-C says, at whatever moment of a command it comes.
-INTERRUPTED_LINE = ("affordance: interrupted; what was finished is kept (the same command resumes a collection from "
-                    "its last finished chunk)")
+#: What Ctrl-C says, at whatever moment of a command it comes: that it stopped, and what the command leaves.
+INTERRUPTED_LINE = "affordance: interrupted"
+#: What a command that collects leaves when Ctrl-C stops it, and what one that does not leaves.
+INTERRUPTED_KEPT = "what was finished is kept (the same command resumes a collection from its last finished chunk)"
+INTERRUPTED_LEFT = {"export": "an unfinished export leaves no Minari dataset"}
+#: The commands that collect interactions into a dataset, which the same command resumes.
+COLLECTING = ("collect", "reproduce", "plan", "train-default")
 
 
 def _was_interrupted(exc: BaseException) -> bool:
@@ -31,8 +35,10 @@ def _was_interrupted(exc: BaseException) -> bool:
     return False
 
 
-def _say_interrupted() -> None:
-    print(INTERRUPTED_LINE, file=sys.stderr, flush=True)
+def _say_interrupted(command: str | None = None) -> None:
+    """The line of Ctrl-C, with what ``command`` leaves (before the command is known, nothing has been done)."""
+    left = INTERRUPTED_KEPT if command in COLLECTING else INTERRUPTED_LEFT.get(command or "")
+    print(INTERRUPTED_LINE + (f"; {left}" if left else ""), file=sys.stderr, flush=True)
 
 
 try:  # Ctrl-C while the command's own modules load is the same one line, not a traceback
@@ -47,6 +53,7 @@ try:  # Ctrl-C while the command's own modules load is the same one line, not a 
     from affordance_env.collect_cli import (
         add_collect_parser,
         add_export_parser,
+        check_writable,
         int_at_least,
         non_negative_int,
         positive_int,
@@ -148,30 +155,10 @@ def _datasets(items: list[str], behaviors: list[str]) -> dict[str, Path]:
     return datasets
 
 
-def _check_writable_directory(directory: Path, what: str) -> None:
-    """Refuse, before any work, a directory that cannot be made or written into (``what`` names it: the option and
-    the path given); what the check makes (the directory, a probe file) is removed again."""
-    if directory.exists() and not directory.is_dir():
-        raise InvalidValueError(f"{what} is a file, not a directory.")
-    missing = [d for d in (directory, *directory.parents) if not d.exists()]
-    probe = directory / f".affordance-write-test-{os.getpid()}"
-    try:
-        directory.mkdir(parents=True, exist_ok=True)
-        with open(probe, "w"):
-            pass
-    except OSError as exc:
-        raise InvalidValueError(f"{what} cannot be written: {directory} ({exc.strerror}).") from None
-    finally:
-        probe.unlink(missing_ok=True)
-        for made in missing:  # deepest first: only what the check made, and only if still empty
-            with contextlib.suppress(OSError):
-                made.rmdir()
-
-
 def _reproduce(args: argparse.Namespace) -> int:
+    check_writable(args.out, f"--out {args.out}")
     from affordance_learning.paper.reproduce import DEFAULT_BEHAVIORS, reproduce
 
-    _check_writable_directory(args.out, f"--out {args.out}")
     behaviors = args.behavior or list(DEFAULT_BEHAVIORS)
     reproduce(args.out, behaviors=behaviors, episodes=args.episodes, trials=args.trials, seed=args.seed,
               workers=args.workers, datasets=_datasets(args.dataset, behaviors), range_noise=args.range_noise,
@@ -183,13 +170,16 @@ def _train_action_models(args: argparse.Namespace) -> int:
     """``affordance train-default --action-conditioned``: goal episodes with random actions (collected into
     ``--dataset`` or reused from there) until every behaviour has 1000 interactions, then an action-conditioned
     model per behaviour."""
-    from affordance_learning.default_model import ACTION_INTERACTIONS, DATA_ENV, train_action_models, user_model_dir
-    from affordance_learning.planning.experiment import PlanSettings, collect_training
+    from affordance_learning.user_models import DATA_ENV, user_model_dir
 
     dataset = args.dataset or Path("default-actions")
     out = args.out or user_model_dir()
-    _check_writable_directory(out, f"--out {out}" if args.out else f"the models' directory {out} (set it with --out "
-                              f"or ${DATA_ENV})")
+    check_writable(out, f"--out {out}" if args.out else f"the models' directory {out} (set it with --out or "
+                   f"${DATA_ENV})")
+    check_writable(dataset, f"--dataset {dataset}")
+    from affordance_learning.default_model import ACTION_INTERACTIONS, train_action_models
+    from affordance_learning.planning.experiment import PlanSettings, collect_training
+
     settings = PlanSettings(max_per_behavior=ACTION_INTERACTIONS)
     frame = collect_training(dataset, settings, seed=0, workers=args.workers, camera=(160, 120))
     written = train_action_models(frame, out)
@@ -202,23 +192,27 @@ def _train_default(args: argparse.Namespace) -> int:
     if args.action_conditioned:
         return _train_action_models(args)
     from affordance_learning.common.behaviors import check_behavior, check_env_offers
+    from affordance_learning.user_models import DATA_ENV, user_model_path
 
     behavior = check_behavior(args.behavior)
-    from affordance_env.dataset import MANIFEST, collect, load_dataset, read_manifest
-    from affordance_learning.default_model import DATA_ENV, train_default_model, user_model_path
-
     dataset = args.dataset or Path("default-taps" if behavior == "tap" else f"default-{behavior}")
     out = args.out or user_model_path(behavior)
     what = f"--out {out}" if args.out else f"the model's place {out} (set it with --out or ${DATA_ENV})"
     if out.is_dir():
         raise InvalidValueError(f"{what} is a directory, not a model file.")
-    _check_writable_directory(out.parent, what)
+    check_writable(out, what, directory=False)
+    check_writable(dataset, f"--dataset {dataset}")
+    from affordance_env.dataset.format import MANIFEST, read_manifest
+
     if (dataset / MANIFEST).exists():  # say so plainly, before the collection refuses its other settings
         found = read_manifest(dataset)["settings"].get("env_options", {}).get("behavior", "tap")
         if found != behavior:
             raise InvalidValueError(f"{dataset} holds {found!r} interactions, not {behavior!r} ones: give --dataset a "
                              f"dataset of {behavior} interactions, or a new directory to collect them into.")
     check_env_offers([behavior])
+    from affordance_env.dataset import collect, load_dataset
+    from affordance_learning.default_model import train_default_model
+
     collect(dataset, 1000, seed=0, workers=args.workers, env_options={"behavior": behavior})
     model = train_default_model(load_dataset(dataset), out, behavior=behavior)
     print(f"default {behavior} model ({model.n_clusters} categories, {len(model.selected_features_)} features "
@@ -292,10 +286,9 @@ def _dataset_kind(manifest: object) -> str:
 def _check_plan_out(out: Path, seed: int) -> None:
     """Refuse an ``--out`` of ``affordance plan`` that holds anything but an earlier plan's output (its dataset is
     resumed, its results rewritten), before anything is written."""
+    check_writable(out, f"--out {out}")
     if not out.exists():
         return
-    if not out.is_dir():
-        raise InvalidValueError(f"--out {out} is a file, not a directory.")
     from affordance_env.dataset.format import GOAL_ENV_ID, MANIFEST
 
     hint = (f"affordance plan writes its goal episodes into OUT/{PLAN_DATASET} and results.json, REPORT.md and "
@@ -510,8 +503,9 @@ def main(argv: list[str] | None = None) -> int:
     one line on stderr and exit status 2; a command-line mistake is
     found before any work starts (a value that cannot be used at all raises SystemExit(2) as it is parsed, the
     others are checked before the subcommand imports what it runs). Ctrl-C is one line and status 130 at any
-    moment, the imports of the command's modules included, and what was finished is kept (a dataset's chunks: the
-    same command resumes it). Anything else is a bug and keeps its traceback. Run as the command (``argv`` None),
+    moment, the imports of the command's modules included; the line says what the command leaves (a command that
+    collects keeps the dataset's finished chunks, and the same command resumes it). A warning is one line too
+    (``affordance: warning: ...``). Anything else is a bug and keeps its traceback. Run as the command (``argv`` None),
     a Ctrl-C after the command's work, as the process ends, is that line and status 130 too, or, once the
     interpreter tears its modules down, nothing: the process ends as it would have.
     """
@@ -520,26 +514,36 @@ def main(argv: list[str] | None = None) -> int:
         # no Python code of the command is left to run, and before the interpreter puts back the default handling
         # of SIGINT (an exit by the signal, without a word)
         atexit.register(signal.signal, signal.SIGINT, signal.SIG_IGN)
+    command = None
     try:
-        return _run(argv)
+        args = build_parser().parse_args(argv)
+        command = args.command
+        return _run(args)
     except BaseException as exc:
         if not _was_interrupted(exc):
             raise
-        _say_interrupted()
+        _say_interrupted(command)
         return INTERRUPTED
     finally:
         if argv is None:
-            _interrupt_ends_the_process()
+            _interrupt_ends_the_process(command)
 
 
-def _run(argv: list[str] | None) -> int:
-    args = build_parser().parse_args(argv)
+def _one_line_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                      file: object = None, line: str | None = None) -> None:
+    """``warnings.showwarning`` of the command: a warning is one line on stderr, as its notes and errors are, not
+    the source line that raised it."""
+    print(f"affordance: warning: {' '.join(str(message).split())}", file=sys.stderr, flush=True)
+
+
+def _run(args: argparse.Namespace) -> int:
     # joblib's resource tracker, a process of its own that inherits this environment, lists on Ctrl-C the
     # semaphores of the workers it stopped as it cleans them up: two warnings after the line below, not for people
     tracker = "ignore::UserWarning:joblib.externals.loky.backend.resource_tracker"
     if tracker not in os.environ.get("PYTHONWARNINGS", ""):
         os.environ["PYTHONWARNINGS"] = ",".join(w for w in (os.environ.get("PYTHONWARNINGS"), tracker) if w)
     with warnings.catch_warnings():
+        warnings.showwarning = _one_line_warning  # put back as the block ends
         # joblib's note, on Ctrl-C, that the chunks its workers held were cancelled: the line below says it
         warnings.filterwarnings("ignore", message=".*tasks which were still being processed by the workers",
                                 category=UserWarning)
@@ -552,14 +556,14 @@ def _run(argv: list[str] | None) -> int:
             return 2
 
 
-def _interrupt_ends_the_process() -> None:
-    """From now on Ctrl-C ends this process at once with the one line and status 130: the command's work is over
-    and only the interpreter's shutdown (its threads, its exit handlers) is left, where a KeyboardInterrupt would
-    be a traceback."""
+def _interrupt_ends_the_process(command: str | None) -> None:
+    """From now on Ctrl-C ends this process at once with the one line of ``command`` and status 130: the command's
+    work is over and only the interpreter's shutdown (its threads, its exit handlers) is left, where a
+    KeyboardInterrupt would be a traceback."""
     def stop(signum: int, frame: object) -> None:
         with contextlib.suppress(Exception):
             sys.stdout.flush()
-        _say_interrupted()
+        _say_interrupted(command)
         os._exit(INTERRUPTED)
 
     if (threading.current_thread() is threading.main_thread()

@@ -49,13 +49,12 @@ from affordance_learning.common.validation import check_float32_range, first_non
 from affordance_learning.paper.model import AffordanceModel, EffectPrediction
 from affordance_learning.planning.effect_model import ActionEffectModel, behavior_model
 from affordance_learning.planning.outcomes import model_inputs, outcome_table
+from affordance_learning.user_models import DATA_ENV, user_model_dir, user_model_path  # noqa: F401 (re-exported)
 
 #: Where the package's own default models are, one file per behaviour (read only).
 MODEL_DIR = Path(__file__).resolve().parent / "data"
 #: The package's default tap model.
 DEFAULT_MODEL_PATH = MODEL_DIR / "tap_model.joblib"
-#: Environment variable naming the user's data directory, where rebuilt default models go.
-DATA_ENV = "TAP_AFFORDANCE_DATA"
 #: Map size and relevancy threshold of the default model.
 DEFAULT_N_CLUSTERS = 4
 DEFAULT_RELEVANCY = 0.4
@@ -71,21 +70,6 @@ FORMAT = 3
 #: The command that rebuilds the default tap model (see :func:`rebuild_command` for the others).
 REBUILD_COMMAND = "affordance train-default"
 _N_FEATURES = 49
-
-
-def user_model_dir() -> Path:
-    """The user's directory of default models: ``$TAP_AFFORDANCE_DATA``, else ``$XDG_DATA_HOME/tap-affordance``,
-    else ``~/.local/share/tap-affordance`` (the XDG convention for a user's application data)."""
-    setting = os.environ.get(DATA_ENV)
-    if setting:
-        return Path(setting).expanduser()
-    base = os.environ.get("XDG_DATA_HOME") or Path.home() / ".local" / "share"
-    return Path(base) / "tap-affordance"
-
-
-def user_model_path(behavior: str = "tap") -> Path:
-    """Where ``affordance train-default`` stores the default model of ``behavior`` (:func:`user_model_dir`)."""
-    return user_model_dir() / f"{check_behavior(behavior)}_model.joblib"
 
 
 def model_path(behavior: str = "tap") -> Path:

@@ -10,12 +10,23 @@ and one step here is a whole interaction, so it would keep one picture of it: co
 from __future__ import annotations
 
 import argparse
+import sys
 
-import gymnasium as gym
-import imageio.v3 as iio
-import numpy as np
+#: What writing the video needs, beyond the package itself.
+INSTALL = 'pip install "tap-affordance[examples]"'
 
-import affordance_env  # noqa: F401  (registers TapAffordance-v2)
+
+def _video_writer():
+    """imageio's v3 API, with its ffmpeg plugin; without them, one line naming the install and exit status 2, before
+    anything is rendered."""
+    try:
+        import imageio.v3 as iio
+        import imageio_ffmpeg  # noqa: F401  (the mp4 writer imageio uses)
+    except ImportError as exc:
+        print(f"tap_video.py: error: writing the video needs imageio with ffmpeg ({exc.name} is missing): "
+              f"{INSTALL}", file=sys.stderr)
+        raise SystemExit(2) from None
+    return iio
 
 
 def main() -> None:
@@ -25,6 +36,11 @@ def main() -> None:
     parser.add_argument("--action", type=float, nargs=3, default=(0.0, 0.0, 0.0), metavar=("HEIGHT", "OFFSET", "SPEED"))
     parser.add_argument("--out", default="taps.mp4")
     args = parser.parse_args()
+    iio = _video_writer()
+    import gymnasium as gym
+    import numpy as np
+
+    import affordance_env  # noqa: F401  (registers TapAffordance-v2)
 
     env = gym.make("TapAffordance-v2", render_mode="rgb_array_list", render_width=640, render_height=480)
     frames = []

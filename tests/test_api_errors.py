@@ -245,6 +245,7 @@ def test_a_fingerprint_file_that_is_not_a_fingerprint_is_refused_before_any_coll
 
     from affordance_learning.paper.reproduce import check_fingerprint
 
+    (tmp_path / "results.json").write_text(json.dumps({"config": {"behavior": "tap", "seed": 0}}))
     (tmp_path / "fingerprint.json").write_text(json.dumps([1, 2]))
     with pytest.raises(ValueError, match="fingerprint.json is not a fingerprint"):
         check_fingerprint(tmp_path)

@@ -89,6 +89,47 @@ def test_collect_command(tmp_path, capsys):
     assert "6 interactions" in capsys.readouterr().out
     assert main([*args[:5], "--seed", "9", *args[5:]]) == 2  # other settings: refused, not mixed in
     assert "other settings" in capsys.readouterr().err
+    damaged = out / "chunk-00001.parquet"
+    damaged.write_bytes(damaged.read_bytes()[:-100])
+    assert main(args) == 0  # the damaged chunk is collected again, and said so in one line, not a raw warning
+    said = [line for line in capsys.readouterr().err.splitlines() if not line.startswith("d: ")]  # no progress
+    assert len(said) == 1 and said[0].startswith("affordance: warning: collecting chunk-00001.parquet again: "), said
+
+
+def test_an_unreachable_dask_scheduler_is_one_line_and_leaves_nothing(tmp_path, capsys):
+    pytest.importorskip("distributed")
+    import dask
+
+    out = tmp_path / "d"
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        assert main(["collect", "--episodes", "2", "--out", str(out), "--dask-address", "tcp://127.0.0.1:1"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("affordance: error: ") and err.count("\n") == 1 and "tcp://127.0.0.1:1" in err, err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(("argv", "line"), [
+    (["demo"], "affordance: interrupted"),
+    (["export", "taps", "--minari", "tap-affordance/taps-v0"],
+     "affordance: interrupted; an unfinished export leaves no Minari dataset"),
+    (["compare", "a", "b"], "affordance: interrupted"),
+    (["collect", "--episodes", "2", "--out", "taps"], "affordance: interrupted; what was finished is kept (the same "
+     "command resumes a collection from its last finished chunk)"),
+])
+def test_ctrl_c_says_what_the_command_leaves(argv, line, tmp_path, capsys, monkeypatch):
+    # export and demo once said that the same command resumes a collection, though they collect nothing
+    import affordance_env.collect_cli as collect_cli
+    import affordance_learning.cli as cli
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    for module, name in ((cli, "_demo"), (cli, "_compare"), (collect_cli, "run_export"),
+                         (collect_cli, "run_collect")):
+        monkeypatch.setattr(module, name, interrupted)
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 130
+    assert capsys.readouterr().err == line + "\n"
 
 
 def test_train_default_checks_the_behaviour_before_collecting(tmp_path, capsys, monkeypatch):
@@ -145,12 +186,22 @@ def test_paths_that_cannot_be_used_are_one_line_errors(tmp_path, capsys, monkeyp
     a_file = tmp_path / "notes.txt"
     a_file.write_text("mine")
     small = ["--camera-width", "32", "--camera-height", "32"]
-    assert main(["collect", "--episodes", "2", "--out", str(a_file / "taps"), *small]) == 2
-    assert capsys.readouterr().err == f"affordance: error: {a_file / 'taps'}: Not a directory\n"
+    # each names the option whose path it is
+    for command in (["collect", "--episodes", "2"], ["plan"], ["reproduce"]):
+        assert main([*command, "--out", str(a_file / "taps"), *(small if command[0] == "collect" else [])]) == 2
+        assert capsys.readouterr().err == (f"affordance: error: --out {a_file / 'taps'} cannot be written: {a_file} "
+                                           "is a file, not a directory.\n")
+    assert main(["train-default", "--out", str(a_file / "m.joblib")]) == 2
+    assert capsys.readouterr().err == (f"affordance: error: --out {a_file / 'm.joblib'} cannot be written: {a_file} "
+                                       "is a file, not a directory.\n")
     read_only = tmp_path / "read-only"
     _read_only(monkeypatch, read_only)
     assert main(["collect", "--episodes", "2", "--out", str(read_only / "taps"), *small]) == 2
-    assert capsys.readouterr().err == f"affordance: error: {read_only / 'taps'}: Read-only file system\n"
+    assert capsys.readouterr().err == (f"affordance: error: --out {read_only / 'taps'} cannot be written: "
+                                       f"{read_only / 'taps'} (Read-only file system).\n")
+    assert main(["plan", "--out", str(read_only / "plan")]) == 2
+    assert capsys.readouterr().err == (f"affordance: error: --out {read_only / 'plan'} cannot be written: "
+                                       f"{read_only / 'plan'} (Read-only file system).\n")
     assert main(["reproduce", "--behavior", "tap", "--episodes", "20", "--out", str(read_only / "repro")]) == 2
     assert capsys.readouterr().err == (f"affordance: error: --out {read_only / 'repro'} cannot be written: "
                                        f"{read_only / 'repro'} (Read-only file system).\n")

@@ -262,10 +262,16 @@ def test_the_id_is_checked_without_minari(monkeypatch):
 def test_a_command_line_mistake_imports_neither_the_simulator_nor_what_the_command_runs(tmp_path):
     collected = tmp_path / "taps"
     _manifest(collected)
+    a_file = tmp_path / "notes.txt"
+    a_file.write_text("mine")
     mistakes = [["plan", "--out", str(tmp_path / "p"), "--objects", "-2"], ["demo", "--episodes", "-1"],
                 ["demo", "--object", "cube"], ["plan", "--out", str(collected)],
                 ["collect", "--out", str(tmp_path / "c"), "--episodes", "3", "--size-range", "0.1", "0.05"],
-                ["export", str(collected), "--minari", "a/b-v0"]]
+                ["export", str(collected), "--minari", "a/b-v0"],
+                # a path that cannot be written, refused before the command's modules load
+                ["plan", "--out", str(a_file / "p")], ["train-default", "--out", str(a_file / "m.joblib")],
+                ["train-default", "--action-conditioned", "--out", str(a_file / "models")],
+                ["reproduce", "--out", str(a_file / "r")], ["collect", "--out", str(a_file / "c"), "--episodes", "3"]]
     # an import of one of these ends the process with status 3, naming it
     code = f"""
 import importlib.abc, os, sys

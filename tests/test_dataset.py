@@ -615,8 +615,9 @@ def test_worker_processes_are_at_most_the_chunks_and_the_cores(tmp_path, monkeyp
 
     module = importlib.import_module("affordance_env.dataset.collect")
     started = []
-    monkeypatch.setattr(module, "_run", lambda tasks, scheduler, workers, address: started.append(
+    monkeypatch.setattr(module, "_run", lambda tasks, scheduler, workers, client: started.append(
         (scheduler, workers)) or iter(()))
+    monkeypatch.setattr(module, "_dask_client", lambda scheduler, address: contextlib.nullcontext())  # no cluster
     monkeypatch.setattr(module.os, "cpu_count", lambda: 4)
     collect(tmp_path / "one", 4, workers=1000, progress=False)  # one chunk
     assert started.pop() == ("joblib", 1) and capsys.readouterr().err == ""

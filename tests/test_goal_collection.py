@@ -140,3 +140,12 @@ def test_the_episode_rule_says_the_reach_clearance_feasible_keeps():
     from affordance_env.dataset.collect import GOAL_EPISODE_RULE
 
     assert f"a reach kept {1000 * REACH_CLEARANCE:g} mm from the object" in GOAL_EPISODE_RULE
+
+
+def test_the_progress_of_a_goal_collection_counts_episodes(tmp_path, monkeypatch, capsys):
+    # its bar counted the goal episodes in "interaction/s"
+    monkeypatch.setattr(TapAffordanceGoalEnv, "feasible", lambda self, behavior, params: False)  # none is run
+    collect(tmp_path / "goal", 2, seed=2, action="random", chunk_size=2, progress=True, env_id="TapAffordanceGoal-v2",
+            env_options=SMALL)
+    bar = capsys.readouterr().err
+    assert "2/2" in bar and "episode/s" in bar and "interaction" not in bar, bar

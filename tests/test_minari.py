@@ -120,3 +120,23 @@ def test_a_failed_export_leaves_nothing_and_a_retry_works(taps, minari_home, mon
     assert minari.list_local_datasets() == {}
     assert [p.name for p in minari_home.rglob("*")] == []  # no half dataset, no staging directory
     assert export_minari(taps, "tap-affordance/retry-v0").total_episodes == len(load_dataset(taps))
+
+
+def test_an_incomplete_dataset_is_refused_with_the_command_that_finishes_it(taps, minari_home, tmp_path, capsys):
+    # the refusal once said "or pass allow_incomplete=True", which neither the export nor its command takes
+    import shutil
+
+    from affordance_env.dataset import DatasetError
+
+    partial = tmp_path / "partial"
+    shutil.copytree(taps, partial)
+    (partial / "chunk-00000.parquet").unlink()
+    finish = f"finish it with `affordance collect --out {partial} --episodes 6 --seed 3"
+    with pytest.raises(DatasetError, match="incomplete") as refused:
+        export_minari(partial, "tap-affordance/partial-v0")
+    assert finish in str(refused.value) and "before exporting it" in str(refused.value)
+    assert "allow_incomplete" not in str(refused.value)
+    assert main(["export", str(partial), "--minari", "tap-affordance/partial-v0"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and finish in err and "allow_incomplete" not in err, err
+    assert not minari_home.exists() or not any(minari_home.rglob("*.json"))

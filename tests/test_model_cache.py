@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import warnings
 
 import mujoco
 import numpy as np
@@ -122,7 +123,31 @@ def test_without_a_usable_cache_the_model_is_compiled(tmp_path, monkeypatch, com
     blocker = tmp_path / "a-file"  # the cache directory cannot be made: a file is in the way
     blocker.write_text("")
     monkeypatch.setenv(model_cache.CACHE_ENV, str(blocker / "cache"))
-    assert _bytes(scene.build_model("tap")) == compiled
+    with pytest.warns(UserWarning, match=f"the model cache {blocker / 'cache'} cannot be written"):
+        assert _bytes(scene.build_model("tap")) == compiled
+    with warnings.catch_warnings():  # said once, not at every env: the cache is off now
+        warnings.simplefilter("error")
+        assert _bytes(scene.build_model("tap")) == compiled
+
+
+def test_a_cache_that_cannot_be_written_is_said_once_before_workers_start(tmp_path, monkeypatch):
+    # each worker of a collection said it again, as Python's raw warning
+    import importlib
+
+    from affordance_env.dataset import collect
+
+    blocker = tmp_path / "a-file"
+    blocker.write_text("")
+    monkeypatch.setenv(model_cache.CACHE_ENV, str(blocker / "cache"))
+    seen = []
+    module = importlib.import_module("affordance_env.dataset.collect")
+    monkeypatch.setattr(module, "_run", lambda tasks, scheduler, workers, client: seen.append(
+        os.environ[model_cache.CACHE_ENV]) or iter(()))  # what the workers would inherit
+    monkeypatch.setattr(module.os, "cpu_count", lambda: 4)
+    with pytest.warns(UserWarning, match=f"the model cache {blocker / 'cache'} cannot be written") as said:
+        collect(tmp_path / "taps", 4, workers=2, chunk_size=2, progress=False)
+    assert len(said) == 1 and seen == ["off"]
+    assert model_cache.check_cache() is None  # off now: nothing more to say
 
 
 def test_the_default_directory_follows_xdg(tmp_path, monkeypatch):

@@ -82,3 +82,8 @@ def test_fingerprint_command_errors_are_one_line(tmp_path, capsys):
     assert main(["fingerprint", str(tmp_path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and f"{tmp_path} holds no results.json of `affordance reproduce`" in err
+    # --check of a directory without results.json once said to write its fingerprint there, which cannot work
+    assert main(["fingerprint", "--check", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{tmp_path} holds no results.json of `affordance reproduce`" in err, err
+    assert "affordance fingerprint" not in err

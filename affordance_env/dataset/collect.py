@@ -280,7 +280,9 @@ def collect(
         scheduler: ``"joblib"`` (processes on this machine) or ``"dask"`` (Dask distributed: the cluster at
             ``dask_address``, or a local cluster of ``workers`` processes).
         dask_address: A Dask scheduler (``"tcp://host:8786"``); implies ``scheduler="dask"``. Its workers need
-            the same tap-affordance version and must see ``out`` (a shared file system).
+            the same tap-affordance version and must see ``out`` (a shared file system). It is connected to before
+            anything is written: where none answers (OSError naming it, after Dask's connect timeout, 30 s by
+            default), nothing is left behind.
         save_images: Also store the initial and final range images (float16) and object masks (bit-packed),
             zstd-compressed; read them with ``load_dataset(out, with_images=True)`` and :func:`images`.
         max_failure_share: Stop with :class:`FailureShareError` once more than this share of the interactions
@@ -310,19 +312,24 @@ def collect(
     out, episodes = Path(out), int(episodes)
 
     stored = _stored_or_new(out, header, episodes)
-    out.mkdir(parents=True, exist_ok=True)
-    with _exclusive(out):
-        for stale in out.glob(".*.tmp"):  # left by a run that was killed while writing
-            stale.unlink(missing_ok=True)
-        ranges = chunk_ranges(episodes, chunk_size)
-        done = _chunks_done(out, ranges, header, stored)
-        write_manifest(out, header, episodes, done)
-        _check_failure_share(done, max_failure_share, out)
-        tasks = [(str(out), i, start, stop, header) for i, (start, stop) in enumerate(ranges) if i not in done]
-        if dask_address is None:  # a cluster of its own: processes of this machine
-            workers = _worker_count(workers, len(tasks), oversubscribe)
-        _collect_chunks(out, tasks, done, header, episodes, progress, max_failure_share,
-                        (scheduler, workers, dask_address))
+    with _dask_client(scheduler, dask_address) as client:  # the scheduler at dask_address answers: now write
+        out.mkdir(parents=True, exist_ok=True)
+        with _exclusive(out):
+            for stale in out.glob(".*.tmp"):  # left by a run that was killed while writing
+                stale.unlink(missing_ok=True)
+            ranges = chunk_ranges(episodes, chunk_size)
+            done = _chunks_done(out, ranges, header, stored)
+            write_manifest(out, header, episodes, done)
+            _check_failure_share(done, max_failure_share, out)
+            tasks = [(str(out), i, start, stop, header) for i, (start, stop) in enumerate(ranges) if i not in done]
+            if dask_address is None:  # a cluster of its own: processes of this machine
+                workers = _worker_count(workers, len(tasks), oversubscribe)
+                if tasks and (workers > 1 or scheduler == "dask"):
+                    from affordance_env.model_cache import check_cache
+
+                    check_cache()  # a cache that cannot be written is said here, not by every worker
+            _collect_chunks(out, tasks, done, header, episodes, progress, max_failure_share,
+                            (scheduler, workers, client))
     return out
 
 
@@ -383,12 +390,14 @@ def _chunks_done(out: Path, ranges: list[tuple[int, int]], header: dict, stored:
 
 
 def _collect_chunks(out: Path, tasks: list, done: dict[int, ChunkResult], header: dict, episodes: int,
-                    progress: bool | None, max_failure_share: float, how: tuple[str, int, str | None]) -> None:
-    """Run the missing chunks' ``tasks`` (``how``: scheduler, workers, Dask address), recording each in ``done`` and
-    the manifest as it comes, with a progress bar over all ``episodes``."""
+                    progress: bool | None, max_failure_share: float, how: tuple[str, int, Any]) -> None:
+    """Run the missing chunks' ``tasks`` (``how``: scheduler, workers, the client of the Dask scheduler at
+    ``dask_address`` or None), recording each in ``done`` and
+    the manifest as it comes, with a progress bar over all ``episodes`` (goal episodes, or interactions)."""
     n_failed = sum(len(chunk.failures) for chunk in done.values())
+    unit = "episode" if is_goal_dataset(header) else "interaction"
     with progress_bar(progress, total=episodes, initial=sum(chunk.episodes for chunk in done.values()),
-                      unit="interaction", desc=out.name, smoothing=0.05) as bar:
+                      unit=unit, desc=out.name, smoothing=0.05) as bar:
         bar.set_postfix(failed=n_failed, refresh=False)
         for chunk in _run(tasks, *how):
             if not (out / chunk_name(chunk.index)).exists():
@@ -468,12 +477,13 @@ def _existing_chunk(path: Path, header: dict, start: int, stop: int, stored: dic
         return None
 
 
-def _run(tasks: list[tuple], scheduler: str, workers: int, address: str | None) -> Iterator[ChunkResult]:
-    """Run chunk tasks, yielding each chunk as it is written."""
+def _run(tasks: list[tuple], scheduler: str, workers: int, client: Any) -> Iterator[ChunkResult]:
+    """Run chunk tasks, yielding each chunk as it is written (``client``: of the Dask scheduler at ``dask_address``;
+    None for joblib or a local Dask cluster of ``workers`` processes)."""
     if not tasks:
         return
     if scheduler == "dask":
-        yield from _run_dask(tasks, workers, address)
+        yield from _run_dask(tasks, workers, client)
     elif workers == 1:
         for task in tasks:
             yield _collect_chunk(*task)
@@ -493,19 +503,43 @@ def _collect_chunk_in_worker(*task) -> ChunkResult:
     return _collect_chunk(*task)
 
 
-def _run_dask(tasks: list[tuple], workers: int, address: str | None) -> Iterator[tuple]:
+def _distributed():
+    """Dask distributed; MissingDependencyError (saying how to install it) without it."""
     try:
-        from distributed import Client, LocalCluster, as_completed
+        import distributed
     except ImportError as exc:
         raise MissingDependencyError("scheduler='dask' needs Dask distributed: pip install "
                                      "'tap-affordance[dask]'") from exc
+    return distributed
+
+
+@contextlib.contextmanager
+def _dask_client(scheduler: str, address: str | None) -> Iterator[Any]:
+    """With ``scheduler="dask"``, Dask distributed checked to be installed and, with ``address``, a client of the
+    scheduler there, connected (an OSError naming the address where none answers: Dask tries for its
+    ``distributed.comm.timeouts.connect``, 30 s by default); None otherwise. Entered before anything is written, so
+    that a scheduler that cannot be reached leaves nothing behind."""
+    if scheduler != "dask":
+        yield None
+        return
+    distributed = _distributed()
+    if address is None:
+        yield None
+        return
+    with distributed.Client(address) as client:
+        yield client
+
+
+def _run_dask(tasks: list[tuple], workers: int, client: Any) -> Iterator[ChunkResult]:
+    """The chunks of ``tasks`` run by ``client``'s scheduler, or by a local cluster of ``workers`` processes
+    started now (``client`` None)."""
+    distributed = _distributed()
     with contextlib.ExitStack() as stack:
-        if address is None:
-            address = stack.enter_context(
-                LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None)
-            )
-        client = stack.enter_context(Client(address))
+        if client is None:
+            cluster = stack.enter_context(distributed.LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None))
+            client = stack.enter_context(distributed.Client(cluster))
         futures = [client.submit(_collect_chunk, *task, pure=False, retries=1) for task in tasks]
-        for future in as_completed(futures):
+        for future in distributed.as_completed(futures):
             yield future.result()
             future.release()

@@ -141,10 +141,34 @@ def load_dataset(path: str | os.PathLike, *, with_images: bool = False, allow_in
     redo = collect_command(path, manifest)
     tables, failures, missing = _read_chunks(path, manifest, renames, with_images, redo)
     if missing and not allow_incomplete:
-        raise DatasetError(f"{path} is incomplete: {len(missing)} chunk(s) missing or unfinished "
-                           f"({', '.join(missing[:3])}{', ...' if len(missing) > 3 else ''}); finish it with "
-                           f"`{redo}`, or pass allow_incomplete=True.")
+        raise DatasetError(f"{_incomplete(path, missing, redo)}, or pass allow_incomplete=True.")
     return _frame(tables, failures, manifest, renames, with_images)
+
+
+def check_complete(path: str | os.PathLike, before: str) -> None:
+    """Raise DatasetError if a chunk of the dataset at ``path`` is missing or unfinished, naming them and the
+    ``affordance collect`` command that finishes the dataset ``before`` what the caller does (``"exporting it"``);
+    FileNotFoundError or DatasetError, as :func:`load_dataset`, if it is no dataset."""
+    path = _dataset_directory(Path(path))
+    manifest = read_manifest(path)
+    missing = _unfinished(path, manifest)
+    if missing:
+        raise DatasetError(f"{_incomplete(path, missing, collect_command(path, manifest))} before {before}.")
+
+
+def _incomplete(path: Path, missing: list[str], redo: str) -> str:
+    """What is missing of the dataset at ``path`` (the names of its chunks ``missing``) and ``redo``, the command
+    that finishes it."""
+    return (f"{path} is incomplete: {len(missing)} chunk(s) missing or unfinished ({', '.join(missing[:3])}"
+            f"{', ...' if len(missing) > 3 else ''}); finish it with `{redo}`")
+
+
+def _unfinished(path: Path, manifest: dict) -> list[str]:
+    """The names of the chunks of the dataset at ``path`` that are missing or unfinished: a chunk is finished once
+    the manifest records its checksum (schema version 5 on), before that once it exists."""
+    version, recorded = manifest["schema_version"], manifest.get(CHECKSUMS) or {}
+    names = [chunk_name(i) for i in range(len(chunk_ranges(manifest["episodes"], manifest["settings"]["chunk_size"])))]
+    return [name for name in names if not (path / name).exists() or (version >= 5 and name not in recorded)]
 
 
 def _dataset_directory(path: Path) -> Path:
@@ -170,17 +194,13 @@ def _read_chunks(path: Path, manifest: dict, renames: dict[str, str], with_image
                  ) -> tuple[list[pa.Table], dict, list[str]]:
     """The tables of the dataset's finished chunks in order (:func:`_read_chunk`), the failures they record
     (episode -> reason) and the names of the chunks missing or unfinished."""
-    version = manifest["schema_version"]
     images_on_disk = {old for old, new in renames.items() if new in IMAGE_COLUMNS} | set(IMAGE_COLUMNS)
-    tables, failures, missing = [], {}, []
+    tables, failures, missing = [], {}, _unfinished(path, manifest)
     ranges = chunk_ranges(manifest["episodes"], manifest["settings"]["chunk_size"])
     for index, (start, stop) in enumerate(ranges):
         chunk = path / chunk_name(index)
-        # a chunk is finished once the manifest records its checksum (version 5 on); older ones: once it exists
-        if not chunk.exists() or (version >= 5 and chunk.name not in (manifest.get(CHECKSUMS) or {})):
-            missing.append(chunk.name)
-            continue
-        tables.append(_read_chunk(chunk, manifest, (start, stop), images_on_disk, with_images, redo, failures))
+        if chunk.name not in missing:
+            tables.append(_read_chunk(chunk, manifest, (start, stop), images_on_disk, with_images, redo, failures))
     return tables, failures, missing
 
 

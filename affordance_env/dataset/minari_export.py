@@ -40,7 +40,7 @@ from typing import Any
 import numpy as np
 
 from affordance_env.dataset.format import GROUND_TRUTH_COLUMNS, POSE_FIELDS, STAGES, DatasetError, is_goal_dataset
-from affordance_env.dataset.load import images, load_dataset
+from affordance_env.dataset.load import check_complete, images, load_dataset
 from affordance_env.exceptions import InvalidValueError, MissingDependencyError
 from affordance_env.features import FEATURE_NAMES
 
@@ -273,7 +273,9 @@ def _free_target(minari, dataset_id: str) -> tuple[Path, Path]:
 
 def _interactions(dataset: str | os.PathLike):
     """The frame of the complete dataset at ``dataset``, with its images (:func:`load_dataset`); DatasetError if
-    it holds goal episodes, which the export does not take."""
+    it is incomplete (naming the command that finishes it) or holds goal episodes, which the export does not
+    take."""
+    check_complete(dataset, "exporting it")
     frame = load_dataset(dataset, with_images=True)
     if is_goal_dataset(frame.attrs["manifest"]):
         raise DatasetError(f"{dataset} holds TapAffordanceGoal-v2 episodes; the Minari export writes one "

@@ -172,15 +172,22 @@ def _write_fingerprint(found: dict[str, Any], where: Path) -> Path:
     return path
 
 
+def _reference_config(where: Path) -> tuple[str, int, dict[str, Any]]:
+    """The behaviour, the seed and the whole config of the ``results.json`` in ``where``; InvalidValueError if it
+    holds none of ``affordance reproduce``."""
+    try:
+        config = json.loads((where / "results.json").read_text())["config"]
+        return config["behavior"], int(config["seed"]), config
+    except (OSError, ValueError, KeyError, TypeError) as exc:
+        raise InvalidValueError(f"{where} holds no results.json of `affordance reproduce` (with config.behavior and "
+                                f"config.seed): {exc}; give one behaviour's directory of a reproduction "
+                                "(OUT/BEHAVIOR of `affordance reproduce --out OUT`).") from None
+
+
 def _collect_reference(where: Path, workers: int = 1) -> dict[str, Any]:
     """The fingerprint of the first interactions that ``affordance reproduce`` collects for the reproduction in
     ``where``, collected now (with the settings of its ``results.json``: behaviour, seed, range noise)."""
-    try:
-        config = json.loads((where / "results.json").read_text())["config"]
-        behavior, seed = config["behavior"], int(config["seed"])
-    except (OSError, ValueError, KeyError, TypeError) as exc:
-        raise InvalidValueError(f"{where} holds no results.json of `affordance reproduce` (with config.behavior and "
-                         f"config.seed): {exc}") from None
+    behavior, seed, config = _reference_config(where)
     env_options: dict[str, Any] = {"behavior": behavior}
     if config.get("range_noise", "none") != "none":
         env_options["range_noise"] = config["range_noise"]
@@ -204,6 +211,7 @@ def check_fingerprint(where: str | Path, workers: int = 1) -> FingerprintCheck:
     found here, otherwise by what holds across machines
     (:func:`~affordance_env.dataset.fingerprint.compare_fingerprints`)."""
     where = Path(where)
+    _reference_config(where)  # what the fingerprint is made from, before it is asked for
     try:
         expected = json.loads((where / FINGERPRINT).read_text())
     except (OSError, ValueError) as exc:
