@@ -277,6 +277,30 @@ def test_feasible_refuses_a_pick_and_place_whose_carry_ends_out_of_reach(env, ob
     assert not info["ik"]["success"]
 
 
+@pytest.mark.slow
+def test_feasible_accepts_a_reach_that_slows_down_onto_its_pose_1_mm_from_the_object(env):
+    # Draw 78 of ``python benchmarks/feasible.py --seed 0``: the tap_back's targets pass 1.0-1.6 mm from a lying
+    # cylinder while the palm slows from 0.12 m/s onto the pre-stroke pose; the arm follows them to within 0.3 mm
+    # there, so it reaches without touching (a 2 mm clearance throughout refused it).
+    env.reset(seed=78, options={"object_type": "horizontal_cylinder", "size": 0.09491, "position": (-0.29502, -0.06539),
+                                "yaw": -0.06383})
+    params = np.array([0.388, 0.171, 0.4658], dtype=np.float32)
+    assert env.feasible("tap_back", params)
+    _, _, _, _, info = env.step({"behavior": "tap_back", "params": params})
+    assert info["ik"]["success"] and info["failure"] is None
+
+
+@pytest.mark.slow
+def test_feasible_refuses_a_reach_that_sweeps_into_the_object(env):
+    # Draw 93 of ``python benchmarks/feasible.py --seed 1``: the tap_back's reach crosses over a ball, its targets
+    # 1.1 mm into it as the palm comes down fast; the arm knocks the ball 4 cm away before the stroke.
+    env.reset(seed=93, options={"object_type": "sphere", "size": 0.08421, "position": (-0.26187, -0.13671)})
+    params = np.array([0.3872, 0.0772, 0.7755], dtype=np.float32)
+    assert not env.feasible("tap_back", params)
+    _, _, _, _, info = env.step({"behavior": "tap_back", "params": params})
+    assert info["ik"]["success"] and info["failure"].startswith("reach: the arm moved the object")
+
+
 def test_bad_actions_options_and_goals_get_clear_errors(env):
     env.reset(seed=0)
     with pytest.raises(ValueError, match="Unknown behavior 'kick'"):
