@@ -83,7 +83,7 @@ def main() -> None:
             if verdict is not None and feasible != verdict:
                 disagreements.append(
                     f"  draw {i}: {name} {info['object']['type']} {info['object']['size'] * 100:.1f} cm at "
-                    f"({position[0]:.4f}, {position[1]:.4f}), params {np.round(params, 4).tolist()}: "
+                    f"({position[0]:.4f}, {position[1]:.4f}), params {[round(float(x), 4) for x in params]}: "
                     f"feasible={feasible}, reached={verdict} (failure: {info['failure']})")
     finally:
         world_module.failure_reason = failure_reason
