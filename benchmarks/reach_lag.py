@@ -8,7 +8,8 @@ params at random), the right arm's behaviours only, those whose poses the IK rea
 reach, the distance between the arm's geoms and the object along the targets (kinematics) and as the arm is (after
 the tick's physics steps), and the palm's speed along the targets. Over the ticks whose targets are within NEAR of
 the object, before the arm first touches it, prints the largest shortfall of the arm's distance from the targets',
-per band of speeds, and the least lag time that covers them all over ``REACH_LAG_FLOOR``.
+per band of speeds, and the least lag time that covers them all over ``REACH_LAG_FLOOR``; ticks whose targets go
+into the table apart (the table holds the arm off them).
 """
 
 from __future__ import annotations
@@ -57,7 +58,7 @@ def main() -> None:
     env = TapAffordanceGoalEnv()
     world = env.world
     rng = np.random.default_rng(args.seed)
-    shortfalls, speeds, reaches, near_reaches = [], [], 0, 0
+    shortfalls, speeds, held_off, reaches, near_reaches = [], [], [], 0, 0
     for i in range(args.draws):
         position = tuple(rng.uniform(REACH_LOW, REACH_HIGH))
         behavior, params = int(rng.integers(len(env.behaviors))), rng.uniform(-1, 1, 3).astype(np.float32)
@@ -72,17 +73,22 @@ def main() -> None:
         if not ik_verdict([start, *stroke.stroke_line(motion, plan, start).results])[0]:
             continue
         reach = stroke.reach_trajectory(motion, stroke.approach_above(motion, plan, start), start).q
-        targets = np.array([physics.sweep_clearance(q, NEAR, None)[0] for q in reach])
+        targets, table = np.array([physics.sweep_clearance(q, NEAR, 0.0) for q in reach], dtype=float).T
         palm_speeds = stroke.palm_speeds(motion, reach)
         arm_distance = _arm_distances(env, behavior, params)[: len(reach)]
         untouched = np.minimum.accumulate(arm_distance) > 0
-        near = (targets[: len(arm_distance)] < NEAR) & untouched
+        n = len(arm_distance)
+        near = (targets[:n] < NEAR) & untouched
         reaches += 1
         near_reaches += bool(near.any())
-        shortfalls += list((targets[: len(arm_distance)] - arm_distance)[near])
-        speeds += list(palm_speeds[: len(arm_distance)][near])
+        shortfall = targets[:n] - arm_distance
+        shortfalls += list(shortfall[near & (table[:n] >= 0.0)])
+        speeds += list(palm_speeds[:n][near & (table[:n] >= 0.0)])
+        held_off += list(shortfall[near & (table[:n] < 0.0)])
     shortfall, speed = np.array(shortfalls), np.array(speeds)
-    print(f"{reaches} reaches, {near_reaches} with targets within {NEAR * 1e3:g} mm of the object: {len(speed)} ticks")
+    print(f"{reaches} reaches, {near_reaches} with targets within {NEAR * 1e3:g} mm of the object: {len(speed)} ticks "
+          f"whose targets keep out of the table, {len(held_off)} whose targets go into it (the arm came nearer than "
+          f"its targets there by {max(held_off, default=0.0) * 1e3:.2f} mm at most)")
     print(f"{'palm speed [m/s]':>18} {'ticks':>6} {'largest shortfall [mm]':>23}")
     for low, high in zip(BANDS[:-1], BANDS[1:], strict=True):
         band = (speed >= low) & (speed < high)

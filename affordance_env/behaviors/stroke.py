@@ -328,8 +328,8 @@ def palm_speeds(motion: MotionExecutor, q: np.ndarray) -> np.ndarray:
 def _clear_by_speed(motion: MotionExecutor, reach: np.ndarray) -> bool:
     """Whether the reach's targets ``reach`` keep from the object the clearance the servos' lag asks at each tick's
     speed (REACH_LAG_FLOOR, REACH_LAG_TIME; REACH_CLEARANCE at most, there at the samples of
-    :func:`stroke_reachable`, elsewhere at every tick): the check of a reach whose samples come nearer than
-    REACH_CLEARANCE."""
+    :func:`stroke_reachable`, elsewhere at every tick, and at the ticks whose targets go into the table, which
+    holds the arm off them): the check of a reach whose samples come nearer than REACH_CLEARANCE."""
     margins = np.minimum(REACH_LAG_FLOOR + REACH_LAG_TIME * palm_speeds(motion, reach), REACH_CLEARANCE)
     slow = margins < REACH_CLEARANCE
     samples = np.arange(0, len(reach), REACH_SWEEP_STRIDE)
@@ -337,8 +337,11 @@ def _clear_by_speed(motion: MotionExecutor, reach: np.ndarray) -> bool:
     physics = motion.physics
     if physics.sweep_clearance(reach[fast], REACH_CLEARANCE, None)[0] < REACH_CLEARANCE:
         return False
-    return all(physics.sweep_clearance(q, margin, None)[0] >= margin
-               for q, margin in zip(reach[slow], margins[slow], strict=True))
+    for q, margin in zip(reach[slow], margins[slow], strict=True):
+        clearance, table = physics.sweep_clearance(q, REACH_CLEARANCE, 0.0)
+        if clearance < (margin if table >= 0.0 else REACH_CLEARANCE):  # into the table: held off the targets
+            return False
+    return True
 
 
 def run_stroke(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> StrokeOutcome:
