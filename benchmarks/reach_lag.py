@@ -1,5 +1,5 @@
 """How much nearer to the object the arm comes than its servo targets during a stroke's or a draw's reach, by the
-palm's speed: the data of ``REACH_LAG_FLOOR`` and ``REACH_LAG_TIME`` (:mod:`affordance_env.behaviors.stroke`).
+palm's speed: the servos' lag that ``REACH_CLEARANCE`` (:mod:`affordance_env.behaviors.stroke`) stands for.
 
     python benchmarks/reach_lag.py [--draws 400] [--seed 2]
 
@@ -8,8 +8,9 @@ params at random), the right arm's behaviours only, those whose poses the IK rea
 reach, the distance between the arm's geoms and the object along the targets (kinematics) and as the arm is (after
 the tick's physics steps), and the palm's speed along the targets. Over the ticks whose targets are within NEAR of
 the object, before the arm first touches it, prints the largest shortfall of the arm's distance from the targets',
-per band of speeds, and the least lag time that covers them all over ``REACH_LAG_FLOOR``; ticks whose targets go
-into the table apart (the table holds the arm off them).
+per band of speeds, how many fell short by more than ``REACH_CLEARANCE``, and for clearances at rest (FLOORS) the
+least lag time that covers all the others (a clearance that would grow with the speed); ticks whose targets go into
+the table apart (the table holds the arm off them).
 """
 
 from __future__ import annotations
@@ -20,15 +21,26 @@ import numpy as np
 
 from affordance_env.behaviors import get_behavior, stroke
 from affordance_env.goal_env import TapAffordanceGoalEnv
-from affordance_env.motion import ik_verdict
+from affordance_env.kinematics import Kinematics
+from affordance_env.motion import CONTROL_DT, ik_verdict
 from affordance_env.registry import BEHAVIOR_ARMS
 
 #: The part of the table the arms can reach at all (x, y) [m]: benchmarks/feasible.py's.
 REACH_LOW, REACH_HIGH = np.array([-0.52, -0.38]), np.array([-0.16, 0.38])
 #: Ticks whose targets are within this distance of the object are counted [m].
 NEAR = 0.02
+#: Clearances at rest [m] for which the lag time that covers the measured shortfalls is printed.
+FLOORS = (0.0005, 0.0007, 0.001)
 #: Bands of the palm's speed [m/s].
 BANDS = (0.0, 0.05, 0.1, 0.2, 0.3, np.inf)
+
+
+def _palm_speeds(kinematics: Kinematics, q: np.ndarray) -> np.ndarray:
+    """The palm's speed [m/s] at each control tick of the joint targets ``q`` ((ticks, joints), one CONTROL_DT
+    apart): its travel since the tick before (the first tick: to the next one)."""
+    palm = np.array([kinematics.hand_pose(q_tick).translation for q_tick in q])
+    steps = np.linalg.norm(palm[1:] - palm[:-1], axis=1) / CONTROL_DT
+    return np.concatenate((steps[:1], steps)) if len(steps) else np.zeros(len(q))
 
 
 def _arm_distances(env: TapAffordanceGoalEnv, behavior: int, params: np.ndarray) -> np.ndarray:
@@ -74,7 +86,7 @@ def main() -> None:
             continue
         reach = stroke.reach_trajectory(motion, stroke.approach_above(motion, plan, start), start).q
         targets, table = np.array([physics.sweep_clearance(q, NEAR, 0.0) for q in reach], dtype=float).T
-        palm_speeds = stroke.palm_speeds(motion, reach)
+        palm_speeds = _palm_speeds(world.kinematics(name), reach)
         arm_distance = _arm_distances(env, behavior, params)[: len(reach)]
         untouched = np.minimum.accumulate(arm_distance) > 0
         n = len(arm_distance)
@@ -94,10 +106,14 @@ def main() -> None:
         band = (speed >= low) & (speed < high)
         largest = f"{shortfall[band].max() * 1e3:.2f}" if band.any() else "-"
         print(f"{low:8.2f} - {high:<7.2f} {int(band.sum()):6d} {largest:>23}")
-    if len(speed):
-        lag = np.max((shortfall - stroke.REACH_LAG_FLOOR) / np.maximum(speed, 1e-9))
-        print(f"all within {stroke.REACH_LAG_FLOOR * 1e3:g} mm + {max(lag, 0.0) * 1e3:.2f} ms times the speed "
-              f"(REACH_LAG_TIME is {stroke.REACH_LAG_TIME * 1e3:g} ms)")
+    capped = shortfall > stroke.REACH_CLEARANCE  # beyond what any clearance up to REACH_CLEARANCE covers
+    if capped.any():
+        print(f"{int(capped.sum())} ticks fell short by more than REACH_CLEARANCE ({shortfall.max() * 1e3:.2f} mm at "
+              f"most), at {speed[capped].min():.2f} m/s and faster")
+    for floor in FLOORS:
+        covered = ~capped & (shortfall > floor)
+        lag = float(np.max((shortfall[covered] - floor) / speed[covered])) if covered.any() else 0.0
+        print(f"the others within {floor * 1e3:.1f} mm + {lag * 1e3:.2f} ms times the speed")
     env.close()
 
 

@@ -189,16 +189,6 @@ def plan_stroke(
 #: mm), where the planner chose actions at the edge of their range. 2 mm refuses those and 6 of the 570 that work
 #: (1 %); 1 mm lets one through, 1 cm refuses 48 that work.
 REACH_CLEARANCE, REACH_SWEEP_STRIDE = 0.002, 5
-#: REACH_CLEARANCE is the servos' lag, and the lag grows with the palm's speed: where the reach's targets come nearer
-#: than REACH_CLEARANCE, each control tick's targets need keep only REACH_LAG_FLOOR + REACH_LAG_TIME times the
-#: palm's speed there [m, s] (never more than REACH_CLEARANCE). Over the 890 control ticks of 188 reaches
-#: (``feasible()``'s benchmark draws, seeds 2 and 3) whose targets were within 2 cm of the object before any touch,
-#: the arm came nearer to the object than its targets by at most 0.30 mm where the palm moved slower than 0.05 m/s,
-#: 0.53 mm at 0.05-0.1 m/s, 1.25 mm at 0.1-0.2 m/s, 2.27 mm at 0.2-0.3 m/s and 2.90 mm faster: all within
-#: 0.4 mm + 6.8 ms times the speed. A reach that slows down onto a pre-stroke pose 1 mm from the object then goes
-#: through (with 2 mm throughout, 2 of the 29 tap_backs of ``python benchmarks/feasible.py --draws 200 --seed 0``
-#: that reached were refused; one of them so).
-REACH_LAG_FLOOR, REACH_LAG_TIME = 0.0004, 0.007
 #: The reach's servo targets may put the arm's geoms at most this far into the table [m] (checked at the same
 #: samples and at the pre-stroke pose), else the stroke is not feasible: the forearm then rests on the table and
 #: holds the hand off its pre-stroke pose. Over 375 random tap_backs that passed the checks above (objects over its
@@ -297,8 +287,7 @@ def reach_trajectory(motion: MotionExecutor, above: IKResult | None, start: IKRe
 
 def stroke_reachable(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> bool:
     """Whether :func:`run_stroke` will find every pose of ``plan`` within the IK's tolerances, and its reach keeps
-    the arm ``REACH_CLEARANCE`` from the object (less where the palm is slow: ``REACH_LAG_FLOOR``,
-    ``REACH_LAG_TIME``) and out of the table beyond ``REACH_TABLE_PENETRATION``;
+    the arm ``REACH_CLEARANCE`` from the object and out of the table beyond ``REACH_TABLE_PENETRATION``;
     kinematics only. The IK of a pose whose miss decides the answer gives up once it stands still (``check``):
     the same answers, a pose out of reach found sooner."""
     start = approach_start(motion, plan, posture, check=True)
@@ -307,41 +296,13 @@ def stroke_reachable(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarr
     if not ik_verdict(stroke_line(motion, plan, start, check=True).results)[0]:
         return False
     above = approach_above(motion, plan, start)  # a via point, used as it is: solved in full
-    reach = reach_trajectory(motion, above, start).q
+    samples = reach_trajectory(motion, above, start).q[::REACH_SWEEP_STRIDE]
     # one kinematic pass over the reach for the object and the table, then the pre-stroke pose for the table
     physics = motion.physics
-    clearance, table = physics.sweep_clearance(reach[::REACH_SWEEP_STRIDE], REACH_CLEARANCE, 0.0)
-    if clearance < REACH_CLEARANCE and not _clear_by_speed(motion, reach):
+    clearance, table = physics.sweep_clearance(samples, REACH_CLEARANCE, 0.0)
+    if clearance < REACH_CLEARANCE:
         return False
     return physics.sweep_clearance(start.q, None, table)[1] >= -REACH_TABLE_PENETRATION
-
-
-def palm_speeds(motion: MotionExecutor, q: np.ndarray) -> np.ndarray:
-    """The palm's speed [m/s] at each control tick of the joint targets ``q`` ((ticks, joints), one CONTROL_DT
-    apart): its travel since the tick before (the first tick: to the next one), from the kinematics."""
-    kinematics = motion.kinematics
-    palm = np.array([kinematics.hand_pose(q_tick).translation for q_tick in q])
-    steps = np.linalg.norm(palm[1:] - palm[:-1], axis=1) / CONTROL_DT
-    return np.concatenate((steps[:1], steps)) if len(steps) else np.zeros(len(q))
-
-
-def _clear_by_speed(motion: MotionExecutor, reach: np.ndarray) -> bool:
-    """Whether the reach's targets ``reach`` keep from the object the clearance the servos' lag asks at each tick's
-    speed (REACH_LAG_FLOOR, REACH_LAG_TIME; REACH_CLEARANCE at most, there at the samples of
-    :func:`stroke_reachable`, elsewhere at every tick, and at the ticks whose targets go into the table, which
-    holds the arm off them): the check of a reach whose samples come nearer than REACH_CLEARANCE."""
-    margins = np.minimum(REACH_LAG_FLOOR + REACH_LAG_TIME * palm_speeds(motion, reach), REACH_CLEARANCE)
-    slow = margins < REACH_CLEARANCE
-    samples = np.arange(0, len(reach), REACH_SWEEP_STRIDE)
-    fast = samples[~slow[samples]]
-    physics = motion.physics
-    if physics.sweep_clearance(reach[fast], REACH_CLEARANCE, None)[0] < REACH_CLEARANCE:
-        return False
-    for q, margin in zip(reach[slow], margins[slow], strict=True):
-        clearance, table = physics.sweep_clearance(q, REACH_CLEARANCE, 0.0)
-        if clearance < (margin if table >= 0.0 else REACH_CLEARANCE):  # into the table: held off the targets
-            return False
-    return True
 
 
 def run_stroke(motion: MotionExecutor, plan: StrokePlan, posture: np.ndarray | None) -> StrokeOutcome:

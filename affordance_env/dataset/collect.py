@@ -95,7 +95,7 @@ PARAM_DRAWS = 10
 #: not see the object. What ``feasible`` checks is part of the rule: since it checks the end of a pick and place's
 #: carry where the held object will hang, a dataset whose grasps it chose before is not resumed.
 GOAL_EPISODE_RULE = (f"feasible actions only (a pick and place's carry checked where the object hangs, a reach "
-                     f"kept 2 mm from the object, 0.4 mm + 7 ms x the palm's speed where that is less), the "
+                     f"kept 2 mm from the object), the "
                      f"behaviours in a random order, {PARAM_DRAWS} draws each per step; truncated where none is or the "
                      "object is not seen")
 
