@@ -13,7 +13,8 @@ for too: it is counted apart (``reached=untried``). Prints the agreement, the ta
 reached) counts, per behaviour how many of those that reached it refused and how many of those that failed it
 accepted, and every draw on which they disagree; then the time of ``feasible`` on the same draws against the same
 calls with every IK spending its whole budget (as an interaction solves it: no giving up once the error stands
-still, :data:`affordance_env.kinematics.STALL_WINDOW`), taking turns, with the share of answers they agree on.
+still, :data:`affordance_env.kinematics.STALL_WINDOW`), taking turns, with the share of answers they agree on, and
+the median time of a call per behaviour.
 """
 
 from __future__ import annotations
@@ -111,7 +112,8 @@ def _report(counts: Counter, disagreements: list[str], n: int) -> None:
 
 
 def _time_checks(env: TapAffordanceGoalEnv, draws: list, rounds: int = 3) -> None:
-    """``feasible`` on every draw's snapshot, as it is and with the IK's whole budget, taking turns."""
+    """``feasible`` on every draw's snapshot, as it is and with the IK's whole budget, taking turns; then the median
+    over the draws of each behaviour of a call's time as it is (the least of its rounds)."""
     ik = MotionExecutor.ik
 
     def in_full(self, p, q_init, hand, check=False):  # every IK as an interaction solves it
@@ -119,12 +121,18 @@ def _time_checks(env: TapAffordanceGoalEnv, draws: list, rounds: int = 3) -> Non
 
     seconds: dict[str, list[float]] = {"feasible": [], "whole budget": []}
     answers: dict[str, list[bool]] = {}
+    calls = np.full((rounds, len(draws)), np.inf)  # each call's time as it is [s]
     try:
-        for _ in range(rounds):
+        for r in range(rounds):
             for name in seconds:
                 MotionExecutor.ik = ik if name == "feasible" else in_full
+                answers[name] = []
                 start = time.perf_counter()
-                answers[name] = [bool(env.feasible(b, p, state=state)) for state, b, p in draws]
+                for k, (state, b, p) in enumerate(draws):
+                    before = time.perf_counter()
+                    answers[name].append(bool(env.feasible(b, p, state=state)))
+                    if name == "feasible":
+                        calls[r, k] = time.perf_counter() - before
                 seconds[name].append(time.perf_counter() - start)
     finally:
         MotionExecutor.ik = ik
@@ -132,6 +140,11 @@ def _time_checks(env: TapAffordanceGoalEnv, draws: list, rounds: int = 3) -> Non
     fast, full = (float(np.median(seconds[name])) / len(draws) * 1e3 for name in seconds)
     print(f"feasible(): {fast:.1f} ms per call against {full:.1f} ms with the whole IK budget ({full / fast:.2f} x, "
           f"medians of {rounds} rounds); the same answer for {same} of {len(draws)}")
+    least = calls.min(axis=0)
+    behaviors = np.array([env.behaviors[b] for _, b, _ in draws])
+    print("median per call (with the state's restore), the least of its rounds: " + ", ".join(
+        f"{name} {np.median(least[behaviors == name]) * 1e3:.1f} ms (n={int(np.sum(behaviors == name))})"
+        for name in env.behaviors if np.any(behaviors == name)))
 
 
 if __name__ == "__main__":
