@@ -361,8 +361,8 @@ class TapAffordanceGoalEnv(gym.Env):
     def feasible(self, behavior: int | str, params: Any, state: GoalEnvState | None = None) -> bool:
         """Whether the arm can reach every pose of ``behavior`` with ``params`` on the object where it is now (or
         where it is in ``state``, a snapshot of :meth:`get_state`: the env is left as it was), from the kinematics
-        alone (no physics step); False: the interaction would fail with ``"ik: ..."``, or a stroke's reach would
-        sweep the arm into the object (``"reach: ..."``)."""
+        alone (no physics step); False: the interaction would fail with ``"ik: ..."``, a stroke's reach would
+        sweep the arm into the object (``"reach: ..."``), or the grasp would put the object down off the table."""
         name, a = self._check_action({"behavior": behavior, "params": params})
         if state is not None:
             if not isinstance(state, GoalEnvState):

@@ -302,7 +302,8 @@ class World:
     def feasible(self, behavior: str, params: Any) -> bool:
         """Whether the arm can reach every pose of ``behavior`` with ``params`` on the object where the last
         observation saw it, from the kinematics alone (no physics step). False: the interaction would fail with
-        ``"ik: ..."``, or a stroke's reach would sweep the arm into the object (``"reach: ..."``)."""
+        ``"ik: ..."``, a stroke's reach would sweep the arm into the object (``"reach: ..."``), or a pick and place
+        would put the object down off the table."""
         a = check_action(params)
         arm = self._arm_of(behavior)
         initial = self._initial

@@ -325,6 +325,31 @@ def test_feasible_refuses_a_pick_and_place_whose_carry_ends_out_of_reach(env, ob
     assert not info["ik"]["success"]
 
 
+@pytest.mark.slow
+def test_feasible_refuses_a_reach_that_sweeps_into_the_object(env):
+    # Draw 93 of ``python benchmarks/feasible.py --seed 1``: the tap_back's reach crosses over a ball, its targets
+    # 1.1 mm into it as the palm comes down fast; the arm knocks the ball 4 cm away before the stroke.
+    env.reset(seed=93, options={"object_type": "sphere", "size": 0.08421, "position": (-0.26187, -0.13671)})
+    params = np.array([0.3872, 0.0772, 0.7755], dtype=np.float32)
+    assert not env.feasible("tap_back", params)
+    _, _, _, _, info = env.step({"behavior": "tap_back", "params": params})
+    assert info["ik"]["success"] and info["failure"].startswith("reach: the arm moved the object")
+
+
+@pytest.mark.slow
+def test_feasible_refuses_a_pick_and_place_off_the_table_though_its_poses_are_reached(env):
+    # Draw 43 of ``python benchmarks/feasible.py --seed 0``: a pick and place asked to put a small lying cylinder
+    # down 19 cm nearer the robot, beyond the table's near edge. Every pose is within the arm's reach and the hand
+    # holds the cylinder, but it cannot be put down there: feasible() refuses it.
+    env.reset(seed=43, options={"object_type": "horizontal_cylinder", "size": 0.04263, "position": (-0.22907, -0.00848),
+                                "yaw": 0.04357})
+    params = np.array([0.9774, -0.6341, 0.926], dtype=np.float32)
+    assert not env.feasible("grasp", params)
+    _, _, _, _, info = env.step({"behavior": "grasp", "params": params})
+    assert info["ik"]["success"] and info["grasp"]["rise"] > 0.05  # held, and carried where it was asked ...
+    assert info["outcome"] == "off_table"  # ... off the table
+
+
 def test_bad_actions_options_and_goals_get_clear_errors(env):
     env.reset(seed=0)
     with pytest.raises(ValueError, match="Unknown behavior 'kick'"):
