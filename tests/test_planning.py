@@ -143,10 +143,11 @@ def test_toward_searches_over_two_interactions_where_the_nearest_first_step_is_a
     assert greedy.behavior == "push" and greedy.probability == 0.0
     ahead = planner.toward(features, start, target, 0.015, steps_left=2)
     assert ahead.behavior == "tap" and ahead.value > 0.9 and ahead.probability == 0.0
-    # Where tap cannot act after the first interaction, the sequence is worth nothing: the nearest again.
+    # Where tap cannot act after the first interaction, the sequence is worth nothing; the nearest end after two
+    # interactions decides: a tap then a push ends 2 cm away, a push then anything 3 cm or more.
     blocked = planner.toward(features, start, target, 0.015, steps_left=2,
                              reachable=lambda name, xy: np.full(len(xy), name != "tap"))
-    assert blocked.behavior == "push" and blocked.value == 0.0
+    assert blocked.behavior == "tap" and blocked.value == 0.0 and blocked.expected_distance < 0.025
     with pytest.raises(ValueError, match="steps_left"):
         planner.toward(features, start, target, 0.015, steps_left=0)
     # By default toward looks ahead (more interactions may follow), as a multi-step episode wants.
