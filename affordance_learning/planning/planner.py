@@ -99,7 +99,7 @@ CEM_MIN_STD = 0.01
 FINALISTS, FINALIST_REGIONS = 4, 3
 #: Model evaluations per decision of the default optimiser, summed over the five behaviours: the cross-entropy
 #: search's cheap scores and the finalists' whole predictive outcomes.
-EVALUATIONS = 5 * (64 + CEM_ITERATIONS * CEM_SAMPLES + FINALISTS + FINALIST_REGIONS + 1)
+EVALUATIONS = 5 * (64 + CEM_ITERATIONS * CEM_SAMPLES + FINALISTS + FINALIST_REGIONS + 1)  # 1320
 #: For a goal with a distance, an action's expected progress towards the goal is taken less this many times its
 #: spread (the standard deviation of the progress under the predictive distribution): of two actions as likely to
 #: reach the goal and that end as near on average, the one the model is surer of. Measured with
@@ -399,7 +399,7 @@ class Planner:
     def _optimise(self, features: np.ndarray, goal: Goal, start: np.ndarray | None, excluded_near
                   ) -> tuple[dict[str, np.ndarray], int]:
         """Per behaviour, the actions to score on their whole predictive outcomes: the search's finalists (the
-        best it found, the best of other regions, the canonical action), and the model evaluations it made.
+        best it found, the best of other regions, the canonical action), and the cheap scores it made.
         ``excluded_near(name, params)``: (n,) bool, the actions that failed here before (never elites)."""
         finalists, evaluations = {}, 0
         step = P_RESOLUTION if goal.ranks_by_progress else 0.0
@@ -439,7 +439,7 @@ class Planner:
             if not any(np.array_equal(c, self.params[0]) for c in chosen):
                 chosen.append(self.params[0])  # the canonical action: what the checks fall back on
             finalists[name] = np.array(chosen)
-        return finalists, evaluations + sum(len(c) for c in finalists.values())
+        return finalists, evaluations
 
     def _excluded_near(self, features: np.ndarray, start: np.ndarray | None):
         """``excluded_near(name, params)``: which of ``params`` (n, 3) of ``name`` lie within
@@ -472,26 +472,29 @@ class Planner:
         ``candidates``, the last of them every candidate), that is not ``excluded`` and that ``feasible`` accepts;
         and how many times ``feasible`` was asked.
 
-        ``feasible`` is asked at most ``max_checks`` times, never about a candidate within :data:`REFUSAL_RADIUS`
-        of one it refused, and one check is kept for the canonical action (its candidate ``params[0]``, where
-        there is one) of every behaviour not asked about yet: where the ranked candidates run out of checks,
-        those behaviours' canonical actions are asked about, the most promising behaviour first. Without
-        ``feasible`` the first entry not excluded."""
+        ``feasible`` is asked at most ``max_checks`` times, never about a ranked candidate within
+        :data:`REFUSAL_RADIUS` of one it refused, and one check is kept for the canonical action (the candidate of
+        zeros, where there is one) of every behaviour: where the ranked candidates run out of checks, the
+        canonical actions not asked about yet are, the most promising behaviour first, whatever was refused near
+        them (the behaviours' workspaces are made around their canonical actions). With fewer checks than
+        behaviours, the ranked candidates get one and the canonical actions of the behaviours ranked first the
+        others. Without ``feasible`` the first entry not excluded."""
         asked = {} if asked is None else asked
         refused: list[tuple[str, np.ndarray]] = [(n, candidates[n][k]) for (n, k), ok in asked.items() if not ok]
         canonical = {name: int(np.flatnonzero(np.all(params == 0.0, axis=1))[0]) for name, params in
                      candidates.items() if np.any(np.all(params == 0.0, axis=1))}
 
         def open_reserve() -> list[str]:
-            tried = {n for n, _ in asked}
-            return [n for n, k in canonical.items() if n not in tried and (n, k) not in excluded]
+            return [n for n, k in canonical.items() if (n, k) not in asked and (n, k) not in excluded]
 
-        def ask(key) -> bool | None:
-            """feasible's answer about ``key``, asking if need be; None where it may not be asked."""
+        def ask(key, near_refused: bool = False) -> bool | None:
+            """feasible's answer about ``key``, asking if need be; None where it may not be asked (within
+            REFUSAL_RADIUS of one refused, unless ``near_refused``)."""
             if key in asked:
                 return asked[key]
             params = candidates[key[0]][key[1]]
-            if any(n == key[0] and np.linalg.norm(params - other) < REFUSAL_RADIUS for n, other in refused):
+            if not near_refused and any(n == key[0] and np.linalg.norm(params - other) < REFUSAL_RADIUS
+                                        for n, other in refused):
                 return None
             asked[key] = bool(feasible(key[0], params))
             if not asked[key]:
@@ -505,9 +508,9 @@ class Planner:
                     continue
                 if feasible is None:
                     return entry, 0
-                reserve = open_reserve()
-                if key not in asked and len(asked) + len(reserve) - (key[0] in reserve) >= self.max_checks:
-                    break  # the remaining checks are kept for the behaviours not asked about
+                kept = min(len(open_reserve()) - (canonical.get(key[0]) == key[1]), self.max_checks - 1)
+                if key not in asked and len(asked) + kept >= self.max_checks:
+                    break  # the remaining checks are kept for the canonical actions not asked about
                 if ask(key):
                     return entry, len(asked)
         if feasible is None:
@@ -520,7 +523,7 @@ class Planner:
             if len(asked) >= self.max_checks:
                 break
             key = (name, canonical[name])
-            if ask(key) and key in last:
+            if ask(key, near_refused=True) and key in last:  # the canonical action, whatever was refused near it
                 return last[key], len(asked)
         return None, len(asked)
 
