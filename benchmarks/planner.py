@@ -1,20 +1,22 @@
 """The planner's decisions on place goals: their time, and how near the place the chosen action puts the object,
 for the cross-entropy search (the default) and the fixed grid of candidates, the grid also at the search's time.
 
-    python benchmarks/planner.py [--objects 12] [--goals 3] [--seed 0] [--execute] [--spread 0.5]
+    python benchmarks/planner.py [--objects 12] [--goals 3] [--seed 0] [--execute] [--spread 0 1]
+                                 [--search-only]
 
 Objects are drawn by ``TapAffordanceGoal-v2`` (reset seeds ``seed * 1000 + i``, objects anywhere in the
 behaviours' workspaces) and each gets ``--goals`` places 5-15 cm away, drawn as the plan experiment draws them
 (:func:`affordance_learning.planning.experiment.draw_goal`); the planners use the shipped action models
 (:func:`affordance_learning.default_model.load_action_model`). Per planner it prints the decision time (median,
 p99 [ms] of the process's CPU time, one thread, ``feasible`` not asked: on a machine others share, CPU time is
-what one core spends, where the wall clock also counts the waits) and, over the goals, the model's expected distance of the chosen
-action to the place (the mean of its predictive outcomes) and its P(within 3 cm). The grid at equal time has as
-many candidates as fit in the search's median time (64 times the ratio of the two's medians on the first goals). With ``--execute`` each planner's
-choice, asked with the env's ``feasible``, is run in the simulator from the object's snapshot, and the distance
-from where the object rests to the place is printed (median, share within 3 cm; a choice that names no action or
-fails to reach counts as the start's distance). ``--spread`` sets the search's spread weight
-(:data:`affordance_learning.planning.planner.SPREAD_WEIGHT`) for a planner beside the default, to measure it.
+what one core spends, where the wall clock also counts the waits) and, over the goals, the model's expected
+distance of the chosen action to the place (the mean of its predictive outcomes) and its P(within 3 cm). The grid
+at equal time has as many candidates as fit in the search's median time (64 times the ratio of the two's medians
+on the first goals). With ``--execute`` each planner's choice, asked with the env's ``feasible``, is run in the
+simulator from the object's snapshot, and the distance from where the object rests to the place is printed
+(median, share within 3 cm; a choice that names no action or fails to reach counts as the start's distance).
+``--spread`` adds a planner beside the default for each spread weight given
+(:data:`affordance_learning.planning.planner.SPREAD_WEIGHT`), to measure it; ``--search-only`` leaves the grid out.
 """
 
 from __future__ import annotations
@@ -61,7 +63,9 @@ def main() -> None:
     parser.add_argument("--goals", type=int, default=3, help="place goals per object")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--execute", action="store_true", help="run each choice in the simulator")
-    parser.add_argument("--spread", type=float, default=None, help="a spread weight to compare with the default's")
+    parser.add_argument("--spread", type=float, nargs="*", default=[],
+                        help="spread weights to compare with the default's")
+    parser.add_argument("--search-only", action="store_true", help="leave the grid out")
     args = parser.parse_args()
     models = {b: load_action_model(b) for b in BEHAVIOR_NAMES}
     env = TapAffordanceGoalEnv(position_range="workspace")
@@ -76,8 +80,8 @@ def main() -> None:
         cases += [(i, features, start, draw_goal("place", start, rng), env.get_state()) for _ in range(args.goals)]
     planners: dict[str, tuple[Planner, float | None]] = {
         "cem": (Planner(models), None), "grid (64)": (Planner(models, optimizer="grid"), None)}
-    if args.spread is not None:
-        planners[f"cem, spread {args.spread:g}"] = (Planner(models), args.spread)
+    for weight in args.spread:
+        planners[f"cem, spread {weight:g}"] = (Planner(models), weight)
     with threadpool_limits(1):
         for planner, _ in planners.values():  # warm up: the leaves' sums are made at the first call
             planner.choose(cases[0][1], cases[0][3], cases[0][2])
@@ -86,6 +90,8 @@ def main() -> None:
         n = int(round(64 * cem_time / grid_time))  # a grid decision's time grows with its candidates
         if n > 64:
             planners[f"grid ({n}, equal time)"] = (Planner(models, n_candidates=n, optimizer="grid"), None)
+        if args.search_only:
+            planners = {k: v for k, v in planners.items() if not k.startswith("grid")}
         print(f"{len(cases)} place goals on {len({c[0] for c in cases})} objects; the search's median "
               f"{1000 * cem_time:.0f} ms fits a grid of {n} candidates")
         for label, (planner, spread) in planners.items():
