@@ -2,7 +2,7 @@
 for the cross-entropy search (the default) and the fixed grid of candidates, the grid also at the search's time.
 
     python benchmarks/planner.py [--objects 12] [--goals 3] [--seed 0] [--execute] [--spread 0 1]
-                                 [--search-only]
+                                 [--search-only] [--toward 0]
 
 Objects are drawn by ``TapAffordanceGoal-v2`` (reset seeds ``seed * 1000 + i``, objects anywhere in the
 behaviours' workspaces) and each gets ``--goals`` places 5-15 cm away, drawn as the plan experiment draws them
@@ -17,6 +17,8 @@ simulator from the object's snapshot, and the distance from where the object res
 (median, share within 3 cm; a choice that names no action or fails to reach counts as the start's distance).
 ``--spread`` adds a planner beside the default for each spread weight given
 (:data:`affordance_learning.planning.planner.SPREAD_WEIGHT`), to measure it; ``--search-only`` leaves the grid out.
+``--toward N`` also times :meth:`~affordance_learning.planning.planner.Planner.toward` (the workspaces' default
+``reachable``, more interactions to follow) toward the first N goals' places.
 """
 
 from __future__ import annotations
@@ -66,6 +68,7 @@ def main() -> None:
     parser.add_argument("--spread", type=float, nargs="*", default=[],
                         help="spread weights to compare with the default's")
     parser.add_argument("--search-only", action="store_true", help="leave the grid out")
+    parser.add_argument("--toward", type=int, default=0, help="time toward on the first this many goals too")
     args = parser.parse_args()
     models = {b: load_action_model(b) for b in BEHAVIOR_NAMES}
     env = TapAffordanceGoalEnv(position_range="workspace")
@@ -115,10 +118,21 @@ def main() -> None:
                             end = np.asarray(info["object"]["final_pose"][:2])
                     landed.append(goal.placement_error(end))
                 planner.forget_failures()
+            toward = []  # a multi-step episode's decision toward the same place, more interactions to follow
+            for _, features, start, goal, _ in cases[: args.toward]:
+                saved = planning.SPREAD_WEIGHT
+                planning.SPREAD_WEIGHT = saved if spread is None else spread
+                t = time.process_time()
+                planner.toward(features, start, goal.target_xy, goal.tolerance)
+                toward.append(time.process_time() - t)
+                planning.SPREAD_WEIGHT = saved
             t = 1000 * np.array(times)
             line = (f"{label:>22}: {np.median(t):6.1f} ms median, {np.quantile(t, 0.99):6.1f} ms p99; expected "
                     f"distance {100 * np.median(expected):.1f} cm median, {100 * np.mean(expected):.1f} cm mean, "
                     f"P(within 3 cm) {np.mean(p_goal):.2f} mean")
+            if toward:
+                line += (f"; toward: {1000 * np.median(toward):.1f} ms median, "
+                         f"{1000 * np.quantile(toward, 0.99):.1f} ms p99")
             if landed:
                 landed_cm = 100 * np.array(landed)
                 line += (f"; landed {np.median(landed_cm):.1f} cm median from the place, "

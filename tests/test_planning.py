@@ -201,11 +201,14 @@ def test_a_decision_asks_feasible_at_most_max_checks_times_and_breaks_ties_by_pr
     assert planner.toward(features, (-0.3, 0.0), (-0.2, 0.0), 0.03, feasible=never, steps_left=1,
                           reachable=None).behavior is None
     assert len(calls) == 5
-    # no candidate near one refused is asked in the same decision: the checks go to other regions and behaviours
+    # no ranked candidate near one refused is asked in the same decision: the checks go to other regions and
+    # behaviours; the canonical action, kept for last, is asked whatever was refused near it
     calls.clear()
     alone = Planner({"push": model}, n_candidates=64, max_checks=12)
     assert alone.choose(features, goal, feasible=never).checked == len(calls) < 12
-    assert all(np.linalg.norm(a - b) >= REFUSAL_RADIUS for i, a in enumerate(calls) for b in calls[:i])
+    assert np.all(calls[-1] == 0.0)
+    ranked = calls[:-1]
+    assert all(np.linalg.norm(a - b) >= REFUSAL_RADIUS for i, a in enumerate(ranked) for b in ranked[:i])
     names = []
     assert planner.choose(features, goal, feasible=lambda name, params: names.append(name) or name == "draw"
                           ).behavior == "draw"

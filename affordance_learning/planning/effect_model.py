@@ -22,6 +22,7 @@ to every neighbour's outcome rather than to the mean alone, so that the distribu
 from __future__ import annotations
 
 import copy
+import functools
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -84,13 +85,36 @@ def _summed(weights: sparse.csr_matrix) -> sparse.csr_matrix:
     return sparse.csr_matrix((dense[stored], stored % n, indptr), shape=(m, n))
 
 
+@functools.lru_cache(maxsize=8)
+def _upper(k: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.triu_indices(k)``, made once per k."""
+    return np.triu_indices(k)
+
+
 def _symmetric(upper: np.ndarray, k: int) -> np.ndarray:
     """(..., k, k) the symmetric matrices whose upper triangles (``np.triu_indices(k)`` order) are ``upper``."""
-    out = np.zeros(upper.shape[:-1] + (k, k))
-    i, j = np.triu_indices(k)
+    out = np.empty(upper.shape[:-1] + (k, k))
+    i, j = _upper(k)
     out[..., i, j] = upper
     out[..., j, i] = upper
     return out
+
+
+def _solve(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.linalg.solve(a, b)`` for stacks of symmetric positive definite ``a`` (..., k, k); for k = 3 (the
+    action's parameters) by the adjugate, several times faster than LAPACK's loop over small matrices."""
+    if a.shape[-1] != 3:
+        return np.linalg.solve(a, b)
+    c00 = a[..., 1, 1] * a[..., 2, 2] - a[..., 1, 2] * a[..., 2, 1]
+    c01 = a[..., 1, 2] * a[..., 2, 0] - a[..., 1, 0] * a[..., 2, 2]
+    c02 = a[..., 1, 0] * a[..., 2, 1] - a[..., 1, 1] * a[..., 2, 0]
+    c11 = a[..., 0, 0] * a[..., 2, 2] - a[..., 0, 2] * a[..., 2, 0]
+    c12 = a[..., 0, 1] * a[..., 2, 0] - a[..., 0, 0] * a[..., 2, 1]
+    c22 = a[..., 0, 0] * a[..., 1, 1] - a[..., 0, 1] * a[..., 1, 0]
+    det = a[..., 0, 0] * c00 + a[..., 0, 1] * c01 + a[..., 0, 2] * c02
+    inverse = np.stack([np.stack([c00, c01, c02], -1), np.stack([c01, c11, c12], -1),
+                        np.stack([c02, c12, c22], -1)], -2) / det[..., None, None]
+    return inverse @ b
 
 
 @dataclass(frozen=True)
@@ -292,7 +316,10 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         forest's own spreads its trees over joblib tasks, whose overhead (about 0.1 ms per tree) is most of a
         planner's decision when it scores a few hundred queries."""
         X32 = np.ascontiguousarray(X, dtype=np.float32)  # the trees' own input type, as the forest converts it
-        return np.column_stack([tree.tree_.apply(X32) for tree in self.forest_.estimators_])
+        leaves = np.empty((len(X32), len(self.forest_.estimators_)), dtype=np.intp)
+        for t, tree in enumerate(self.forest_.estimators_):
+            leaves[:, t] = tree.tree_.apply(X32)
+        return leaves
 
     @staticmethod
     def _leaf_onehot(leaf_ids: np.ndarray) -> tuple[np.ndarray, sparse.csr_matrix]:
@@ -448,7 +475,7 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         cov_y = second_y - mean_y[..., :, None] * mean_y[..., None, :]
         if k:
             fitted = (mass > 0) & (mass**2 / np.maximum(squares, 1e-300) >= MIN_SLOPE_NEIGHBOURS)
-            slopes = np.linalg.solve(cov_p + SLOPE_RIDGE * np.eye(k), cov_py)  # (m, kinds, k, 2)
+            slopes = _solve(cov_p + SLOPE_RIDGE * np.eye(k), cov_py)  # (m, kinds, k, 2)
             slopes[~fitted] = 0.0
             actions = X[:, X.shape[1] - k:]
             mean_y = mean_y + np.einsum("mck,mckj->mcj", actions[:, None, :] - mean_p, slopes)

@@ -716,25 +716,25 @@ class Planner:
         second = self.params[: LOOKAHEAD_SECOND]
         best = np.zeros(len(keys))
         nearest = np.full(len(keys), np.inf)  # the expected distance after the best second interaction
-        starts = np.repeat(xy, len(second), axis=0)  # each query's start: its state's
         target = np.asarray(goal.target_xy)
+        evaluations = 0
         for name, model in self.models.items():
-            X2 = np.hstack([np.repeat(seen, len(second), axis=0), np.tile(second, (len(keys), 1))])
+            acts = np.flatnonzero(np.ones(len(keys), bool) if reachable is None else reachable(name, xy))
+            if not acts.size:  # the behaviour reaches none of the states: it scores none of them
+                continue
+            X2 = np.hstack([np.repeat(seen[acts], len(second), axis=0), np.tile(second, (len(acts), 1))])
             moments = model.kind_moments(X2, check_input=False)
-            p2, g2 = _gaussian_score(moments, goal, starts, self.table)
-            p2, d2 = p2.reshape(len(keys), len(second)), -g2.reshape(len(keys), len(second))
-            if reachable is not None:
-                acts = np.asarray(reachable(name, xy), dtype=bool)
-                p2, d2 = p2 * acts[:, None], np.where(acts[:, None], d2, np.inf)
-            best = np.maximum(best, p2.max(axis=1))
-            nearest = np.minimum(nearest, d2.min(axis=1))
+            p2, g2 = _gaussian_score(moments, goal, np.repeat(xy[acts], len(second), axis=0), self.table)
+            best[acts] = np.maximum(best[acts], p2.reshape(len(acts), len(second)).max(axis=1))
+            nearest[acts] = np.minimum(nearest[acts], -g2.reshape(len(acts), len(second)).max(axis=1))
+            evaluations += len(X2)
         here = np.linalg.norm(xy - target, axis=1)
         for name, k, mass, followed in links:  # the followed outcomes stand for all that leave something to do
             total = sum(w for _, w in followed)
             value[name][k] += mass * sum(w * best[state] for state, w in followed) / total
             gain = sum(w * min(nearest[state] - here[state], 0.0) for state, w in followed) / total
             distance[name][k] += mass * gain
-        return len(keys) * len(second) * len(self.models)
+        return evaluations
 
 
 def _order(p: np.ndarray, g: np.ndarray, step: float, excluded: np.ndarray) -> np.ndarray:
