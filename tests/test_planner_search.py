@@ -142,3 +142,35 @@ def test_a_choice_without_an_action_has_none_and_says_why_and_checks_stay_within
     assert unlikely.abstained and unlikely.params is not None and "threshold" in unlikely.reason
     with pytest.raises(ValueError, match="optimizer"):
         Planner(models, optimizer="annealing")
+
+
+def _mover(dx: float, dy: float, n: int = 300, seed: int = 0) -> ActionEffectModel:
+    """A behaviour that moves every object by (dx, dy) [m], whatever its 2 features and the 3 parameters."""
+    rng = np.random.default_rng(seed)
+    X = np.column_stack([rng.uniform(-0.2, 0.2, n), rng.normal(size=n), rng.uniform(-1, 1, (n, 3))])
+    Y = pd.DataFrame({"dx": dx + rng.normal(0, 1e-4, n), "dy": dy + rng.normal(0, 1e-4, n), "rolled": np.zeros(n),
+                      "off_table": np.zeros(n), "lifted": np.zeros(n), "effect_x": np.zeros(n),
+                      "effect_n": np.zeros(n)})
+    return ActionEffectModel(n_estimators=30, random_state=seed).fit(X, Y)
+
+
+def test_toward_first_moves_the_object_where_a_behaviour_can_act_toward_the_target():
+    # The target lies 15 cm toward the robot; only the draw brings an object that way, and it acts only on objects
+    # right of y = 0.03 (not where this one is). A tap moves it 5 cm right, where the draw can; a push 2 cm
+    # toward the robot (nearer the target after one interaction, 13 cm, but where nothing can draw it further).
+    planner = Planner({"tap": _mover(0.0, 0.05), "push": _mover(0.02, 0.0, seed=1),
+                       "draw": _mover(0.15, 0.0, seed=2)})
+    features, start, target = np.array([0.0, 0.0]), (-0.45, 0.0), (-0.30, 0.0)
+
+    def reachable(name, xy):
+        return xy[:, 1] > 0.03 if name == "draw" else np.ones(len(xy), bool)
+
+    def feasible(name, params):  # the draw cannot reach the object where it is
+        return name != "draw"
+
+    greedy = planner.toward(features, start, target, 0.03, feasible=feasible, steps_left=1, reachable=reachable)
+    assert greedy.behavior == "push"  # the nearest after one interaction
+    ahead = planner.toward(features, start, target, 0.03, feasible=feasible, reachable=reachable)
+    assert ahead.behavior == "tap" and ahead.expected_distance < 0.06  # a tap then a draw: 5 cm off
+    assert planner.toward(features, start, target, 0.03, feasible=feasible, steps_left=3,
+                          reachable=reachable).behavior == "tap"  # the horizon follows steps_left

@@ -662,17 +662,20 @@ class Planner:
     def _look_ahead(self, features, goal, predicted, ends, p1, distance, value, reachable, candidates) -> int:
         """Add to ``value`` (P(within) of each first action) the chance of a second interaction (see
         :meth:`toward`), and bring ``distance`` down to the expected distance after the best second interaction
-        where that is nearer, over the ``LOOKAHEAD_ROOTS`` first actions nearest on average and most likely,
-        their ``LOOKAHEAD_OUTCOMES`` most likely outcomes each, and ``LOOKAHEAD_SECOND`` parameter vectors per
-        behaviour for the second (scored by the search's cheap score: :meth:`_moment_score`). ``predicted`` and
-        ``ends``: per behaviour, the first actions' predictive outcomes and, per entry, where it ends, whether it
-        left the table and whether it ends within the tolerance. Returns the model evaluations it made."""
+        where that is nearer, over the ``LOOKAHEAD_ROOTS`` first actions nearest on average, half as many most
+        likely and each behaviour's nearest (a behaviour that brings the object nowhere near may bring it where
+        another can act), their ``LOOKAHEAD_OUTCOMES`` most likely outcomes each, and ``LOOKAHEAD_SECOND``
+        parameter vectors per behaviour for the second (scored by the search's cheap score:
+        :meth:`_moment_score`). ``predicted`` and ``ends``: per behaviour, the first actions' predictive outcomes
+        and, per entry, where it ends, whether it left the table and whether it ends within the tolerance.
+        Returns the model evaluations it made."""
         names = list(self.models)
         flat = [(n, k) for n in names for k in range(len(candidates[n]))]
         p_all = np.concatenate([p1[n] for n in names])
         d_all = np.concatenate([distance[n] for n in names])
         roots = list(dict.fromkeys([flat[i] for i in np.argsort(d_all, kind="stable")[:LOOKAHEAD_ROOTS]]
-                                   + [flat[i] for i in np.argsort(-p_all, kind="stable")[:LOOKAHEAD_ROOTS // 2]]))
+                                   + [flat[i] for i in np.argsort(-p_all, kind="stable")[:LOOKAHEAD_ROOTS // 2]]
+                                   + [(n, int(np.argmin(distance[n]))) for n in names]))  # each behaviour's nearest
         # The outcomes (root, training row) the roots lead to: where each ends and the training row of its effect.
         states: dict[tuple[str, int, int], int] = {}
         where: list[np.ndarray] = []
