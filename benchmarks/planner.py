@@ -14,7 +14,8 @@ distance of the chosen action to the place (the mean of its predictive outcomes)
 at equal time has as many candidates as fit in the search's median time (64 times the ratio of the two's medians
 on the first goals). With ``--execute`` each planner's choice, asked with the env's ``feasible``, is run in the
 simulator from the object's snapshot, and the distance from where the object rests to the place is printed
-(median, share within 3 cm; a choice that names no action or fails to reach counts as the start's distance).
+(median, share within 3 cm; a choice that names no action or fails to reach counts as the start's distance),
+also over the goals where the choice's P reached the planner's threshold (it did not abstain).
 ``--spread`` adds a planner beside the default for each spread weight given
 (:data:`affordance_learning.planning.planner.SPREAD_WEIGHT`), to measure it; ``--search-only`` leaves the grid out.
 ``--toward N`` also times :meth:`~affordance_learning.planning.planner.Planner.toward` (the workspaces' default
@@ -98,7 +99,7 @@ def main() -> None:
         print(f"{len(cases)} place goals on {len({c[0] for c in cases})} objects; the search's median "
               f"{1000 * cem_time:.0f} ms fits a grid of {n} candidates")
         for label, (planner, spread) in planners.items():
-            times, expected, p_goal, landed = [], [], [], []
+            times, expected, p_goal, landed, committed = [], [], [], [], []
             for _, features, start, goal, state in cases:
                 choice, seconds = _decide(planner, spread, features, goal, start)
                 times.append(seconds)
@@ -117,6 +118,7 @@ def main() -> None:
                         if info["failure"] is None or not info["failure"].startswith(("ik", "reach")):
                             end = np.asarray(info["object"]["final_pose"][:2])
                     landed.append(goal.placement_error(end))
+                    committed.append(choice.behavior is not None and not choice.abstained)
                 planner.forget_failures()
             toward = []  # a multi-step episode's decision toward the same place, more interactions to follow
             for _, features, start, goal, _ in cases[: args.toward]:
@@ -135,8 +137,11 @@ def main() -> None:
                          f"{1000 * np.quantile(toward, 0.99):.1f} ms p99")
             if landed:
                 landed_cm = 100 * np.array(landed)
+                sure = np.array(committed)
                 line += (f"; landed {np.median(landed_cm):.1f} cm median from the place, "
-                         f"{np.mean(landed_cm <= 100 * goal.tolerance):.0%} within 3 cm")
+                         f"{np.mean(landed_cm <= 100 * goal.tolerance):.0%} within 3 cm; where P >= the threshold "
+                         f"({sure.sum()} goals) {np.median(landed_cm[sure]) if sure.any() else np.nan:.1f} cm median, "
+                         f"{np.mean(landed_cm[sure] <= 100 * goal.tolerance) if sure.any() else np.nan:.0%} within")
             print(line)
 
 

@@ -19,6 +19,7 @@ ROOT = Path(__file__).resolve().parents[1]
     ["benchmarks/put_down_offset.py", "--draws", "4"],  # wraps MotionExecutor.line and grasp.plan_grasp
     ["benchmarks/render_frames.py", "--episodes", "2"],  # replaces World.picture
     ["benchmarks/reach_clearance.py", "--episodes", "2"],  # plans the reach with the strokes' functions
+    ["benchmarks/planner.py", "--objects", "2", "--goals", "1", "--spread", "0"],  # sets planner.SPREAD_WEIGHT
 ])
 def test_benchmark_runs(argv):
     done = subprocess.run([sys.executable, *argv], cwd=ROOT, capture_output=True, text=True, timeout=600)

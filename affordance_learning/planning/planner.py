@@ -57,13 +57,15 @@ SCENE_TABLE = table_extent()
 SEEN_MARGIN = 0.05
 #: The search over two interactions (:meth:`Planner.toward`): first actions looked at (the nearest on average,
 #: and half as many of the most likely), predicted outcomes followed from each, and parameter vectors per
-#: behaviour for the second interaction (the first of the planner's candidates). 8 and 4 instead of 16 and 8 make
-#: the same first choice in 39 of 40 decisions on ``affordance plan``'s models of seed 0, in half the time.
+#: behaviour for the second interaction (the first of the planner's candidates), besides each behaviour's nearest
+#: first action. 8 and 4 instead of 16 and 8 made the same first choice in 39 of 40 decisions on ``affordance
+#: plan``'s models of seed 0, in half the time (measured with the fixed candidates, before the search).
 LOOKAHEAD_ROOTS, LOOKAHEAD_OUTCOMES, LOOKAHEAD_SECOND = 8, 4, 8
 #: A first action is chosen for its value over two interactions when that value is at least this.
 MIN_SEQUENCE_VALUE = 0.1
-#: Calls to ``feasible`` per decision at most: the candidates asked, from the best down. Each costs 2-70 ms (the
-#: grasp's the most); 12 keep a decision under a second where the most likely candidates are out of reach.
+#: Calls to ``feasible`` per decision at most: the candidates asked, from the best down, of which one per behaviour
+#: is kept for its canonical action (:meth:`Planner._search`). Each costs 2-70 ms (the grasp's the most); 12 keep
+#: a decision under a second where the most likely candidates are out of reach.
 MAX_CHECKS = 12
 #: :meth:`Planner.choose` ranks candidates by P(goal) in steps of this, then by their expected progress towards the
 #: goal: P is a weighted share of a few hundred training outcomes, and differences under a few per cent are its
