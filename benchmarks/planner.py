@@ -18,8 +18,10 @@ simulator from the object's snapshot, and the distance from where the object res
 also over the goals where the choice's P reached the planner's threshold (it did not abstain).
 ``--spread`` adds a planner beside the default for each spread weight given
 (:data:`affordance_learning.planning.planner.SPREAD_WEIGHT`), to measure it; ``--search-only`` leaves the grid out.
-``--toward N`` also times :meth:`~affordance_learning.planning.planner.Planner.toward` (the workspaces' default
-``reachable``, more interactions to follow) toward the first N goals' places.
+First it prints the CPU time of 1000 queries over every behaviour, scored on their whole predictive outcomes
+and by the search's per-kind moments. ``--toward N`` also times
+:meth:`~affordance_learning.planning.planner.Planner.toward` (the workspaces' default ``reachable``, more
+interactions to follow) toward the first N goals' places.
 """
 
 from __future__ import annotations
@@ -60,6 +62,23 @@ def _decide(planner: Planner, spread: float | None, *args, **kwargs):
         planning.SPREAD_WEIGHT = saved
 
 
+def _evaluation_times(models, features) -> None:
+    """Print the CPU time of 1000 queries' whole predictive outcomes and of their per-kind moments, over every
+    behaviour (the features of one object, actions drawn uniformly), the best of 3."""
+    X = np.hstack([np.repeat(np.asarray(features, dtype=np.float64)[None], 1000, axis=0),
+                   np.random.default_rng(0).uniform(-1, 1, (1000, 3))])
+    for model in models.values():
+        model.kind_moments(X[:2])  # the leaves' sums are made at the first call
+    for label, method in (("predictive_outcomes", "predictive_outcomes"), ("kind_moments", "kind_moments")):
+        best = np.inf
+        for _ in range(3):
+            t = time.process_time()
+            for model in models.values():
+                getattr(model, method)(X)
+            best = min(best, time.process_time() - t)
+        print(f"{label}: {1000 * best:.0f} ms for 1000 queries over the {len(models)} behaviours")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--objects", type=int, default=12)
@@ -87,6 +106,7 @@ def main() -> None:
     for weight in args.spread:
         planners[f"cem, spread {weight:g}"] = (Planner(models), weight)
     with threadpool_limits(1):
+        _evaluation_times(models, cases[0][1])
         for planner, _ in planners.values():  # warm up: the leaves' sums are made at the first call
             planner.choose(cases[0][1], cases[0][3], cases[0][2])
         cem_time, grid_time = (np.median([_decide(planners[k][0], None, f, g, s)[1] for _, f, s, g, _ in cases[:6]])
