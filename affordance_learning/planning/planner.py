@@ -721,7 +721,11 @@ class Planner:
             return self.models[name].outcomes_[j, columns] if len(columns) else 0.0
 
         xy = np.array(where)
-        seen = np.array([features + effect(n, j) for n, _, j in keys])
+        # The models' inputs at a state are the features it is seen with (the root's behaviour and the training
+        # outcome's effect), not where it is: states that share them share the models' moments.
+        inputs: dict[tuple[str, int], int] = {}
+        row = np.array([inputs.setdefault((n, j), len(inputs)) for n, _, j in keys])
+        seen = np.array([features + effect(n, j) for n, j in inputs])
         second = self.params[: LOOKAHEAD_SECOND]
         best = np.zeros(len(keys))
         nearest = np.full(len(keys), np.inf)  # the expected distance after the best second interaction
@@ -731,8 +735,11 @@ class Planner:
             acts = np.flatnonzero(np.ones(len(keys), bool) if reachable is None else reachable(name, xy))
             if not acts.size:  # the behaviour reaches none of the states: it scores none of them
                 continue
-            X2 = np.hstack([np.repeat(seen[acts], len(second), axis=0), np.tile(second, (len(acts), 1))])
-            moments = model.kind_moments(X2, check_input=False)
+            needed = np.unique(row[acts])
+            X2 = np.hstack([np.repeat(seen[needed], len(second), axis=0), np.tile(second, (len(needed), 1))])
+            found = model.kind_moments(X2, check_input=False)
+            at = (np.searchsorted(needed, row[acts])[:, None] * len(second) + np.arange(len(second))).ravel()
+            moments = KindMoments(found.mass[at], found.mean[at], found.covariance[at], found.flags)
             p2, g2 = _gaussian_score(moments, goal, np.repeat(xy[acts], len(second), axis=0), self.table)
             best[acts] = np.maximum(best[acts], p2.reshape(len(acts), len(second)).max(axis=1))
             nearest[acts] = np.minimum(nearest[acts], -g2.reshape(len(acts), len(second)).max(axis=1))
