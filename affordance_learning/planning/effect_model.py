@@ -440,8 +440,9 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
 
         Every sum the slopes and moments need is linear in the forest's weights, so it is the mean over the
         query's leaves of sums stored per leaf (computed once, at the first call): a query costs one sparse
-        row of T leaves, not the few hundred neighbours of :meth:`predictive_outcomes` (about 20 times less on
-        the shipped models: ``benchmarks/planner.py``). The weights, means and covariances are those of
+        row of T leaves, not the few hundred neighbours of :meth:`predictive_outcomes` (on the shipped models,
+        1000 queries over the five behaviours took 85 ms of CPU time against 293 ms: ``benchmarks/planner.py``,
+        which times both). The weights, means and covariances are those of
         :meth:`predictive_outcomes`' entries to float tolerance, but for one thing: whether a kind has the
         :data:`MIN_SLOPE_NEIGHBOURS` effective neighbours a slope needs is judged from the leaves' sums of
         squared weights, which do not add up a training outcome that several trees share (more effective
