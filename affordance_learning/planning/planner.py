@@ -473,7 +473,7 @@ class Planner:
 
     # --- asking feasible -----------------------------------------------------------------------------------------
     def _search(self, rankings, feasible, excluded: set[tuple[str, int]], candidates: Mapping[str, np.ndarray],
-                asked: dict[tuple[str, int], bool] | None = None):
+                asked: dict[tuple[str, int], bool] | None = None, fallback: bool = True):
         """The first entry, over ``rankings`` in turn (each a list of entries ending with behaviour and index in
         ``candidates``, the last of them every candidate), that is not ``excluded`` and that ``feasible`` accepts;
         and how many times ``feasible`` was asked.
@@ -484,11 +484,12 @@ class Planner:
         canonical actions not asked about yet are, the most promising behaviour first, whatever was refused near
         them (the behaviours' workspaces are made around their canonical actions). With fewer checks than
         behaviours, the ranked candidates get one and the canonical actions of the behaviours ranked first the
-        others. Without ``feasible`` the first entry not excluded."""
+        others. Without ``fallback`` no check is kept (a refinement around an action already found). Without
+        ``feasible`` the first entry not excluded."""
         asked = {} if asked is None else asked
         refused: list[tuple[str, np.ndarray]] = [(n, candidates[n][k]) for (n, k), ok in asked.items() if not ok]
         canonical = {name: int(np.flatnonzero(np.all(params == 0.0, axis=1))[0]) for name, params in
-                     candidates.items() if np.any(np.all(params == 0.0, axis=1))}
+                     candidates.items() if fallback and np.any(np.all(params == 0.0, axis=1))}
 
         def open_reserve() -> list[str]:
             return [n for n, k in canonical.items() if (n, k) not in asked and (n, k) not in excluded]
@@ -586,7 +587,7 @@ class Planner:
             for entry in self._ranked(around, goal):
                 if entry[-1] == len(p_local) or len(refined) >= min(REFINE_CHECKS, self.max_checks - checked):
                     break  # none better than the one found, or enough asked
-                found = self._search([[entry]], feasible, excluded, local, refined)[0]
+                found = self._search([[entry]], feasible, excluded, local, refined, fallback=False)[0]
                 if found is not None:
                     p, params = found[0], local[name][found[-1]]
                     break
