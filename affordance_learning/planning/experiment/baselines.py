@@ -21,10 +21,10 @@ from affordance_learning.planning.outcomes import outcome_table
 from affordance_learning.planning.planner import Planner
 
 #: Candidates of the grid planner set beside the search (:func:`grid_planner`): as many as take the search's time.
-#: ``python benchmarks/planner.py --objects 12 --goals 3 --execute`` (36 place goals, the shipped models, one
-#: thread) measured a median decision of 87 ms of CPU time for the search and 53 ms for the grid of 64, which
-#: makes 103; 104 is the nearest multiple of 8.
-GRID_CANDIDATES = 104
+#: Five runs of ``benchmarks/planner.py`` (seeds 0-2, 24-72 place goals, the shipped models, one thread, on a
+#: machine others shared) found the search's median decision to take as long as a grid of 87, 93, 96, 103 and 112
+#: candidates: 96, their median.
+GRID_CANDIDATES = 96
 
 
 def grid_planner(planner: Planner) -> Planner:
