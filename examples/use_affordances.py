@@ -43,10 +43,13 @@ def main() -> None:
     obs, info = env.reset(seed=args.seed, options={"object_type": "sphere", "size": 0.06, "position": (-0.3, 0.05)})
     goal = Move((0.0, -1.0), 0.05)  # 5 cm to the robot's right
     choice = planner.choose(obs["observation"]["features"], goal, obs["achieved_goal"], feasible=world.feasible)
-    print(f"goal: {describe(goal)} -> {choice.behavior} {np.round(choice.params, 2)}, P = {choice.probability:.2f}")
-    obs, _, _, _, info = env.step({"behavior": choice.behavior, "params": choice.params.astype(np.float32)})
-    moved = np.asarray(info["object"]["final_pose"][:2]) - np.asarray(info["object"]["initial_pose"][:2])
-    print(f"  the {info['object']['type']} moved {np.round(100 * moved, 1)} cm")
+    if choice.behavior is None:  # no action it asked about was feasible: the reason says so
+        print(f"goal: {describe(goal)} -> no action: {choice.reason}")
+    else:
+        print(f"goal: {describe(goal)} -> {choice.behavior} {np.round(choice.params, 2)}, P = {choice.probability:.2f}")
+        obs, _, _, _, info = env.step({"behavior": choice.behavior, "params": choice.params.astype(np.float32)})
+        moved = np.asarray(info["object"]["final_pose"][:2]) - np.asarray(info["object"]["initial_pose"][:2])
+        print(f"  the {info['object']['type']} moved {np.round(100 * moved, 1)} cm")
 
     obs, info = env.reset(seed=args.seed)
     print(f"episode: {info['object']['type']} at {np.round(obs['achieved_goal'], 3)}, target "
@@ -58,7 +61,7 @@ def main() -> None:
                                 world.goal_tolerance, feasible=world.feasible, steps_left=steps - step + 1,
                                 reachable=in_workspace)
         if choice.behavior is None:
-            print("  none of the candidates asked about is reachable: stopping")
+            print(f"  no action: {choice.reason}")
             break
         obs, reward, terminated, truncated, info = env.step(
             {"behavior": choice.behavior, "params": choice.params.astype(np.float32)})

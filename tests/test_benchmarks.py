@@ -20,6 +20,7 @@ ROOT = Path(__file__).resolve().parents[1]
     ["benchmarks/render_frames.py", "--episodes", "2"],  # replaces World.picture
     ["benchmarks/reach_clearance.py", "--episodes", "2"],  # plans the reach with the strokes' functions
     ["benchmarks/reach_lag.py", "--draws", "6"],  # plans the reach with the strokes' functions, watches the steps
+    ["benchmarks/planner.py", "--objects", "2", "--goals", "1", "--spread", "0"],  # sets planner.SPREAD_WEIGHT
 ])
 def test_benchmark_runs(argv):
     done = subprocess.run([sys.executable, *argv], cwd=ROOT, capture_output=True, text=True, timeout=600)

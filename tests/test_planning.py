@@ -143,10 +143,11 @@ def test_toward_searches_over_two_interactions_where_the_nearest_first_step_is_a
     assert greedy.behavior == "push" and greedy.probability == 0.0
     ahead = planner.toward(features, start, target, 0.015, steps_left=2)
     assert ahead.behavior == "tap" and ahead.value > 0.9 and ahead.probability == 0.0
-    # Where tap cannot act after the first interaction, the sequence is worth nothing: the nearest again.
+    # Where tap cannot act after the first interaction, the sequence is worth nothing; the nearest end after two
+    # interactions decides: a tap then a push ends 2 cm away, a push then anything 3 cm or more.
     blocked = planner.toward(features, start, target, 0.015, steps_left=2,
                              reachable=lambda name, xy: np.full(len(xy), name != "tap"))
-    assert blocked.behavior == "push" and blocked.value == 0.0
+    assert blocked.behavior == "tap" and blocked.value == 0.0 and blocked.expected_distance < 0.025
     with pytest.raises(ValueError, match="steps_left"):
         planner.toward(features, start, target, 0.015, steps_left=0)
     # By default toward looks ahead (more interactions may follow), as a multi-step episode wants.
@@ -200,11 +201,14 @@ def test_a_decision_asks_feasible_at_most_max_checks_times_and_breaks_ties_by_pr
     assert planner.toward(features, (-0.3, 0.0), (-0.2, 0.0), 0.03, feasible=never, steps_left=1,
                           reachable=None).behavior is None
     assert len(calls) == 5
-    # no candidate near one refused is asked in the same decision: the checks go to other regions and behaviours
+    # no ranked candidate near one refused is asked in the same decision: the checks go to other regions and
+    # behaviours; the canonical action, kept for last, is asked whatever was refused near it
     calls.clear()
     alone = Planner({"push": model}, n_candidates=64, max_checks=12)
     assert alone.choose(features, goal, feasible=never).checked == len(calls) < 12
-    assert all(np.linalg.norm(a - b) >= REFUSAL_RADIUS for i, a in enumerate(calls) for b in calls[:i])
+    assert np.all(calls[-1] == 0.0)
+    ranked = calls[:-1]
+    assert all(np.linalg.norm(a - b) >= REFUSAL_RADIUS for i, a in enumerate(ranked) for b in ranked[:i])
     names = []
     assert planner.choose(features, goal, feasible=lambda name, params: names.append(name) or name == "draw"
                           ).behavior == "draw"

@@ -22,7 +22,9 @@ to every neighbour's outcome rather than to the mean alone, so that the distribu
 from __future__ import annotations
 
 import copy
+import functools
 from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -81,6 +83,59 @@ def _summed(weights: sparse.csr_matrix) -> sparse.csr_matrix:
     stored = np.flatnonzero(dense)  # every weight is positive: a stored entry sums to more than 0
     indptr = np.concatenate([[0], np.cumsum(np.bincount(stored // n, minlength=m))])
     return sparse.csr_matrix((dense[stored], stored % n, indptr), shape=(m, n))
+
+
+@functools.lru_cache(maxsize=8)
+def _upper(k: int) -> tuple[np.ndarray, np.ndarray]:
+    """``np.triu_indices(k)``, made once per k."""
+    return np.triu_indices(k)
+
+
+def _symmetric(upper: np.ndarray, k: int) -> np.ndarray:
+    """(..., k, k) the symmetric matrices whose upper triangles (``np.triu_indices(k)`` order) are ``upper``."""
+    out = np.empty(upper.shape[:-1] + (k, k))
+    i, j = _upper(k)
+    out[..., i, j] = upper
+    out[..., j, i] = upper
+    return out
+
+
+def _solve(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.linalg.solve(a, b)`` for stacks of symmetric positive definite ``a`` (..., k, k); for k = 3 (the
+    action's parameters) by the adjugate, several times faster than LAPACK's loop over small matrices."""
+    if a.shape[-1] != 3:
+        return np.linalg.solve(a, b)
+    c00 = a[..., 1, 1] * a[..., 2, 2] - a[..., 1, 2] * a[..., 2, 1]
+    c01 = a[..., 1, 2] * a[..., 2, 0] - a[..., 1, 0] * a[..., 2, 2]
+    c02 = a[..., 1, 0] * a[..., 2, 1] - a[..., 1, 1] * a[..., 2, 0]
+    c11 = a[..., 0, 0] * a[..., 2, 2] - a[..., 0, 2] * a[..., 2, 0]
+    c12 = a[..., 0, 1] * a[..., 2, 0] - a[..., 0, 0] * a[..., 2, 1]
+    c22 = a[..., 0, 0] * a[..., 1, 1] - a[..., 0, 1] * a[..., 1, 0]
+    det = a[..., 0, 0] * c00 + a[..., 0, 1] * c01 + a[..., 0, 2] * c02
+    inverse = np.stack([np.stack([c00, c01, c02], -1), np.stack([c01, c11, c12], -1),
+                        np.stack([c02, c12, c22], -1)], -2) / det[..., None, None]
+    return inverse @ b
+
+
+@dataclass(frozen=True)
+class KindMoments:
+    """Queries' predictive distributions summed up per kind of outcome (:meth:`ActionEffectModel.kind_moments`).
+
+    Attributes:
+        mass: (m, kinds) each kind's weight in each query's distribution (rows sum to 1).
+        mean: (m, kinds, 2) the mean displacement (dx, dy) [m] of each kind's neighbours at the query's action.
+        covariance: (m, kinds, 2, 2) its covariance [m^2].
+        flags: (kinds, len(KIND_COLUMNS)) each kind's flags (rolled, left the table, lifted).
+    """
+
+    mass: np.ndarray
+    mean: np.ndarray
+    covariance: np.ndarray
+    flags: np.ndarray
+
+    def flag(self, name: str) -> np.ndarray:
+        """(kinds,) bool: whether each kind has the flag ``name`` (one of :data:`KIND_COLUMNS`)."""
+        return self.flags[:, KIND_COLUMNS.index(name)]
 
 
 class PredictiveOutcomes:
@@ -261,7 +316,10 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         forest's own spreads its trees over joblib tasks, whose overhead (about 0.1 ms per tree) is most of a
         planner's decision when it scores a few hundred queries."""
         X32 = np.ascontiguousarray(X, dtype=np.float32)  # the trees' own input type, as the forest converts it
-        return np.column_stack([tree.tree_.apply(X32) for tree in self.forest_.estimators_])
+        leaves = np.empty((len(X32), len(self.forest_.estimators_)), dtype=np.intp)
+        for t, tree in enumerate(self.forest_.estimators_):
+            leaves[:, t] = tree.tree_.apply(X32)
+        return leaves
 
     @staticmethod
     def _leaf_onehot(leaf_ids: np.ndarray) -> tuple[np.ndarray, sparse.csr_matrix]:
@@ -345,6 +403,113 @@ class ActionEffectModel(RegressorMixin, BaseEstimator):
         slopes = np.linalg.solve(covariance, cross - mean_p[..., :, None] * mean_y[..., None, :])
         slopes[~fitted] = 0.0
         return slopes
+
+    def _query_leaves(self, X: np.ndarray) -> sparse.csr_matrix:
+        """(m, leaves) each query's leaf in every tree, 1 / T each, as rows of the stacked table of leaves: the
+        forest's weights are this times the leaves' row-normalised membership (:meth:`predictive_weights`)."""
+        leaves = self._apply(X)  # (m, T)
+        node_offset, node_row = self._leaf_table[3:]
+        rows = node_row[(leaves + node_offset[None, :]).ravel()]
+        m, trees = leaves.shape
+        return sparse.csr_matrix((np.full(m * trees, 1.0 / trees), rows, np.arange(0, m * trees + 1, trees)),
+                                 shape=(m, len(self._leaf_table[0]) - 1))
+
+    def _leaf_means(self, values: np.ndarray) -> np.ndarray:
+        """(leaves, ...) the mean of ``values`` (one row per training outcome) over every leaf of every tree."""
+        indptr, indices, data = self._leaf_table[:3]
+        members = sparse.csr_matrix((data, indices, indptr), shape=(len(indptr) - 1, len(self.outcomes_)))
+        return np.asarray(members @ values.reshape(len(self.outcomes_), -1)).reshape(-1, *values.shape[1:])
+
+    def leaf_share(self, X, values) -> np.ndarray:
+        """(m,) each query's weighted mean of ``values`` (one per training outcome, (n,)): what
+        :meth:`PredictiveOutcomes.share` gives for values that do not depend on the query's action (a flag, the
+        perceptual effect; not the displacement, which :meth:`kind_moments` follows), to float tolerance, from
+        the mean of ``values`` in each leaf, without the query's neighbours one by one."""
+        check_is_fitted(self)
+        X = validate_data(self, X, reset=False, dtype=np.float64)
+        values = np.asarray(values, dtype=np.float64)
+        if values.shape != (len(self.outcomes_),):
+            raise InvalidValueError(f"values must be one number per training outcome ({len(self.outcomes_)},), got "
+                                    f"shape {values.shape}.")
+        return np.asarray(self._query_leaves(X) @ self._leaf_means(values)).ravel()
+
+    def kind_moments(self, X, *, check_input: bool = True) -> KindMoments:
+        """Each query's predictive distribution summed up per kind of outcome (:class:`KindMoments`): the weight
+        of each kind, and the mean and covariance of its displacement at the query's action, the neighbours'
+        displacements moved along the slopes :meth:`predictive_outcomes` fits.
+
+        Every sum the slopes and moments need is linear in the forest's weights, so it is the mean over the
+        query's leaves of sums stored per leaf (computed once, at the first call): a query costs one sparse
+        row of T leaves, not the few hundred neighbours of :meth:`predictive_outcomes` (on the shipped models,
+        1000 queries over the five behaviours took 85 ms of CPU time against 293 ms: ``benchmarks/planner.py``,
+        which times both). The weights, means and covariances are those of
+        :meth:`predictive_outcomes`' entries to float tolerance, but for one thing: whether a kind has the
+        :data:`MIN_SLOPE_NEIGHBOURS` effective neighbours a slope needs is judged from the leaves' sums of
+        squared weights, which do not add up a training outcome that several trees share (more effective
+        neighbours than there are: a kind of a handful of neighbours may get a slope here and none there).
+        ``check_input=False`` takes ``X`` as it is, a finite float64 array of the model's inputs (a caller that
+        made it so spares the check, about a millisecond a call).
+        """
+        check_is_fitted(self)
+        if not len(self.displacement_columns_):
+            raise InvalidValueError(f"kind_moments needs outcomes with {' and '.join(DISPLACEMENT_COLUMNS)}; the "
+                                    f"model's are {self.outcome_names_[:6]}.")
+        if check_input:
+            X = validate_data(self, X, reset=False, dtype=np.float64)
+        if getattr(self, "_kind_table", None) is None:
+            self._kind_table = self._kind_sums()
+        flags, sums = self._kind_table
+        kinds, k = len(flags), 0 if self.action_params_ is None else self.action_params_.shape[1]
+        query = self._query_leaves(X)
+        trees = len(self.forest_.estimators_)
+        totals = np.asarray(query @ sums).reshape(len(X), kinds, -1)
+        mass, squares = totals[:, :, 0], totals[:, :, -1] / trees  # sum w and (as the leaves see it) sum w^2
+        total = np.where(mass > 0, mass, 1.0)[:, :, None]
+        mean_p, mean_y = totals[:, :, 1 : 1 + k] / total, totals[:, :, 1 + k : 3 + k] / total
+        tri = 3 + k
+        second_p = _symmetric(totals[:, :, tri : tri + k * (k + 1) // 2] / total, k)
+        tri += k * (k + 1) // 2
+        second_y = _symmetric(totals[:, :, tri : tri + 3] / total, 2)
+        cross = totals[:, :, tri + 3 : tri + 3 + 2 * k].reshape(len(X), kinds, k, 2) / total[..., None]
+        cov_p = second_p - mean_p[..., :, None] * mean_p[..., None, :]
+        cov_py = cross - mean_p[..., :, None] * mean_y[..., None, :]
+        cov_y = second_y - mean_y[..., :, None] * mean_y[..., None, :]
+        if k:
+            fitted = (mass > 0) & (mass**2 / np.maximum(squares, 1e-300) >= MIN_SLOPE_NEIGHBOURS)
+            slopes = _solve(cov_p + SLOPE_RIDGE * np.eye(k), cov_py)  # (m, kinds, k, 2)
+            slopes[~fitted] = 0.0
+            actions = X[:, X.shape[1] - k:]
+            mean_y = mean_y + np.einsum("mck,mckj->mcj", actions[:, None, :] - mean_p, slopes)
+            # the covariance of y - S^T p: each neighbour's displacement moved to the same action
+            moved = np.einsum("mcki,mckj->mcij", slopes, cov_py)
+            cov_y = cov_y - moved - np.swapaxes(moved, -1, -2) + np.einsum(
+                "mcki,mckl,mclj->mcij", slopes, cov_p, slopes)
+        return KindMoments(mass, mean_y, cov_y, flags)
+
+    def _kind_sums(self) -> tuple[np.ndarray, np.ndarray]:
+        """The flags of every kind (kinds, len(KIND_COLUMNS)) and, per leaf, the mean over its training outcomes
+        of each kind's terms (1, p, p p^T, y, y y^T, p y^T, 1 / leaf size; the upper triangles of the symmetric
+        ones), (leaves, kinds * terms): what :meth:`kind_moments` sums over a query's leaves."""
+        y = self.outcomes_[:, self.displacement_columns_]
+        n = len(y)
+        p = np.zeros((n, 0)) if self.action_params_ is None else self.action_params_
+        k = p.shape[1]
+        flags = np.zeros((int(self.kinds_.max()) + 1, len(KIND_COLUMNS)), dtype=bool)
+        for j, name in enumerate(KIND_COLUMNS):
+            if name in self.outcome_names_:
+                flags[self.kinds_, j] = self.outcomes_[:, self.outcome_names_.index(name)] > 0.5
+        upper_p, upper_y = np.triu_indices(k), np.triu_indices(2)
+        terms = np.hstack([np.ones((n, 1)), p, y, (p[:, :, None] * p[:, None, :])[:, upper_p[0], upper_p[1]],
+                           (y[:, :, None] * y[:, None, :])[:, upper_y[0], upper_y[1]],
+                           (p[:, :, None] * y[:, None, :]).reshape(n, -1)])
+        indptr = self._leaf_table[0]
+        size = np.diff(indptr)  # each leaf's training outcomes, once per entry of the leaf
+        blocks = np.zeros((n, len(flags), terms.shape[1] + 1))
+        blocks[np.arange(n), self.kinds_, :-1] = terms
+        sums = self._leaf_means(blocks.reshape(n, -1)).reshape(len(size), len(flags), -1)
+        # sum over a leaf's outcomes of its weight squared, T^2 times: its kind's count over the leaf's size^2
+        sums[:, :, -1] = sums[:, :, 0] / size[:, None]
+        return flags, sums.reshape(len(size), -1)
 
     def predict(self, X) -> np.ndarray:
         """The mean outcome under the predictive distribution (:meth:`predictive_outcomes`), (m, n_outcomes) (or

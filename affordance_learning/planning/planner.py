@@ -1,14 +1,30 @@
 """Choosing what to do: the behaviour and its parameters that make a goal most likely, from the effect models.
 
-:class:`Planner` scores candidate actions, every behaviour with ``n_candidates`` parameter vectors (the canonical
-action and a scrambled Sobol sequence over [-1, 1]^3), by P(goal) under each behaviour's
-:class:`~affordance_learning.planning.effect_model.ActionEffectModel`, and takes the most likely one that the arm can
-reach: ``feasible`` (the kinematics, tens of milliseconds a call) is asked from the most likely down, at most
-``max_checks`` times per decision, so that a decision costs a few calls, not one per candidate. Candidates of equal
-P (every one near 0 for a goal out of reach) are ranked by how far their predicted outcomes go towards the goal,
-then candidate by candidate across the behaviours. Below ``threshold`` it abstains. :meth:`Planner.toward` chooses
-the next interaction of a multi-step episode towards a place on the table: by default a search over two
-interactions, where the behaviours' workspaces say a second one can act (re-planned after every interaction).
+:class:`Planner` chooses every behaviour's parameters in [-1, 1]^3 by an optimiser over the action (``optimizer``
+``"cem"``, the default): a cross-entropy search per behaviour, seeded by ``n_candidates`` parameter vectors (the
+canonical action and a scrambled Sobol sequence), that refits a Gaussian to its elite actions
+(:data:`CEM_ELITES`) and draws :data:`CEM_SAMPLES` more from it, :data:`CEM_ITERATIONS` times. Its score is the
+cheap one of :meth:`~affordance_learning.planning.effect_model.ActionEffectModel.kind_moments` (each kind of
+outcome's weight and the mean and covariance of its displacement at the action): P(goal), for a goal with a
+distance from a Gaussian per kind, then how far the predicted outcomes go towards the goal less
+:data:`SPREAD_WEIGHT` times their spread. A decision scores (64 + 2 x 96) x 5 = 1280 actions so (summed over the
+behaviours: :data:`EVALUATIONS`); the best few of each behaviour, and the best of other regions of its parameters
+(:data:`FINALISTS`, :data:`FINALIST_REGIONS`) and its canonical action, are then scored on their whole predictive
+outcomes (:meth:`~affordance_learning.planning.effect_model.ActionEffectModel.predictive_outcomes`), which says
+the P(goal) a choice reports. ``optimizer="grid"`` scores the ``n_candidates`` vectors alone on their whole
+predictive outcomes, and for a goal with a distance :data:`REFINE_POINTS` more around the best of them: the
+planner as it was, for comparison at equal time (``benchmarks/planner.py``).
+
+Of the actions scored, the planner takes the most likely one that the arm can reach: ``feasible`` (the
+kinematics, tens of milliseconds a call) is asked from the most likely down, at most ``max_checks`` times per
+decision, keeping one of those checks for the canonical action of every behaviour not asked about yet, so that no
+behaviour is passed over for the refusals of another's. Actions of equal P (every one near 0 for a goal out of
+reach) are ranked by how far their predicted outcomes go towards the goal, then action by action across the
+behaviours. Below ``threshold`` the choice is flagged ``abstained`` (it still names the most likely action); where
+no action it asked about is feasible it names none (``behavior`` and ``params`` None, and a ``reason``).
+:meth:`Planner.toward` chooses the next interaction of a multi-step episode towards a place on the table: a search
+over two interactions where more are left (``steps_left``), where the behaviours' workspaces say a second one can
+act, re-planned after every interaction.
 
 The planner remembers the actions that failed (:meth:`Planner.note_failure`: they failed to reach, or left the
 object where it was): on an object still where one failed (within ``FAILURE_RADIUS``), no action within
@@ -22,6 +38,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.special import ndtr
 from scipy.stats import qmc
 
 from affordance_env.registry import BEHAVIOR_NAMES
@@ -29,8 +46,8 @@ from affordance_env.table import table_extent
 from affordance_env.values import float_array, is_integer
 from affordance_learning.common.exceptions import InvalidValueError
 from affordance_learning.common.validation import check_float32_range
-from affordance_learning.planning.effect_model import ActionEffectModel, PredictiveOutcomes
-from affordance_learning.planning.goals import OFF_TABLE_DISTANCE, Goal, Place, check_goal, check_start
+from affordance_learning.planning.effect_model import ActionEffectModel, KindMoments, PredictiveOutcomes
+from affordance_learning.planning.goals import OFF_TABLE_DISTANCE, Goal, Move, Place, check_goal, check_start
 
 #: The scene's table top, ((x_low, y_low), (x_high, y_high)) [m] in the robot's root frame: the planner's default
 #: ``table``.
@@ -40,13 +57,15 @@ SCENE_TABLE = table_extent()
 SEEN_MARGIN = 0.05
 #: The search over two interactions (:meth:`Planner.toward`): first actions looked at (the nearest on average,
 #: and half as many of the most likely), predicted outcomes followed from each, and parameter vectors per
-#: behaviour for the second interaction (the first of the planner's candidates). 8 and 4 instead of 16 and 8 make
-#: the same first choice in 39 of 40 decisions on ``affordance plan``'s models of seed 0, in half the time.
+#: behaviour for the second interaction (the first of the planner's candidates), besides each behaviour's nearest
+#: first action. 8 and 4 instead of 16 and 8 made the same first choice in 39 of 40 decisions on ``affordance
+#: plan``'s models of seed 0, in half the time (measured with the fixed candidates, before the search).
 LOOKAHEAD_ROOTS, LOOKAHEAD_OUTCOMES, LOOKAHEAD_SECOND = 8, 4, 8
 #: A first action is chosen for its value over two interactions when that value is at least this.
 MIN_SEQUENCE_VALUE = 0.1
-#: Calls to ``feasible`` per decision at most: the candidates asked, from the best down. Each costs 2-70 ms (the
-#: grasp's the most); 12 keep a decision under a second where the most likely candidates are out of reach.
+#: Calls to ``feasible`` per decision at most: the candidates asked, from the best down, of which one per behaviour
+#: is kept for its canonical action (:meth:`Planner._search`). Each costs 2-70 ms (the grasp's the most); 12 keep
+#: a decision under a second where the most likely candidates are out of reach.
 MAX_CHECKS = 12
 #: :meth:`Planner.choose` ranks candidates by P(goal) in steps of this, then by their expected progress towards the
 #: goal: P is a weighted share of a few hundred training outcomes, and differences under a few per cent are its
@@ -64,6 +83,35 @@ REFUSAL_RADIUS = 1.0
 #: 0.25 apart in the two parameters that aim a stroke or a place: 5 cm of a pick and place's 20 cm range, coarser
 #: than a place's 3 cm tolerance.
 REFINE_POINTS, REFINE_RADIUS, REFINE_CHECKS = 16, 0.15, 2
+#: The optimisers :class:`Planner` takes (``optimizer``): a cross-entropy search over each behaviour's parameters,
+#: or the fixed candidates and a refinement around the best.
+OPTIMIZERS = ("cem", "grid")
+#: The cross-entropy search: iterations after the seed candidates, actions drawn per behaviour and iteration, and
+#: the elite actions (the best of all scored so far) whose mean and per-parameter spread the next draw follows.
+#: With the 64 seed candidates, (64 + 2 x 96) x 5 behaviours = 1280 actions scored per decision: two iterations
+#: of 96 rather than three of 64, since a call of a model costs about 2 ms whatever its size (a hundred trees).
+CEM_ITERATIONS, CEM_SAMPLES, CEM_ELITES = 2, 96, 8
+#: The spread of a draw is kept at least this (per parameter, in [-1, 1] units): 0.01 of a pick and place's
+#: 0.2 m per unit is 2 mm, under the arm's own precision of a place, so the search does not collapse sooner.
+CEM_MIN_STD = 0.01
+#: Per behaviour, the actions the search scored best (``FINALISTS``) and the best of other regions of its
+#: parameters (at most ``FINALIST_REGIONS``, each at least REFUSAL_RADIUS from the others), with its canonical
+#: action, are scored on their whole predictive outcomes and ranked for ``feasible``: the others give the checks
+#: somewhere to go where the best region is out of reach.
+FINALISTS, FINALIST_REGIONS = 4, 3
+#: Model evaluations per decision of the default optimiser, summed over the five behaviours: the cross-entropy
+#: search's cheap scores and the finalists' whole predictive outcomes.
+EVALUATIONS = 5 * (64 + CEM_ITERATIONS * CEM_SAMPLES + FINALISTS + FINALIST_REGIONS + 1)  # 1320
+#: For a goal with a distance, an action's expected progress towards the goal is taken less this many times its
+#: spread (the standard deviation of the progress under the predictive distribution): of two actions as likely to
+#: reach the goal and that end as near on average, the one the model is surer of (P(goal) first, itself lower where
+#: the outcomes spread, is the larger part of the penalty). ``python benchmarks/planner.py --objects 24 --goals 3
+#: --seed 1 --execute --spread 0 0.25 1 --search-only`` and the same with ``--objects 16 --seed 2`` (72 and 48
+#: place goals, the shipped models, each choice run in the simulator) put the object within 3 cm of the place in
+#: 56 / 57 / 56 / 57 % and 69 / 71 / 71 / 69 % of the goals with weights 0 / 0.25 / 0.5 / 1, and its median
+#: landing error rose with the weight in the second (1.2 / 1.4 / 1.5 / 2.0 cm; 0.6 / 0.7 / 0.9 / 0.9 cm where
+#: P reached the threshold): 0.25 is as often within as any, its median within 0.2 cm of none's.
+SPREAD_WEIGHT = 0.25
 #: An action that failed (to reach, or to move the object) is not chosen again, nor one within REFUSAL_RADIUS of
 #: it, on an object that is still within this distance [m] of where it failed (:meth:`Planner.note_failure`); an
 #: object that moved further is a new situation.
@@ -120,24 +168,33 @@ class Choice:
     """A planner's decision.
 
     Attributes:
-        behavior: The behaviour chosen (None where none of the candidates it asked ``feasible`` about was).
-        params: Its parameters, (3,).
+        behavior: The behaviour chosen; None where the planner names no action (none it asked ``feasible`` about
+            was, or every action failed there before): ``reason`` says which.
+        params: Its parameters, (3,); None where ``behavior`` is None.
         probability: P(goal) of the choice under the model (for :meth:`Planner.toward` when no action is likely
-            to reach the place: still P(within tolerance)).
-        abstained: P(goal) was below the threshold.
+            to reach the place: still P(within tolerance)); 0 without an action.
+        abstained: P(goal) was below the threshold, or there is no action.
         expected_distance: For :meth:`Planner.toward`: the mean predicted distance to the place [m]; else NaN.
-        checked: How many candidates the kinematics was asked about (at most the planner's ``max_checks``).
+        checked: How many actions the kinematics was asked about (at most the planner's ``max_checks``).
         value: For :meth:`Planner.toward`: P(within the tolerance) after this interaction and, where more are
             left, after the best second one (:meth:`Planner.toward`); else NaN.
+        reason: Why the planner abstained or names no action; empty where it is confident.
+        evaluations: The model evaluations the decision made (actions scored, summed over the behaviours).
     """
 
     behavior: str | None
-    params: np.ndarray
+    params: np.ndarray | None
     probability: float
     abstained: bool
     expected_distance: float = float("nan")
     checked: int = 0
     value: float = float("nan")
+    reason: str = ""
+    evaluations: int = 0
+
+
+def _below(p: float, threshold: float) -> str:
+    return f"P(goal) {p:.2f} is below the threshold {threshold:.2f}" if p < threshold else ""
 
 
 class Planner:
@@ -147,15 +204,19 @@ class Planner:
         models: A fitted :class:`~.effect_model.ActionEffectModel` per behaviour name (one of
             :data:`affordance_env.registry.BEHAVIOR_NAMES`, in any order), each of the same inputs: the object's
             features (the 49 of ``affordance_env.FEATURE_NAMES``) and the 3 action parameters.
-        n_candidates: Parameter vectors scored per behaviour.
+        n_candidates: Parameter vectors scored per behaviour: the optimiser's seed, or (``"grid"``) all of them.
         threshold: Abstain below this P(goal).
-        random_state: Seed of the candidates.
+        random_state: Seed of the candidates and of the optimiser's draws: a decision is the same for the same
+            seed and inputs.
         max_checks: Calls to ``feasible`` per decision at most (:data:`MAX_CHECKS`); when none of the candidates
             asked is feasible the choice is None (``behavior`` None, abstained).
         table: The table top's extent, ((x_low, y_low), (x_high, y_high)) [m] in the frame of the positions the
             methods are given (default :data:`SCENE_TABLE`, the scene's): a predicted outcome that leaves the
             object's centre beyond it leaves the object off the table, whatever the neighbour it comes from says
             (a place beyond the edge was never executed, so no training outcome says what it does). None: no table.
+        optimizer: ``"cem"`` (a cross-entropy search over each behaviour's parameters, :data:`EVALUATIONS` model
+            evaluations a decision) or ``"grid"`` (the ``n_candidates`` alone, refined around the best):
+            :data:`OPTIMIZERS`.
 
     Every method checks its inputs before any work: ``features`` must have as many values as the models take
     (ValueError), the goal must be a goal of :mod:`affordance_learning.planning.goals` (TypeError), a
@@ -165,7 +226,12 @@ class Planner:
 
     def __init__(self, models: Mapping[str, ActionEffectModel], n_candidates: int = 64, threshold: float = 0.5,
                  random_state: int = 0, max_checks: int = MAX_CHECKS,
-                 table: tuple[tuple[float, float], tuple[float, float]] | None = SCENE_TABLE) -> None:
+                 table: tuple[tuple[float, float], tuple[float, float]] | None = SCENE_TABLE,
+                 optimizer: str = "cem") -> None:
+        if optimizer not in OPTIMIZERS:
+            raise InvalidValueError(f"optimizer must be one of {', '.join(OPTIMIZERS)}, got {optimizer!r}.")
+        #: How each behaviour's parameters are chosen (:data:`OPTIMIZERS`).
+        self.optimizer = optimizer
         if not models:
             raise InvalidValueError("models must map at least one behaviour name to its fitted ActionEffectModel.")
         if not (isinstance(threshold, int | float) and 0.0 <= threshold <= 1.0):
@@ -191,6 +257,8 @@ class Planner:
         if not is_integer(random_state) or random_state < 0:
             raise InvalidValueError(f"random_state must be an integer >= 0, got {random_state!r}.")
         self.params = candidate_params(n_candidates, random_state)
+        #: The seed of the candidates and of the optimiser's draws.
+        self.random_state = int(random_state)
         if table is not None:
             corners = float_array("table", table, finite=False, error=InvalidValueError,
                                   expected="the table top's ((x_low, y_low), (x_high, y_high)) [m]")
@@ -280,19 +348,15 @@ class Planner:
 
     def _score(self, features: np.ndarray, goal: Goal, start_xy, candidates: Mapping[str, np.ndarray] | None = None
                ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """Per behaviour, every candidate's P(goal) and expected progress towards it (the goal's
-        :meth:`~affordance_learning.planning.goals.Goal.progress`, 0 where it has no distance), from the models'
-        predictive outcomes (each neighbour's displacement at the candidate's action:
+        """Per behaviour, every candidate's P(goal) and expected progress towards it less :data:`SPREAD_WEIGHT`
+        times its spread (the goal's :meth:`~affordance_learning.planning.goals.Goal.progress`; 0 where it has no
+        distance), from the models' predictive outcomes (each neighbour's displacement at the candidate's action:
         :meth:`~.effect_model.ActionEffectModel.predictive_outcomes`, read with the table: :meth:`on_table`).
         ``candidates``: the actions per behaviour (default: :attr:`params` for every behaviour). ``start_xy`` (where
         the object is) is needed for a goal that :attr:`~affordance_learning.planning.goals.Goal.needs_start` (a
         :class:`Place`), and for any goal, when given, says which outcomes leave the object beyond the table's
         edge; the places the goal names must lie on the table top."""
-        check_goal(goal)
-        start = self._check_where(start_xy) if goal.needs_start or start_xy is not None else None
-        if self.table is not None:
-            for what, xy in goal.positions().items():
-                _check_on_table(f"the goal's {what}", xy, np.asarray(xy), self.table)
+        start = self._check_goal(goal, start_xy)
         if candidates is None:
             candidates = dict.fromkeys(self.models, self.params)
         out = {}
@@ -300,44 +364,180 @@ class Planner:
             outcomes = self.on_table(self.models[name].predictive_outcomes(self._inputs(features, params)), start)
             p = outcomes.probability(goal, start)
             progress = goal.progress(outcomes, start)
-            out[name] = (p, np.zeros(len(p)) if progress is None else outcomes.share(progress))
+            if progress is None:
+                out[name] = (p, np.zeros(len(p)))
+                continue
+            mean = outcomes.share(progress)
+            spread = np.sqrt(np.maximum(outcomes.share(progress**2) - mean**2, 0.0))
+            out[name] = (p, mean - SPREAD_WEIGHT * spread)
         return out
+
+    def _check_goal(self, goal: Goal, start_xy) -> np.ndarray | None:
+        """``start_xy`` checked (None where the goal needs none and none is given); the goal's places on the
+        table."""
+        check_goal(goal)
+        start = self._check_where(start_xy) if goal.needs_start or start_xy is not None else None
+        if self.table is not None:
+            for what, xy in goal.positions().items():
+                _check_on_table(f"the goal's {what}", xy, np.asarray(xy), self.table)
+        return start
 
     def scores(self, features: np.ndarray, goal: Goal, start_xy=None) -> dict[str, np.ndarray]:
         """P(goal) of every candidate, per behaviour: {behaviour: (n_candidates,)}; ``start_xy`` as for
         :meth:`choose` (outcomes that leave the object beyond the table's edge are off the table)."""
         return {name: p for name, (p, _) in self._score(features, goal, start_xy).items()}
 
-    def _first_feasible(self, ranked, feasible, excluded: set[tuple[str, int]], asked: dict[tuple[str, int], bool],
-                        candidates: Mapping[str, np.ndarray]):
-        """The first entry of ``ranked`` (each ending with behaviour and candidate index in ``candidates``) that is
-        not ``excluded`` and that ``feasible`` accepts, asking at most ``max_checks`` times per decision over all
-        rankings (``asked`` holds the answers so far) and not about a candidate within :data:`REFUSAL_RADIUS` of
-        one it refused; None when none is found within that."""
-        refused = [(name, candidates[name][k]) for (name, k), ok in asked.items() if not ok]
-        for entry in ranked:
-            key = (entry[-2], entry[-1])
-            if key in excluded:
-                continue
-            if feasible is None:
-                return entry
-            if key not in asked:
-                if len(asked) >= self.max_checks:
-                    return None
-                params = candidates[key[0]][key[1]]
-                if any(name == key[0] and np.linalg.norm(params - other) < REFUSAL_RADIUS for name, other in refused):
+    # --- the cross-entropy search --------------------------------------------------------------------------------
+    def _moment_score(self, name: str, features: np.ndarray, goal: Goal, start: np.ndarray | None,
+                      params: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The search's cheap score of ``params`` (n, 3) of behaviour ``name``: P(goal) and progress less
+        :data:`SPREAD_WEIGHT` times its spread, as :meth:`_score` gives them, from each kind of outcome's weight,
+        mean and covariance (:meth:`~.effect_model.ActionEffectModel.kind_moments`). P of a goal with a distance
+        comes from a Gaussian per kind (a place's disc as a square of the same area); a goal without one reads
+        no displacement, and its P is the exact share of the training outcomes that reach it."""
+        model, X = self.models[name], self._inputs(features, params)
+        if not goal.has_distance:
+            reached = goal.reached(model.outcome_frame(), start).astype(np.float64)
+            return model.leaf_share(X, reached), np.zeros(len(params))
+        moments = model.kind_moments(X, check_input=False)  # _inputs checked the features
+        return _gaussian_score(moments, goal, start, self.table)
+
+    def _optimise(self, features: np.ndarray, goal: Goal, start: np.ndarray | None, excluded_near
+                  ) -> tuple[dict[str, np.ndarray], int]:
+        """Per behaviour, the actions to score on their whole predictive outcomes: the search's finalists (the
+        best it found, the best of other regions, the canonical action), and the cheap scores it made.
+        ``excluded_near(name, params)``: (n,) bool, the actions that failed here before (never elites)."""
+        finalists, evaluations = {}, 0
+        step = P_RESOLUTION if goal.ranks_by_progress else 0.0
+        for index, name in enumerate(self.models):
+            rng = np.random.default_rng([self.random_state, index])
+            tried = [self.params]
+            p, g = self._moment_score(name, features, goal, start, self.params)
+            scores = [(p, g)]
+            for _ in range(CEM_ITERATIONS):
+                order = _order(np.concatenate([s[0] for s in scores]), np.concatenate([s[1] for s in scores]),
+                               step, excluded_near(name, np.vstack(tried)))
+                elites = np.vstack(tried)[order[:CEM_ELITES]]
+                spread = np.maximum(elites.std(axis=0), CEM_MIN_STD)
+                draw = np.clip(elites.mean(axis=0) + spread * rng.standard_normal((CEM_SAMPLES, elites.shape[1])),
+                               -1.0, 1.0)
+                tried.append(draw)
+                scores.append(self._moment_score(name, features, goal, start, draw))
+            every = np.vstack(tried)
+            evaluations += len(every)
+            failed = excluded_near(name, every)
+            order = _order(np.concatenate([s[0] for s in scores]), np.concatenate([s[1] for s in scores]), step,
+                           failed)
+            order = order[~failed[order]] if not failed.all() else order  # none that failed here, if any other
+            chosen: list[np.ndarray] = []
+            for k in order:  # the best, distinct
+                if len(chosen) == FINALISTS:
+                    break
+                if not any(np.array_equal(every[k], c) for c in chosen):
+                    chosen.append(every[k])
+            ranked = every[order]
+            for _ in range(FINALIST_REGIONS):  # then the best of other regions
+                far = np.min(np.linalg.norm(ranked[:, None, :] - np.array(chosen)[None], axis=2), axis=1)
+                others = np.flatnonzero(far >= REFUSAL_RADIUS)
+                if not others.size:
+                    break
+                chosen.append(ranked[others[0]])
+            if not any(np.array_equal(c, self.params[0]) for c in chosen):
+                chosen.append(self.params[0])  # the canonical action: what the checks fall back on
+            finalists[name] = np.array(chosen)
+        return finalists, evaluations
+
+    def _excluded_near(self, features: np.ndarray, start: np.ndarray | None):
+        """``excluded_near(name, params)``: which of ``params`` (n, 3) of ``name`` lie within
+        :data:`REFUSAL_RADIUS` of an action that failed on this object where it is."""
+        failed = [(name, params) for name, params, where, seen in self.failures
+                  if (np.linalg.norm(where - start) <= FAILURE_RADIUS if where is not None and start is not None
+                      else seen.shape == features.shape and np.allclose(seen, features, rtol=1e-3, atol=1e-6))]
+
+        def excluded_near(name: str, params: np.ndarray) -> np.ndarray:
+            out = np.zeros(len(params), dtype=bool)
+            for other, failed_params in failed:
+                if other == name:
+                    out |= np.linalg.norm(params - failed_params, axis=1) < REFUSAL_RADIUS
+            return out
+
+        return excluded_near
+
+    def _candidates(self, features: np.ndarray, goal: Goal, start: np.ndarray | None
+                    ) -> tuple[dict[str, np.ndarray], int]:
+        """Per behaviour, the actions a decision ranks (the optimiser's finalists, or :attr:`params`), and the
+        model evaluations that cost before they are scored on their whole predictive outcomes."""
+        if self.optimizer == "grid":
+            return dict.fromkeys(self.models, self.params), 0
+        return self._optimise(features, goal, start, self._excluded_near(features, start))
+
+    # --- asking feasible -----------------------------------------------------------------------------------------
+    def _search(self, rankings, feasible, excluded: set[tuple[str, int]], candidates: Mapping[str, np.ndarray],
+                asked: dict[tuple[str, int], bool] | None = None, fallback: bool = True):
+        """The first entry, over ``rankings`` in turn (each a list of entries ending with behaviour and index in
+        ``candidates``, the last of them every candidate), that is not ``excluded`` and that ``feasible`` accepts;
+        and how many times ``feasible`` was asked.
+
+        ``feasible`` is asked at most ``max_checks`` times, never about a ranked candidate within
+        :data:`REFUSAL_RADIUS` of one it refused, and one check is kept for the canonical action (the candidate of
+        zeros, where there is one) of every behaviour: where the ranked candidates run out of checks, the
+        canonical actions not asked about yet are, the most promising behaviour first, whatever was refused near
+        them (the behaviours' workspaces are made around their canonical actions). With fewer checks than
+        behaviours, the ranked candidates get one and the canonical actions of the behaviours ranked first the
+        others. Without ``fallback`` no check is kept (a refinement around an action already found). Without
+        ``feasible`` the first entry not excluded."""
+        asked = {} if asked is None else asked
+        refused: list[tuple[str, np.ndarray]] = [(n, candidates[n][k]) for (n, k), ok in asked.items() if not ok]
+        canonical = {name: int(np.flatnonzero(np.all(params == 0.0, axis=1))[0]) for name, params in
+                     candidates.items() if fallback and np.any(np.all(params == 0.0, axis=1))}
+
+        def open_reserve() -> list[str]:
+            return [n for n, k in canonical.items() if (n, k) not in asked and (n, k) not in excluded]
+
+        def ask(key, near_refused: bool = False) -> bool | None:
+            """feasible's answer about ``key``, asking if need be; None where it may not be asked (within
+            REFUSAL_RADIUS of one refused, unless ``near_refused``)."""
+            if key in asked:
+                return asked[key]
+            params = candidates[key[0]][key[1]]
+            if not near_refused and any(n == key[0] and np.linalg.norm(params - other) < REFUSAL_RADIUS
+                                        for n, other in refused):
+                return None
+            asked[key] = bool(feasible(key[0], params))
+            if not asked[key]:
+                refused.append((key[0], params))
+            return asked[key]
+
+        for ranked in rankings:
+            for entry in ranked:
+                key = (entry[-2], entry[-1])
+                if key in excluded:
                     continue
-                asked[key] = bool(feasible(key[0], params))
-                if not asked[key]:
-                    refused.append((key[0], params))
-            if asked[key]:
-                return entry
-        return None
+                if feasible is None:
+                    return entry, 0
+                kept = min(len(open_reserve()) - (canonical.get(key[0]) == key[1]), self.max_checks - 1)
+                if key not in asked and len(asked) + kept >= self.max_checks:
+                    break  # the remaining checks are kept for the canonical actions not asked about
+                if ask(key):
+                    return entry, len(asked)
+        if feasible is None:
+            return None, 0
+        last = {(e[-2], e[-1]): e for e in rankings[-1]} if rankings else {}
+        order = {}
+        for entry in rankings[-1] if rankings else ():
+            order.setdefault(entry[-2], len(order))
+        for name in sorted(open_reserve(), key=lambda n: order.get(n, len(order))):
+            if len(asked) >= self.max_checks:
+                break
+            key = (name, canonical[name])
+            if ask(key, near_refused=True) and key in last:  # the canonical action, whatever was refused near it
+                return last[key], len(asked)
+        return None, len(asked)
 
     def _ranked(self, scores: Mapping[str, tuple[np.ndarray, np.ndarray]], goal: Goal) -> list[tuple]:
         """Every candidate (P, progress, behaviour, index), best first: by P(goal), for a goal that
         :attr:`~affordance_learning.planning.goals.Goal.ranks_by_progress` (a place) in steps of P_RESOLUTION (the
-        nearer expected end decides among them), then by progress, then the earlier candidate,
+        nearer expected end decides among them), then by progress (less its spread), then the earlier candidate,
         behaviour after behaviour."""
         step = P_RESOLUTION if goal.ranks_by_progress else 0.0
         ranked = sorted(((float(p), float(g), k, i, name) for i, name in enumerate(scores)
@@ -345,40 +545,55 @@ class Planner:
                         key=lambda e: (-np.floor(e[0] / step + 1e-9) if step else -e[0], -e[1], e[2], e[3]))
         return [(p, g, name, k) for p, g, k, _, name in ranked]
 
+    def _nothing(self, asked: int, evaluations: int) -> Choice:
+        """The choice that names no action, and why."""
+        if asked:
+            why = (f"none of the {asked} actions asked about was feasible (at most {self.max_checks} a decision, "
+                   "one kept for each behaviour's canonical action)")
+        else:
+            why = "every action scored failed on this object where it is before (note_failure)"
+        return Choice(None, None, 0.0, True, checked=asked, value=0.0, reason=why, evaluations=evaluations)
+
+    # --- deciding ------------------------------------------------------------------------------------------------
     def choose(self, features: np.ndarray, goal: Goal, start_xy=None,
                feasible: Callable[[str, np.ndarray], bool] | None = None) -> Choice:
         """The most likely feasible action for ``goal`` on the object seen with ``features`` at ``start_xy``, not
-        one that failed there (:meth:`note_failure`), ranked as :meth:`_ranked` says; ``feasible`` is asked at
-        most ``max_checks`` times, and where none of those is feasible the choice is None. For a goal with a
-        distance (:class:`Move`, :class:`Place`) the actions around the one found are scored too
-        (:data:`REFINE_POINTS` within :data:`REFINE_RADIUS`), and the best of them that ranks above it is taken
-        if feasible (at most :data:`REFINE_CHECKS` asked)."""
-        start = None if start_xy is None else self._check_where(start_xy)
-        scores = self._score(features, goal, start_xy)
-        candidates = dict.fromkeys(scores, self.params)
+        one that failed there (:meth:`note_failure`), ranked as :meth:`_ranked` says among the optimiser's
+        finalists (module docstring); ``feasible`` is asked at most ``max_checks`` times (:meth:`_search`), and
+        where none of those is feasible the choice names no action (``behavior`` and ``params`` None, with a
+        ``reason``). With ``optimizer="grid"`` and a goal with a distance (:class:`Move`, :class:`Place`), the
+        actions around the one found are scored too (:data:`REFINE_POINTS` within :data:`REFINE_RADIUS`), and the
+        best of them that ranks above it is taken if feasible (at most :data:`REFINE_CHECKS` asked, within
+        ``max_checks``)."""
+        start = self._check_goal(goal, start_xy)
         seen = self._inputs(features)[0, : self.n_features]
+        candidates, evaluations = self._candidates(seen, goal, start)
+        scores = self._score(features, goal, start_xy, candidates)
+        evaluations += sum(len(c) for c in candidates.values())
+        excluded = self._excluded(seen, start, candidates)
         asked: dict[tuple[str, int], bool] = {}
-        best = self._first_feasible(self._ranked(scores, goal), feasible, self._excluded(seen, start, candidates),
-                                    asked, candidates)
+        best, checked = self._search([self._ranked(scores, goal)], feasible, excluded, candidates, asked)
         if best is None:
-            return Choice(None, np.zeros(3), 0.0, True, checked=len(asked))
+            return self._nothing(checked, evaluations)
         p, _, name, k = best
-        params, checked = candidates[name][k], len(asked)
-        if goal.has_distance:
+        params = candidates[name][k]
+        if goal.has_distance and self.optimizer == "grid":
             local = {name: np.clip(params + self._offsets, -1.0, 1.0)}
             p_local, g_local = self._score(features, goal, start_xy, local)[name]
+            evaluations += len(p_local)
             around = {name: (np.append(p_local, p), np.append(g_local, best[1]))}  # the one found last
             local[name] = np.vstack([local[name], params])
             excluded, refined = self._excluded(seen, start, local), {}
             for entry in self._ranked(around, goal):
-                if entry[-1] == len(p_local) or len(refined) >= REFINE_CHECKS:
+                if entry[-1] == len(p_local) or len(refined) >= min(REFINE_CHECKS, self.max_checks - checked):
                     break  # none better than the one found, or enough asked
-                found = self._first_feasible([entry], feasible, excluded, refined, local)
+                found = self._search([[entry]], feasible, excluded, local, refined, fallback=False)[0]
                 if found is not None:
                     p, params = found[0], local[name][found[-1]]
                     break
             checked += len(refined)
-        return Choice(name, params.copy(), p, p < self.threshold, checked=checked)
+        return Choice(name, params.copy(), p, p < self.threshold, checked=checked,
+                      reason=_below(p, self.threshold), evaluations=evaluations)
 
     def toward(self, features: np.ndarray, start_xy, target_xy, tolerance: float,
                feasible: Callable[[str, np.ndarray], bool] | None = None, steps_left: int | None = None,
@@ -386,16 +601,22 @@ class Planner:
         """The next interaction towards ``target_xy`` [m], a place on the table top (:attr:`table`, the scene's
         :func:`table_extent` without one; another is a ValueError), re-planned after every interaction.
 
-        By default (``steps_left`` None: more interactions may follow) a search over sequences of two
-        interactions: an action's value is its P(within ``tolerance``) plus the share of its predicted outcomes
-        that neither end within nor leave the table times the best P(within) of a second interaction from there,
-        averaged over the most likely of those outcomes (the object where the outcome leaves it, seen with the
-        initial features plus the outcome's perceptual effect, or unchanged where the models have none). An action
-        likely enough to end within (the threshold) is taken at once; else the most valuable one, if its value
-        reaches ``MIN_SEQUENCE_VALUE``;
-        else the one whose predicted outcomes end nearest on average. With ``steps_left`` 1 (this interaction is
-        the last) only the first and the last of these. Actions that failed on the object where it is
-        (:meth:`note_failure`) are left out, and ``feasible`` is asked at most ``max_checks`` times.
+        The horizon follows ``steps_left``: with 2 or more (or None: more interactions may follow) a search over
+        sequences of two interactions (the planner looks no further): an action's value is its P(within
+        ``tolerance``) plus the share of its predicted outcomes that neither end within nor leave the table times
+        the best P(within) of a second interaction from there, averaged over the most likely of those outcomes
+        (the object where the outcome leaves it, seen with the initial features plus the outcome's perceptual
+        effect, or unchanged where the models have none); and its expected distance is the one after the best
+        second interaction where that is nearer, so that an action that brings the object where a behaviour can
+        act toward the target ranks before one that leaves it where none can. With ``steps_left`` 1 (this
+        interaction is the last) the value is P(within) and the distance this interaction's. An action likely
+        enough to end within (the threshold) is taken at once; else the most valuable one, if its value reaches
+        ``MIN_SEQUENCE_VALUE``; else the one whose predicted outcomes end nearest on average (less
+        :data:`SPREAD_WEIGHT` times their spread). The actions are the optimiser's finalists for the place
+        (:meth:`choose`). Actions that failed on the object where it is (:meth:`note_failure`) are left out, and
+        ``feasible`` is asked at most ``max_checks`` times (:meth:`_search`: every behaviour's canonical action
+        gets a check where the ranked ones are refused); the choice names no action only where none of those
+        was feasible.
 
         Args:
             steps_left: Interactions left in the episode, this one included; None: more than one.
@@ -410,52 +631,58 @@ class Planner:
         target = np.asarray(goal.target_xy)
         _check_on_table("target_xy", target_xy, target, self.table)
         start = self._check_where(start_xy)
-        X = self._inputs(features)
-        features = X[0, : self.n_features]
+        features = self._inputs(features)[0, : self.n_features]
+        candidates, evaluations = self._candidates(features, goal, start)
         names = list(self.models)
         predicted, p1, distance, ends = {}, {}, {}, {}
         for name, model in self.models.items():
-            outcomes = self.on_table(model.predictive_outcomes(X), start)  # per entry: a neighbour's outcome at
-            end, off = start + outcomes.displacement, outcomes["off_table"].astype(bool)  # the candidate's action
+            outcomes = self.on_table(model.predictive_outcomes(self._inputs(features, candidates[name])), start)
+            end, off = start + outcomes.displacement, outcomes["off_table"].astype(bool)
             within = goal.reached(outcomes, start).astype(np.float64)
             dist = np.where(off, OFF_TABLE_DISTANCE, np.linalg.norm(end - target, axis=1))
             if reachable is not None:  # an end no behaviour reaches counts as off the table, unless within
                 open_ = np.flatnonzero((within == 0) & ~off)
                 dist[open_[~_reached_by_any(reachable, names, end[open_])]] = OFF_TABLE_DISTANCE
             predicted[name], ends[name] = outcomes, (end, off, within)
-            p1[name], distance[name] = outcomes.share(within), outcomes.share(dist)
+            mean = outcomes.share(dist)
+            spread = np.sqrt(np.maximum(outcomes.share(dist**2) - mean**2, 0.0))
+            p1[name], distance[name] = outcomes.share(within), mean + SPREAD_WEIGHT * spread
+            evaluations += len(candidates[name])
         value = {name: p1[name].copy() for name in names}
         if steps_left is None or steps_left >= 2:
-            self._look_ahead(features, goal, predicted, ends, p1, distance, value, reachable)
+            evaluations += self._look_ahead(features, goal, predicted, ends, p1, distance, value, reachable,
+                                            candidates)
         entries = [(float(value[n][k]), float(p1[n][k]), float(distance[n][k]), n, k)
-                   for k in range(len(self.params)) for n in names]
+                   for n in names for k in range(len(candidates[n]))]
+        entries.sort(key=lambda e: e[-1])  # action by action across the behaviours, as ties go
         finish = sorted((e for e in entries if e[1] >= self.threshold), key=lambda e: (-e[1], e[2]))
         sequence = sorted((e for e in entries if e[0] >= MIN_SEQUENCE_VALUE), key=lambda e: (-e[0], e[2]))
         nearest = sorted(entries, key=lambda e: (e[2], -e[0]))
-        candidates = dict.fromkeys(names, self.params)
         excluded = self._excluded(features, start, candidates)
-        asked: dict[tuple[str, int], bool] = {}
-        for ranked in (finish, sequence, nearest):
-            found = self._first_feasible(ranked, feasible, excluded, asked, candidates)
-            if found is not None:
-                v, p, d, name, k = found
-                return Choice(name, self.params[k].copy(), p, p < self.threshold, d, len(asked), v)
-            if feasible is not None and len(asked) >= self.max_checks:
-                break
-        return Choice(None, np.zeros(3), 0.0, True, float("nan"), len(asked), 0.0)
+        found, checked = self._search([finish, sequence, nearest], feasible, excluded, candidates)
+        if found is None:
+            return self._nothing(checked, evaluations)
+        v, p, d, name, k = found
+        return Choice(name, candidates[name][k].copy(), p, p < self.threshold, d, checked, v,
+                      reason=_below(p, self.threshold), evaluations=evaluations)
 
-    def _look_ahead(self, features, goal, predicted, ends, p1, distance, value, reachable) -> None:
+    def _look_ahead(self, features, goal, predicted, ends, p1, distance, value, reachable, candidates) -> int:
         """Add to ``value`` (P(within) of each first action) the chance of a second interaction (see
-        :meth:`toward`), over the ``LOOKAHEAD_ROOTS`` first actions nearest on average and most likely, their
-        ``LOOKAHEAD_OUTCOMES`` most likely outcomes each, and ``LOOKAHEAD_SECOND`` parameter vectors per
-        behaviour for the second. ``predicted`` and ``ends``: per behaviour, the first actions' predictive outcomes
-        and, per entry, where it ends, whether it left the table and whether it ends within the tolerance."""
+        :meth:`toward`), and bring ``distance`` down to the expected distance after the best second interaction
+        where that is nearer, over the ``LOOKAHEAD_ROOTS`` first actions nearest on average, half as many most
+        likely and each behaviour's nearest (a behaviour that brings the object nowhere near may bring it where
+        another can act), their ``LOOKAHEAD_OUTCOMES`` most likely outcomes each, and ``LOOKAHEAD_SECOND``
+        parameter vectors per behaviour for the second (scored by the search's cheap score:
+        :meth:`_moment_score`). ``predicted`` and ``ends``: per behaviour, the first actions' predictive outcomes
+        and, per entry, where it ends, whether it left the table and whether it ends within the tolerance.
+        Returns the model evaluations it made."""
         names = list(self.models)
-        flat = [(n, k) for n in names for k in range(len(self.params))]
+        flat = [(n, k) for n in names for k in range(len(candidates[n]))]
         p_all = np.concatenate([p1[n] for n in names])
         d_all = np.concatenate([distance[n] for n in names])
         roots = list(dict.fromkeys([flat[i] for i in np.argsort(d_all, kind="stable")[:LOOKAHEAD_ROOTS]]
-                                   + [flat[i] for i in np.argsort(-p_all, kind="stable")[:LOOKAHEAD_ROOTS // 2]]))
+                                   + [flat[i] for i in np.argsort(-p_all, kind="stable")[:LOOKAHEAD_ROOTS // 2]]
+                                   + [(n, int(np.argmin(distance[n]))) for n in names]))  # each behaviour's nearest
         # The outcomes (root, training row) the roots lead to: where each ends and the training row of its effect.
         states: dict[tuple[str, int, int], int] = {}
         where: list[np.ndarray] = []
@@ -480,7 +707,7 @@ class Planner:
                 followed.append((states[key], float(weights.data[e])))
             links.append((name, k, float(data.sum()), followed))
         if not states:
-            return
+            return 0
         keys = list(states)
         for name in {n for n, _, _ in keys}:
             if len(self.models[name].effect_columns_) not in (0, len(features)):
@@ -495,16 +722,74 @@ class Planner:
             return self.models[name].outcomes_[j, columns] if len(columns) else 0.0
 
         xy = np.array(where)
-        seen = np.array([features + effect(n, j) for n, _, j in keys])
+        # The models' inputs at a state are the features it is seen with (the root's behaviour and the training
+        # outcome's effect), not where it is: states that share them share the models' moments.
+        inputs: dict[tuple[str, int], int] = {}
+        row = np.array([inputs.setdefault((n, j), len(inputs)) for n, _, j in keys])
+        seen = np.array([features + effect(n, j) for n, j in inputs])
         second = self.params[: LOOKAHEAD_SECOND]
         best = np.zeros(len(keys))
-        starts = np.repeat(xy, len(second), axis=0)  # each query's start: its state's
+        nearest = np.full(len(keys), np.inf)  # the expected distance after the best second interaction
+        target = np.asarray(goal.target_xy)
+        evaluations = 0
         for name, model in self.models.items():
-            X2 = np.hstack([np.repeat(seen, len(second), axis=0), np.tile(second, (len(keys), 1))])
-            p2 = self.on_table(model.predictive_outcomes(X2), starts).probability(goal, starts)
-            p2 = p2.reshape(len(keys), len(second)).max(axis=1)
-            if reachable is not None:
-                p2 = p2 * np.asarray(reachable(name, xy), dtype=bool)
-            best = np.maximum(best, p2)
+            acts = np.flatnonzero(np.ones(len(keys), bool) if reachable is None else reachable(name, xy))
+            if not acts.size:  # the behaviour reaches none of the states: it scores none of them
+                continue
+            needed = np.unique(row[acts])
+            X2 = np.hstack([np.repeat(seen[needed], len(second), axis=0), np.tile(second, (len(needed), 1))])
+            found = model.kind_moments(X2, check_input=False)
+            at = (np.searchsorted(needed, row[acts])[:, None] * len(second) + np.arange(len(second))).ravel()
+            moments = KindMoments(found.mass[at], found.mean[at], found.covariance[at], found.flags)
+            p2, g2 = _gaussian_score(moments, goal, np.repeat(xy[acts], len(second), axis=0), self.table)
+            best[acts] = np.maximum(best[acts], p2.reshape(len(acts), len(second)).max(axis=1))
+            nearest[acts] = np.minimum(nearest[acts], -g2.reshape(len(acts), len(second)).max(axis=1))
+            evaluations += len(X2)
+        here = np.linalg.norm(xy - target, axis=1)
         for name, k, mass, followed in links:  # the followed outcomes stand for all that leave something to do
-            value[name][k] += mass * sum(w * best[state] for state, w in followed) / sum(w for _, w in followed)
+            total = sum(w for _, w in followed)
+            value[name][k] += mass * sum(w * best[state] for state, w in followed) / total
+            gain = sum(w * min(nearest[state] - here[state], 0.0) for state, w in followed) / total
+            distance[name][k] += mass * gain
+        return evaluations
+
+
+def _order(p: np.ndarray, g: np.ndarray, step: float, excluded: np.ndarray) -> np.ndarray:
+    """The indices of actions scored (P, progress), best first as :meth:`Planner._ranked` ranks them, those
+    ``excluded`` last."""
+    first = -np.floor(p / step + 1e-9) if step else -p
+    return np.lexsort((-g, first, excluded))
+
+
+def _gaussian_score(moments: KindMoments, goal: Goal, start, table) -> tuple[np.ndarray, np.ndarray]:
+    """(P(goal), progress less :data:`SPREAD_WEIGHT` times its spread) of each query from its kinds' moments, for a
+    :class:`Move` or a :class:`Place` from ``start`` ((2,) or (m, 2) [m]; a kind whose mean end lies beyond the
+    ``table``'s edge counts as off it). Each kind's displacement is taken as a Gaussian: P that it moves at least
+    the distance along the direction, or (the disc of the tolerance as a square of the same area, axis by axis)
+    that it ends within the tolerance; the progress's mean and spread from the kinds' means and covariances."""
+    mass, mean, cov = moments.mass, moments.mean, moments.covariance
+    off = np.broadcast_to(moments.flag("off_table")[None, :], mass.shape)
+    sd = np.sqrt(np.maximum(np.diagonal(cov, axis1=-2, axis2=-1), 1e-12))  # (m, kinds, 2)
+    if start is not None:
+        start = np.asarray(start, dtype=np.float64)
+        end = (start[:, None, :] if start.ndim == 2 else start) + mean
+        if table is not None:
+            off = off | np.any((end < table[0]) | (end > table[1]), axis=-1)
+    if isinstance(goal, Move):
+        direction = np.asarray(goal.direction)
+        along = mean @ direction
+        var = np.einsum("i,mcij,j->mc", direction, cov, direction)
+        p_kind = ndtr((along - goal.min_distance) / np.sqrt(np.maximum(var, 1e-12)))
+        progress, second = np.where(off, -OFF_TABLE_DISTANCE, along), np.where(off, OFF_TABLE_DISTANCE**2,
+                                                                               along**2 + var)
+    else:
+        miss = end - np.asarray(goal.target_xy)
+        half = goal.tolerance * np.sqrt(np.pi) / 2.0
+        p_kind = np.prod(ndtr((half - miss) / sd) - ndtr((-half - miss) / sd), axis=-1)
+        square = np.sum(miss**2, axis=-1) + np.trace(cov, axis1=-2, axis2=-1)  # E |end - target|^2 of the kind
+        progress = -np.where(off, OFF_TABLE_DISTANCE, np.sqrt(square))
+        second = np.where(off, OFF_TABLE_DISTANCE**2, square)
+    p = np.minimum(np.sum(mass * np.where(off, 0.0, p_kind), axis=1), 1.0)
+    mean_progress = np.sum(mass * progress, axis=1)
+    spread = np.sqrt(np.maximum(np.sum(mass * second, axis=1) - mean_progress**2, 0.0))
+    return p, mean_progress - SPREAD_WEIGHT * spread

@@ -52,7 +52,7 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
                                     feasible=feasible_at(env, state), steps_left=GOAL_MAX_EPISODE_STEPS - step)
             decisions.append(time.perf_counter() - t)
             env.set_state(state)  # feasible may have put it back: the same state, to be sure
-            if choice.behavior is None:  # none of the candidates asked is reachable: stop rather than fail
+            if choice.behavior is None:  # none of the actions asked about is reachable: stop rather than fail
                 gave_up = True
                 break
             behavior, params = choice.behavior, choice.params

@@ -14,7 +14,9 @@ from affordance_env.objects import OBJECT_TYPES
 GOAL_KINDS = ("roll", "lift", "move", "place")
 
 
-POLICIES = ("planner", "random", "best_fixed", "canonical_choice", "som_categories", "oracle")
+#: The single step's policies: ``planner_grid`` is the planner with its fixed candidates instead of the search
+#: (:func:`~.baselines.grid_planner`), at the search's time.
+POLICIES = ("planner", "planner_grid", "random", "best_fixed", "canonical_choice", "som_categories", "oracle")
 
 
 MULTI_POLICIES = ("planner", "direction", "random")

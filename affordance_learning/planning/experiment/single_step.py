@@ -10,7 +10,7 @@ from typing import Any
 import numpy as np
 
 from affordance_env.registry import BEHAVIOR_NAMES
-from affordance_learning.planning.experiment.baselines import SomBaseline
+from affordance_learning.planning.experiment.baselines import SomBaseline, grid_planner
 from affordance_learning.planning.experiment.goal_drawing import draw_goals
 from affordance_learning.planning.experiment.settings import oracle_params
 from affordance_learning.planning.experiment.simulation import (
@@ -59,9 +59,10 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
     # Every oracle action's P(goal) is read from its predictive outcomes, computed once for the object.
     X = np.hstack([np.repeat(features[None], len(oracle_set), axis=0), oracle_set])
     predicted = {b: planner.on_table(planner.models[b].predictive_outcomes(X), start) for b in BEHAVIOR_NAMES}
-    canonical_pick = Planner(planner.models, n_candidates=1, threshold=planner.threshold)
+    canonical_pick = Planner(planner.models, n_candidates=1, threshold=planner.threshold, optimizer="grid")
+    grid = grid_planner(planner)
     left_out = shape_planners.get(item["shape"])
-    for p in (planner, left_out):
+    for p in (planner, grid, left_out):
         if p is not None:
             p.forget_failures()
     shape, size = info["object"]["type"], float(info["object"]["size"])
@@ -76,6 +77,7 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
         if error is not None:  # a goal of a place
             record["placement_error"] = error
             record["placement_committed"] = not choice.abstained
+        record["planner_grid"] = _decide(grid, features, goal, start, feasible, outcomes)[1]
         if left_out is not None:
             record["planner_left_out"] = _decide(left_out, features, goal, start, feasible, outcomes)[1]
         hits = {(b, k): reached(goal, info) for b, k, info in tried}
