@@ -46,10 +46,37 @@ def test_goals_round_trip_through_json_and_refuse_bad_fields():
         goal_from_dict({"kind": "fly"})
     with pytest.raises(ValueError, match="non-zero"):
         Move((0.0, 0.0))
-    with pytest.raises(ValueError, match="tolerance must be a positive"):
-        Place((0.0, 0.0), -1.0)
+    with pytest.raises(ValueError, match="tolerance must be a distance in metres"):
+        Place((-0.3, 0.0), -1.0)
     with pytest.raises(ValueError, match="start_xy"):
-        Place((0.0, 0.0)).reached({"dx": [0.0], "dy": [0.0], "off_table": [False]})
+        Place((-0.3, 0.0)).reached({"dx": [0.0], "dy": [0.0], "off_table": [False]})
+
+
+def test_goals_refuse_what_cannot_be_metres_on_the_table():
+    """The table top is x in [-0.76, -0.16], y in [-0.5, 0.5] (1.17 m across): a distance, a place or a tolerance
+    in centimetres, given as metres, is refused with the value and the unit expected."""
+    from affordance_learning.planning.goals import MAX_TOLERANCE, table_diagonal
+
+    assert table_diagonal() == pytest.approx(np.hypot(0.6, 1.0))
+    with pytest.raises(ValueError, match=r"min_distance must be a distance in metres on the table, in \(0, 1.17\] m "
+                                         r"\(the table's diagonal\), got 5"):
+        Move((2, 0), 5)
+    with pytest.raises(ValueError, match="min_distance must be a distance in metres"):
+        Move((1, 0), 0.0)
+    assert Move((1, 0), 1.1).min_distance == 1.1  # corner to corner, nearly
+    with pytest.raises(ValueError, match=r"target_xy must be \(x, y\) \[m\] on the table top, x in \[-0.76, -0.16\] "
+                                         r"and y in \[-0.50, 0.50\].*got \(-30, 10\)"):
+        Place((-30, 10))
+    with pytest.raises(ValueError, match="target_xy must be .* got \\(0.0, 0.0\\): 16 cm off the table"):
+        Place((0.0, 0.0))
+    assert Place((-0.14, 0.0), 0.03).target_xy == (-0.14, 0.0)  # 2 cm beyond the edge: within 3 cm of the rim
+    with pytest.raises(ValueError, match="target_xy"):
+        Place((-0.14, 0.0), 0.01)
+    with pytest.raises(ValueError, match=r"tolerance must be a distance in metres, in \(0, 0.5\] m, got 3"):
+        Place((-0.3, 0.0), 3)
+    assert Place((-0.3, 0.0), MAX_TOLERANCE).tolerance == 0.5
+    with pytest.raises(ValueError, match="min_distance must be a distance in metres"):
+        goal_from_dict({"kind": "move", "direction": [1, 0], "min_distance": 5})
 
 
 def test_goals_judge_outcomes():
@@ -265,8 +292,9 @@ def test_predictive_outcomes_move_each_neighbour_to_the_query_action():
             assert np.abs(outcomes.displacement[~lifted]).max() < 0.005
         else:  # as they were, the neighbours' actions blur the place by centimetres
             assert np.median(error[lifted]) > 0.01
-    place = [Place(tuple(0.2 * x[2:4]), 0.01) for x in Xq[small]]
-    p_moved, p_as_were = ([model.goal_probability(x[None], goal, (0.0, 0.0))[0]
+    on_table = np.array([-0.46, 0.0])  # a place is on the table: 20 cm around its middle
+    place = [Place(tuple(on_table + 0.2 * x[2:4]), 0.01) for x in Xq[small]]
+    p_moved, p_as_were = ([model.goal_probability(x[None], goal, on_table)[0]
                            for x, goal in zip(Xq[small], place, strict=True)] for model in (moved, as_were))
     assert np.mean(p_moved) > 0.8 > 0.5 > np.mean(p_as_were)
     np.testing.assert_allclose(moved.predict(Xq)[:, 0], moved.predictive_outcomes(Xq).share(
@@ -318,11 +346,12 @@ def test_an_outcome_that_ends_beyond_the_table_edge_counts_as_off_the_table():
         outcomes.off_beyond(np.zeros((3, 2)), (-0.76, y_low), (x_edge, y_high))
     with pytest.raises(ValueError, match="table"):
         Planner({"grasp": model}, table=((0.0, 0.0), (-1.0, 1.0)))
-    # toward's target is checked against the planner's table: another frame, another table
+    # toward's start is checked against the planner's table (a place's target against the scene's, Place): a start
+    # 6 cm beyond the scene table's edge is refused by default, taken on a larger table
     with pytest.raises(ValueError, match="on the table top"):
-        Planner({"grasp": model}).toward(small, (0.0, 0.0), (0.1, 0.0), 0.03, steps_left=1, reachable=None)
+        Planner({"grasp": model}).toward(small, (-0.1, 0.0), (-0.2, 0.0), 0.03, steps_left=1, reachable=None)
     assert Planner({"grasp": model}, table=((-1.0, -1.0), (1.0, 1.0))).toward(
-        small, (0.0, 0.0), (0.1, 0.0), 0.03, steps_left=1, reachable=None).behavior == "grasp"
+        small, (-0.1, 0.0), (-0.2, 0.0), 0.03, steps_left=1, reachable=None).behavior == "grasp"
 
 
 def test_place_goals_lie_on_the_table_where_the_goal_env_puts_its_goals():
