@@ -93,7 +93,13 @@ from affordance_learning.planning.experiment.simulation import (
     reached,
 )
 from affordance_learning.planning.experiment.single_step import evaluate_object
-from affordance_learning.planning.experiment.statistics import calibrations, seconds_summary, summarize, wilson
+from affordance_learning.planning.experiment.statistics import (
+    calibrations,
+    seconds_summary,
+    summarize,
+    wilson,
+    within_shares,
+)
 from affordance_learning.planning.experiment.training import (
     TOP_UP_EPISODES,
     TOP_UP_MARGIN,
@@ -113,4 +119,4 @@ __all__ = ["DATASET_DIR", "DIRECTIONS", "EVAL_STREAM", "GOALS_PER_OBJECT", "GOAL
            "evaluation_env", "evaluation_items", "feasible_at", "fit_models", "goal_toward_robot", "load_training",
            "measured_outcome", "oracle_params", "place_target", "reach_failure", "reached", "record_episode",
            "run_plan", "seconds_summary", "share_text", "step_reach", "summarize", "top_up_path", "toward_robot",
-           "training_frames", "wilson", "within_reach"]
+           "training_frames", "wilson", "within_reach", "within_shares"]

@@ -38,12 +38,19 @@ from affordance_learning.planning.experiment.settings import (
     oracle_params,
 )
 from affordance_learning.planning.experiment.single_step import evaluate_object
-from affordance_learning.planning.experiment.statistics import calibrations, seconds_summary, summarize, wilson
+from affordance_learning.planning.experiment.statistics import (
+    calibrations,
+    seconds_summary,
+    summarize,
+    wilson,
+    within_shares,
+)
 from affordance_learning.planning.experiment.training import collect_training, fit_models, training_frames
 from affordance_learning.planning.planner import Planner
 from affordance_learning.planning.results import (
     PLAN_RESULTS_FORMAT,
     PLAN_RESULTS_VERSION,
+    SUCCESS_DISTANCES_M,
     Episode,
     GoalRecord,
     MultiStep,
@@ -52,6 +59,7 @@ from affordance_learning.planning.results import (
     PolicyOutcome,
     Rate,
     ReachFailures,
+    WithinDistance,
 )
 
 #: The format ``results.json`` of ``affordance plan`` declares, and its version.
@@ -142,8 +150,17 @@ def _single_step(run: _Stages, objects: list) -> tuple[list[dict], dict[str, Pol
             f"(with step 5: {run.timings['evaluate']:.0f} s): "
             + ", ".join(f"{p} {share_text(single[p].success, single[p].n, single[p].success_ci)}"
                         for p in POLICIES)
-            + f"; {single['oracle'].n_feasible} goals feasible")
+            + f"; {single['oracle'].n_feasible} goals feasible; place goals within "
+            + _within_text(within_shares([r["planner_within"] for r in records if "planner_within" in r])))
     return records, single, fixed_choice
+
+
+def _within_text(shares: Sequence[WithinDistance]) -> str:
+    """Shares within each distance as the console shows them: ``"1 cm 10 %, 3 cm 30 %, 5 cm 45 % (n=240)"``."""
+    if not shares or not shares[0].n:
+        return "not measured (n=0)"
+    return (", ".join(f"{100 * w.distance_m:.0f} cm {100 * w.success:.0f} %" for w in shares)
+            + f" (n={shares[0].n})")
 
 
 def _leave_one_shape_out(run: _Stages, records: Sequence[Mapping[str, Any]]
@@ -162,7 +179,8 @@ def _leave_one_shape_out(run: _Stages, records: Sequence[Mapping[str, Any]]
 
 def _policy_summary(episodes: Sequence[Mapping[str, Any]], **planner_only: Any) -> MultiStepOutcome:
     """One policy's multi-step episodes: success (and toward the robot) with Wilson intervals, reach failures per
-    interaction, episodes given up, the median final distance [m]; ``planner_only``: the planner's details
+    interaction, episodes given up, the median final distance [m], the share that ended on the table within each
+    of :data:`SUCCESS_DISTANCES_M` of the target; ``planner_only``: the planner's details
     (:func:`_planner_episodes`)."""
     n = len(episodes)
     k = sum(e["success"] for e in episodes)
@@ -175,7 +193,9 @@ def _policy_summary(episodes: Sequence[Mapping[str, Any]], **planner_only: Any) 
         interactions=interactions, gave_up=sum(e["gave_up"] for e in episodes),
         median_final_distance_m=float(np.median([e["final_distance"] for e in episodes])),
         success_toward_robot=kt / len(toward) if toward else None,
-        success_toward_robot_ci=wilson(kt, len(toward)), n_toward_robot=len(toward), **planner_only)
+        success_toward_robot_ci=wilson(kt, len(toward)), n_toward_robot=len(toward),
+        success_within=within_shares([[not e["off_table"] and e["final_distance"] <= d for d in SUCCESS_DISTANCES_M]
+                                      for e in episodes]), **planner_only)
 
 
 def _episode(e: Mapping[str, Any], reach: Mapping[str, Mapping[str, float]], tolerance: float, most: int
@@ -218,19 +238,24 @@ def _multi_step(run: _Stages, by_policy: Sequence[Sequence[Mapping[str, Any]]], 
             + ", ".join(f"{p} {share_text(o.success, o.n, o.success_ci)}" for p, o in multi.policies.items())
             + "; toward the robot: planner " + share_text(multi.planner.success_toward_robot,
                                                            multi.planner.n_toward_robot,
-                                                           multi.planner.success_toward_robot_ci))
+                                                           multi.planner.success_toward_robot_ci)
+            + "; planner within " + _within_text(multi.planner.success_within))
     return multi
 
 
 def _placement(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """The median distance [m] of the object's end from a place goal's target, over the place goals the planner
-    acted on (the median's n), and over those it acted on without abstaining (P(goal) >= its threshold)."""
+    acted on (the median's n), and over those it acted on without abstaining (P(goal) >= its threshold); and the
+    share of every place goal that the planner and the oracle brought within each of :data:`SUCCESS_DISTANCES_M`."""
     placement = [r["placement_error"] for r in records if "placement_error" in r]
     committed = [r["placement_error"] for r in records if r.get("placement_committed")]
+    places = [r for r in records if "planner_within" in r]
     return {"placement_error_median_m": float(np.median(placement)) if placement else None,
             "placement_error_n": len(placement),
             "placement_error_committed_median_m": float(np.median(committed)) if committed else None,
-            "placement_error_committed_n": len(committed)}
+            "placement_error_committed_n": len(committed),
+            "place_success_within": _view({policy: within_shares([r[f"{policy}_within"] for r in places])
+                                           for policy in ("planner", "oracle")})}
 
 
 #: What results.json keeps of each single-step goal's record.
