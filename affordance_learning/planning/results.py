@@ -379,7 +379,9 @@ class PlanResults:
         calibration: The calibration of the planner's predicted probabilities.
         decision_seconds: The planner's decision times, single-step and multi-step together (n 0 in results
             written before they were recorded).
-        timings_s: The time of each stage and the ``total`` [s].
+        timings_s: The time of each stage and the ``total`` [s]; where recorded, the collection's parts
+            (``collect_goal_episodes``, ``collect_top_up_<behaviour>``) and the CPU seconds the evaluation's
+            processes spent on the single step and on the multi-step episodes (``evaluate_*_cpu``).
         goals: The single-step goals, one record each (empty in results written without them).
     """
 

@@ -69,13 +69,17 @@ DATASET_DIR = "dataset"
 
 
 def _evaluate(task: tuple[str | None, Mapping[str, Any]], planner: Planner, shape_planners: Mapping[str, Planner],
-              som: SomBaseline | None, camera: tuple[int, int]):
-    """One task of the evaluation: ``(None, item)`` an object of the single step (:func:`evaluate_object`),
+              som: SomBaseline | None, camera: tuple[int, int]) -> tuple[Any, float]:
+    """One task of the evaluation and the CPU seconds its process spent on it (what it costs on a core of its own,
+    however loaded the machine): ``(None, item)`` an object of the single step (:func:`evaluate_object`),
     ``(policy, item)`` a multi-step episode of that policy (:func:`evaluate_episode`)."""
     policy, item = task
+    t = time.process_time()
     if policy is None:
-        return evaluate_object(item, planner, shape_planners, som, camera)
-    return evaluate_episode(item, planner, policy, camera)
+        done = evaluate_object(item, planner, shape_planners, som, camera)
+    else:
+        done = evaluate_episode(item, planner, policy, camera)
+    return done, time.process_time() - t
 
 
 @dataclass
@@ -102,7 +106,8 @@ def _collect(run: _Stages) -> tuple[pd.DataFrame, dict[str, pd.DataFrame]]:
     settings = run.settings
     run.say(f"[1/5] collecting goal episodes with random actions into {run.out / DATASET_DIR} until every behaviour "
             f"has {settings.max_per_behavior} interactions (at most {settings.max_episodes} episodes)")
-    frame = collect_training(run.out / DATASET_DIR, settings, run.seed, run.workers, run.camera, run.say)
+    frame = collect_training(run.out / DATASET_DIR, settings, run.seed, run.workers, run.camera, run.say,
+                             run.timings)
     frames = training_frames(frame, settings.max_per_behavior)
     run.timings["collect"] = time.perf_counter() - run.start
     run.say(f"      {frame['episode'].nunique()} episodes ({run.timings['collect']:.0f} s); "
@@ -136,6 +141,10 @@ def _evaluate_all(run: _Stages, planner: Planner, shape_planners: Mapping[str, P
                             + [(policy, item) for policy in MULTI_POLICIES for item in multi_items],
                             run.workers, planner=planner, shape_planners=shape_planners, som=som, camera=run.camera)
     run.timings["evaluate"] = time.perf_counter() - t
+    # the CPU seconds the processes spent on each part, together (what the evaluation costs on one core)
+    run.timings["evaluate_single_step_cpu"] = sum(s for _, s in done[: len(items)])
+    run.timings["evaluate_multi_step_cpu"] = sum(s for _, s in done[len(items):])
+    done = [d for d, _ in done]
     objects, multi_done = done[: len(items)], done[len(items):]
     n = len(multi_items)
     return objects, [multi_done[i * n: (i + 1) * n] for i in range(len(MULTI_POLICIES))]
