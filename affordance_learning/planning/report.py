@@ -47,6 +47,10 @@ def write_plan_report(results: PlanResults | Mapping[str, Any], out: str | os.Pa
               + ", ".join(f"{b} {n}" for b, n in results.training.items())
               + f" (random actions from {results.episodes} goal episodes, objects over the workspaces). "
               f"Total time {results.total_time_s / 60:.1f} min.", ""]
+    if results.settings.get("quick"):
+        lines += ["**A quick run** (`affordance plan --quick`): the whole pipeline on few data, to see that it runs "
+                  "and what it writes. Its numbers are not the experiment's: wherever n is below a target's minimum "
+                  "the verdict reads *too few data*.", ""]
     oracle = results.oracle
     if oracle:
         lines += [f"Single step: {oracle.get('objects')} held-out objects ("

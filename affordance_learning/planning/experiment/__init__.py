@@ -80,6 +80,7 @@ from affordance_learning.planning.experiment.settings import (
     PLACE_DISTANCE,
     PLACE_TOLERANCE,
     POLICIES,
+    QUICK,
     PlanSettings,
     evaluation_items,
     oracle_params,
@@ -112,7 +113,7 @@ from affordance_learning.planning.experiment.training import (
 
 __all__ = ["DATASET_DIR", "DIRECTIONS", "EVAL_STREAM", "GOALS_PER_OBJECT", "GOAL_KINDS", "MOVE_DISTANCE",
            "MULTI_POLICIES", "ORACLE_LEVELS", "Outcomes", "PLACE_DISTANCE", "PLACE_TOLERANCE", "POLICIES", "PULLING",
-           "PlanSettings",
+           "PlanSettings", "QUICK",
            "RESULTS_FORMAT", "SomBaseline", "TOP_UP_EPISODES", "TOP_UP_MARGIN", "TOWARD_ROBOT_EVERY",
            "TOWARD_ROBOT_OBJECTS", "best_fixed", "calibration", "calibrations", "collect_training",
            "direction_heuristic", "draw_goal", "draw_goals", "episode_start", "evaluate_episode", "evaluate_object",

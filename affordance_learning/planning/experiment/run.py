@@ -18,7 +18,6 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from affordance_env.dataset import load_dataset
 from affordance_env.goal_env import TapAffordanceGoalEnv
 from affordance_env.objects import OBJECT_TYPES
 from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
@@ -45,7 +44,12 @@ from affordance_learning.planning.experiment.statistics import (
     wilson,
     within_shares,
 )
-from affordance_learning.planning.experiment.training import collect_training, fit_models, training_frames
+from affordance_learning.planning.experiment.training import (
+    collect_training,
+    fit_models,
+    load_training,
+    training_frames,
+)
 from affordance_learning.planning.planner import Planner
 from affordance_learning.planning.results import (
     PLAN_RESULTS_FORMAT,
@@ -97,7 +101,8 @@ class _Stages:
 
     def planner(self, frames: Mapping[str, pd.DataFrame]) -> Planner:
         """A planner over effect models fitted on ``frames``, with the run's sizes."""
-        return Planner(fit_models(frames, self.seed, n_jobs=self.workers), n_candidates=self.settings.candidates,
+        return Planner(fit_models(frames, self.seed, n_jobs=self.workers, n_estimators=self.settings.trees),
+                       n_candidates=self.settings.candidates,
                        threshold=self.settings.threshold, random_state=self.seed)
 
 
@@ -335,11 +340,12 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
 def record_episode(out: str | os.PathLike, results: PlanResults | Mapping[str, Any], seed: int = 0
                    ) -> list[tuple[str, np.ndarray]]:
     """Pictures of one multi-step planner episode (the first of the evaluation's), with the models refitted from
-    ``out/dataset``: the start, then the scene after each interaction, titled with the behaviour."""
+    ``out/dataset`` and its top-ups (:func:`~.training.load_training`, as the run fitted them): the start, then
+    the scene after each interaction, titled with the behaviour."""
     settings = PlanSettings(**PlanResults.from_dict(results).settings)
-    frames = training_frames(load_dataset(Path(out) / DATASET_DIR), settings.max_per_behavior)
-    planner = Planner(fit_models(frames, seed), n_candidates=settings.candidates, threshold=settings.threshold,
-                      random_state=seed)
+    frames = training_frames(load_training(Path(out) / DATASET_DIR), settings.max_per_behavior)
+    planner = Planner(fit_models(frames, seed, n_estimators=settings.trees), n_candidates=settings.candidates,
+                      threshold=settings.threshold, random_state=seed)
     env = TapAffordanceGoalEnv(position_range="workspace", render_mode="rgb_array", render_width=320,
                                render_height=240)
     try:

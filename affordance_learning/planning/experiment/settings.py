@@ -61,6 +61,9 @@ class PlanSettings:
         candidates: The planner's parameter vectors per behaviour.
         threshold: The planner abstains below this P(goal).
         som_clusters: Effect categories of the ``som_categories`` baseline.
+        trees: Trees of each behaviour's effect model (its forest's ``n_estimators``).
+        quick: A quick run (:data:`QUICK`): the whole pipeline on too few data for the targets' verdicts, which
+            then read "too few data" wherever n is below a target's minimum; the console and the report say so.
 
     Sizing (TapAffordanceGoal-v2, five behaviours, one core each): an object's single step costs 18-57 s (seed 0),
     most of it the oracle (65 actions x 5 behaviours; a grasp 0.2-0.5 s, a stroke or a draw 0.02-0.06 s); a
@@ -79,6 +82,8 @@ class PlanSettings:
     candidates: int = 64
     threshold: float = 0.5
     som_clusters: int = 6
+    trees: int = 200
+    quick: bool = False
 
     @property
     def goals(self) -> int:
@@ -96,3 +101,11 @@ def evaluation_items(seed: int, part: int, n: int) -> list[dict]:
         env_seed, rng_seed = (int(v) for v in ss.generate_state(2))
         items.append({"seed": env_seed, "rng": rng_seed, "index": i, "shape": OBJECT_TYPES[i % len(OBJECT_TYPES)]})
     return items
+
+
+#: The sizes of ``affordance plan --quick``: the whole pipeline in a few minutes, to see that it runs and what it
+#: writes, not to judge the targets (every n stays below their minimum). 60 goal episodes give each behaviour
+#: 25-35 interactions (about 0.45 grasps an episode), the rest topped up to 60; one held-out object of each shape;
+#: 6 multi-step episodes per policy; 25 trees instead of 200 (fit and prediction take about an eighth as long).
+QUICK = PlanSettings(episodes=60, max_per_behavior=60, max_episodes=60, objects=4, multi_episodes=6, candidates=32,
+                     som_clusters=4, trees=25, quick=True)

@@ -30,11 +30,12 @@ def training_frames(frame: pd.DataFrame, max_per_behavior: int, exclude_type: st
     return {b: frame[frame["behavior"] == b].head(max_per_behavior) for b in BEHAVIOR_NAMES}
 
 
-def fit_models(frames: Mapping[str, pd.DataFrame], random_state: int, n_jobs: int | None = None
-               ) -> dict[str, ActionEffectModel]:
-    """An effect model per behaviour (:func:`~affordance_learning.planning.effect_model.behavior_model`)."""
-    return {b: behavior_model(b, random_state=random_state, n_jobs=n_jobs).fit(model_inputs(f), outcome_table(f))
-            for b, f in frames.items()}
+def fit_models(frames: Mapping[str, pd.DataFrame], random_state: int, n_jobs: int | None = None,
+               n_estimators: int = 200) -> dict[str, ActionEffectModel]:
+    """An effect model per behaviour (:func:`~affordance_learning.planning.effect_model.behavior_model`) of
+    ``n_estimators`` trees."""
+    return {b: behavior_model(b, random_state=random_state, n_jobs=n_jobs, n_estimators=n_estimators)
+            .fit(model_inputs(f), outcome_table(f)) for b, f in frames.items()}
 
 
 #: Top-up interactions are collected this many times what is missing (some fail, and are not rows) ...
