@@ -504,13 +504,15 @@ def test_the_evaluation_takes_new_processes_not_those_joblib_kept_from_the_colle
 
 @pytest.mark.slow
 def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
-    from affordance_learning.planning.experiment import PlanSettings, oracle_params, run_plan
+    from dataclasses import replace
+
+    from affordance_learning.planning.experiment import QUICK, oracle_params, run_plan
     from affordance_learning.planning.report import write_plan_figures, write_plan_report
     from affordance_learning.planning.results import PlanResults
     from affordance_learning.planning.targets import TARGETS
 
-    settings = PlanSettings(episodes=40, max_episodes=40, objects=2, multi_episodes=2, candidates=8,
-                            som_clusters=2)
+    # the quick run's data (60 goal episodes, each behaviour topped up to 60 interactions, 25 trees), fewer objects
+    settings = replace(QUICK, objects=2, multi_episodes=2, candidates=8, som_clusters=2)
     plan = run_plan(tmp_path, seed=1, workers=1, settings=settings, camera=(40, 30), say=lambda text: None)
     results = json.loads((tmp_path / "results.json").read_text())
     assert PlanResults.from_dict(results) == plan  # the file reads back as the results it was written from
@@ -532,6 +534,17 @@ def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     assert set(results["leave_one_shape_out"]) == {"sphere", "box", "horizontal_cylinder", "vertical_cylinder"}
     for policy in ("planner", "direction", "random"):
         assert 0 <= results["multi_step"][policy]["reach_failures"] <= 1
+        within = results["multi_step"][policy]["success_within"]  # 1, 3 and 5 cm: nested, as the distances are
+        assert [w["distance_m"] for w in within] == [0.01, 0.03, 0.05] and all(w["n"] == 2 for w in within)
+        assert within[0]["success"] <= within[1]["success"] <= within[2]["success"]
+        assert within[1]["success"] == results["multi_step"][policy]["success"]  # the goal env's own 3 cm
+    places = sum(g["kind"] == "place" for g in results["goals"])
+    for policy in ("planner", "oracle"):
+        within = results["place_success_within"][policy]
+        assert [w["n"] for w in within] == [places] * 3 and within[0]["success"] <= within[2]["success"]
+    assert plan.place_within("planner", 0.03).value == sum(  # the place goals' own tolerance: the same verdicts
+        g["planner"] for g in results["goals"] if g["kind"] == "place") / places
+    assert {"collect_goal_episodes", "collect_top_up_tap", "evaluate_single_step_cpu"} <= set(results["timings_s"])
     assert {"ece", "auroc"} <= set(results["calibration"])
     actions = len(BEHAVIOR_NAMES) * len(oracle_params())  # every goal: how many of the oracle's actions reached it
     for goal in results["goals"]:
