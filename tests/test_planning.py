@@ -502,6 +502,15 @@ def test_the_evaluation_takes_new_processes_not_those_joblib_kept_from_the_colle
     assert fresh and not fresh & kept
 
 
+def test_the_goal_episodes_are_counted_without_the_top_ups():
+    from affordance_learning.planning.experiment import TOP_UP_EPISODES
+    from affordance_learning.planning.experiment.run import _goal_episodes
+
+    # 3 goal episodes of 2 steps, then two behaviours' top-ups, each numbered from TOP_UP_EPISODES
+    frame = pd.DataFrame({"episode": [0, 0, 1, 1, 2, 2] + [TOP_UP_EPISODES + i for i in (0, 1, 2, 0, 1)]})
+    assert _goal_episodes(frame) == 3
+
+
 @pytest.mark.slow
 def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     from dataclasses import replace

@@ -45,6 +45,7 @@ from affordance_learning.planning.experiment.statistics import (
     within_shares,
 )
 from affordance_learning.planning.experiment.training import (
+    TOP_UP_EPISODES,
     collect_training,
     fit_models,
     load_training,
@@ -115,9 +116,15 @@ def _collect(run: _Stages) -> tuple[pd.DataFrame, dict[str, pd.DataFrame]]:
                              run.timings)
     frames = training_frames(frame, settings.max_per_behavior)
     run.timings["collect"] = time.perf_counter() - run.start
-    run.say(f"      {frame['episode'].nunique()} episodes ({run.timings['collect']:.0f} s); "
+    run.say(f"      {_goal_episodes(frame)} goal episodes and their top-ups ({run.timings['collect']:.0f} s); "
             + ", ".join(f"{b} {len(f)}" for b, f in frames.items()) + " interactions for training")
     return frame, frames
+
+
+def _goal_episodes(frame: pd.DataFrame) -> int:
+    """The goal episodes of a training frame (:func:`~.training.load_training`), not counting the top-ups' single
+    interactions (numbered from ``TOP_UP_EPISODES``, each top-up from there)."""
+    return int(frame.loc[frame["episode"] < TOP_UP_EPISODES, "episode"].nunique())
 
 
 def _fit(run: _Stages, frame: pd.DataFrame, frames: Mapping[str, pd.DataFrame]
@@ -290,7 +297,7 @@ def _results(run: _Stages, frame: pd.DataFrame, frames: Mapping[str, pd.DataFram
     return PlanResults(
         seed=run.seed, settings=_view(asdict(run.settings)),
         training=_view({b: len(f) for b, f in frames.items()}),
-        training_episodes=int(frame["episode"].nunique()),
+        training_episodes=_goal_episodes(frame),
         workers=run.workers, cpu_count=os.cpu_count(),
         oracle=_view({"actions_per_behavior": len(oracle_params()), "levels": list(ORACLE_LEVELS),
                       "objects": n_objects, "goals_per_object": dict(GOALS_PER_OBJECT),
