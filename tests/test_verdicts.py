@@ -266,8 +266,11 @@ def test_shares_within_1_3_and_5_cm_carry_their_n_and_read_too_few_below_the_min
 def test_a_quick_run_says_so_in_its_report(tmp_path: Path) -> None:
     results = _plan_results()
     assert "quick run" not in write_plan_report(results, tmp_path).read_text()
+    plan_time = "affordance plan's time [min]"
+    assert evaluate_targets(results)[plan_time].word == MET  # 1 min of a full run
     results["settings"] = {**results["settings"], "quick": True}
     assert "**A quick run** (`affordance plan --quick`)" in write_plan_report(results, tmp_path).read_text()
+    assert evaluate_targets(results)[plan_time].word == TOO_FEW  # a quick run's time is not a full run's
 
 
 # --- the paper's claims ----------------------------------------------------------------------------------------

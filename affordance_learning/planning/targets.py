@@ -499,6 +499,15 @@ def _seconds(which: str) -> Callable[[PlanResults], Measured]:
     return lambda r: Measured(getattr(r.decision_seconds, which), r.decision_seconds.n, "decisions")
 
 
+def _plan_time(results: PlanResults) -> Measured:
+    """The run's time [min], on one full run: a quick run (``settings["quick"]``) is none (n=0), its time not the
+    one the bound is for."""
+    workers = f"on {results.workers or '?'} workers"
+    if results.settings.get("quick"):
+        return Measured(results.total_time_s / 60, 0, "full runs")
+    return Measured(results.total_time_s / 60, 1, f"run {workers}")
+
+
 _TARGET_LIST = (
     Target("single-step success on feasible goals", ">=", 0.92, MIN_FEASIBLE_GOALS,
            lambda r: _measured(_single(r).feasible, "feasible goals"), why=_single_step_gap_why),
@@ -528,9 +537,7 @@ _TARGET_LIST = (
            _decision_time_why),
     Target("decision time, 99th percentile [s]", "<=", 1.0, MIN_DECISIONS, _seconds("p99"), SECONDS,
            _decision_time_why),
-    Target("affordance plan's time [min]", "<=", 15.0, 1,
-           lambda r: Measured(r.total_time_s / 60, 1, f"run on {r.workers or '?'} workers"), MINUTES,
-           _plan_time_why),
+    Target("affordance plan's time [min]", "<=", 15.0, 1, lambda r: _plan_time(r), MINUTES, _plan_time_why),
 )
 #: Every target of the planner by name, in the order the report lists them.
 TARGETS: Mapping[str, Target] = {t.name: t for t in _TARGET_LIST}
