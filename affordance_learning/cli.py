@@ -333,20 +333,26 @@ def _check_plan_out(out: Path, seed: int) -> None:
 
 def _plan(args: argparse.Namespace) -> int:
     _check_plan_out(args.out, args.seed)
+    from dataclasses import replace
+
     from affordance_learning.common.verdicts import tally_text
-    from affordance_learning.planning.experiment import PlanSettings, record_episode, run_plan
+    from affordance_learning.planning.experiment import QUICK, PlanSettings, record_episode, run_plan
     from affordance_learning.planning.report import write_plan_figures, write_plan_report
     from affordance_learning.planning.targets import evaluate_targets
 
-    settings = PlanSettings(**{name: getattr(args, name) for name in PLAN_DEFAULTS
-                               if getattr(args, name) is not None})
+    settings = replace(QUICK if args.quick else PlanSettings(),
+                       **{name: getattr(args, name) for name in PLAN_DEFAULTS if getattr(args, name) is not None})
+    if settings.quick:
+        print("a quick run: the whole pipeline on few data (--quick), so its targets' verdicts read \"too few data\" "
+              "where n is below a target's minimum")
     plan = run_plan(args.out, seed=args.seed, workers=args.workers, settings=settings)
     frames = record_episode(args.out, plan, seed=args.seed)
     write_plan_figures(plan, args.out, frames)
     report = write_plan_report(plan, args.out)
     verdicts = list(evaluate_targets(plan).values())
-    print(f"{tally_text(verdicts, 'targets')} (a verdict only on enough data); {report} gives each with its n and "
-          f"why a missed one is missed; {args.out / 'results.json'} holds every number "
+    quick = " of a quick run, on too few data for most verdicts" if settings.quick else ""
+    print(f"{tally_text(verdicts, 'targets')}{quick} (a verdict only on enough data); {report} gives each with its n "
+          f"and why a missed one is missed; {args.out / 'results.json'} holds every number "
           f"({plan.total_time_s / 60:.1f} min)")
     return 0
 
@@ -446,6 +452,9 @@ def _add_plan_parser(sub: argparse._SubParsersAction) -> None:
                       f"{PLAN_DEFAULTS['objects']})")
     plan.add_argument("--multi-episodes", type=positive_int, default=None,
                       help=f"multi-step episodes per policy (default {PLAN_DEFAULTS['multi_episodes']})")
+    plan.add_argument("--quick", action="store_true",
+                      help="a quick run: the whole pipeline on few data (few episodes, objects and trees) in a few "
+                      "minutes, its verdicts on too few data; --episodes, --objects, --multi-episodes still apply")
     plan.set_defaults(func=_plan)
 
 

@@ -43,6 +43,8 @@ from affordance_learning.planning.outcomes import model_inputs, outcome_table
 GOALS = [Roll(), Lift(), *(Move(d, 0.05) for d in ((1, 0), (-1, 0), (0, 1), (0, -1)))]
 #: Place goals per held-out interaction, their distance from where the object was [m] and tolerance [m].
 PLACES, PLACE_DISTANCE, PLACE_TOLERANCE = 2, (0.05, 0.15), 0.03
+#: Where the places are, on the table (x, y) [m]: only the offset from the object's start matters.
+PLACE_AT = (-0.46, 0.0)
 
 
 class KnnEffectModel:
@@ -81,11 +83,11 @@ def main() -> None:
         split = int(0.75 * len(rows))
         train, test = rows.iloc[:split], rows.iloc[split:]
         X, Y, Xt, Yt = model_inputs(train), outcome_table(train), model_inputs(test), outcome_table(test)
-        # Places relative to where each object was: Place((0, 0)) seen from minus the target's offset
+        # Places relative to where each object was: a place on the table seen from it minus the target's offset
         angle = rng.uniform(-np.pi, np.pi, (PLACES, len(Yt)))
         offsets = rng.uniform(*PLACE_DISTANCE, (PLACES, len(Yt)))[..., None] * np.stack([np.cos(angle),
                                                                                           np.sin(angle)], -1)
-        place = Place((0.0, 0.0), PLACE_TOLERANCE)
+        place = Place(PLACE_AT, PLACE_TOLERANCE)
         for name, make in learners.items():
             start = time.perf_counter()
             model = make(behavior).fit(X, Y)
@@ -97,8 +99,8 @@ def main() -> None:
                     scores[name]["y"].append(truth)
             for offset in offsets:
                 for key in ("", "place_"):
-                    scores[name][f"{key}p"].append(model.goal_probability(Xt, place, -offset))
-                    scores[name][f"{key}y"].append(place.reached(Yt, -offset))
+                    scores[name][f"{key}p"].append(model.goal_probability(Xt, place, PLACE_AT - offset))
+                    scores[name][f"{key}y"].append(place.reached(Yt, PLACE_AT - offset))
     print(f"{'learner':<15} {'goals':<6} {'log-loss':>9} {'Brier':>7} {'ECE':>7} {'AUROC':>7} {'fit [s]':>8}")
     for name, s in scores.items():
         for key, goals in (("", "all"), ("place_", "place")):

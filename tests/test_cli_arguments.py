@@ -123,6 +123,27 @@ def test_plan_takes_the_sizes_given_and_plan_settings_defaults_otherwise(no_work
     assert started.value.args[1]["settings"] == PlanSettings(objects=3)
 
 
+def test_a_quick_plan_takes_few_data_and_says_its_verdicts_are_on_too_few(no_work, tmp_path, capsys):
+    from dataclasses import replace
+
+    from affordance_learning.planning.experiment import GOALS_PER_OBJECT, QUICK
+    from affordance_learning.planning.targets import MIN_CALIBRATION_ACTIONS, MIN_EPISODES, MIN_FEASIBLE_GOALS
+
+    with pytest.raises(WorkStarted) as started:
+        main(["plan", "--out", str(tmp_path / "out"), "--quick"])
+    settings = started.value.args[1]["settings"]
+    assert settings == QUICK and settings.quick
+    out = capsys.readouterr().out
+    assert "a quick run" in out and "too few data" in out
+    # few episodes, objects and trees: every n of the targets below its minimum, so no verdict is given on them
+    assert settings.max_episodes <= 100 and settings.max_per_behavior <= 100 and settings.trees <= 50
+    assert settings.objects * sum(GOALS_PER_OBJECT.values()) < min(MIN_FEASIBLE_GOALS, MIN_CALIBRATION_ACTIONS)
+    assert settings.multi_episodes < MIN_EPISODES
+    with pytest.raises(WorkStarted) as started:
+        main(["plan", "--out", str(tmp_path / "out"), "--quick", "--objects", "2"])
+    assert started.value.args[1]["settings"] == replace(QUICK, objects=2)  # a size given still applies
+
+
 def _manifest(directory, env_id="TapAffordance-v2", action="canonical", seed=0):
     from affordance_env.dataset.format import MANIFEST, dataset_header
 

@@ -46,10 +46,37 @@ def test_goals_round_trip_through_json_and_refuse_bad_fields():
         goal_from_dict({"kind": "fly"})
     with pytest.raises(ValueError, match="non-zero"):
         Move((0.0, 0.0))
-    with pytest.raises(ValueError, match="tolerance must be a positive"):
-        Place((0.0, 0.0), -1.0)
+    with pytest.raises(ValueError, match="tolerance must be a distance in metres"):
+        Place((-0.3, 0.0), -1.0)
     with pytest.raises(ValueError, match="start_xy"):
-        Place((0.0, 0.0)).reached({"dx": [0.0], "dy": [0.0], "off_table": [False]})
+        Place((-0.3, 0.0)).reached({"dx": [0.0], "dy": [0.0], "off_table": [False]})
+
+
+def test_goals_refuse_what_cannot_be_metres_on_the_table():
+    """The table top is x in [-0.76, -0.16], y in [-0.5, 0.5] (1.17 m across): a distance, a place or a tolerance
+    in centimetres, given as metres, is refused with the value and the unit expected."""
+    from affordance_learning.planning.goals import MAX_TOLERANCE, table_diagonal
+
+    assert table_diagonal() == pytest.approx(np.hypot(0.6, 1.0))
+    with pytest.raises(ValueError, match=r"min_distance must be a distance in metres on the table, in \(0, 1.17\] m "
+                                         r"\(the table's diagonal\), got 5"):
+        Move((2, 0), 5)
+    with pytest.raises(ValueError, match="min_distance must be a distance in metres"):
+        Move((1, 0), 0.0)
+    assert Move((1, 0), 1.1).min_distance == 1.1  # corner to corner, nearly
+    with pytest.raises(ValueError, match=r"target_xy must be \(x, y\) \[m\] on the table top, x in \[-0.76, -0.16\] "
+                                         r"and y in \[-0.50, 0.50\].*got \(-30, 10\)"):
+        Place((-30, 10))
+    with pytest.raises(ValueError, match="target_xy must be .* got \\(0.0, 0.0\\): 16 cm off the table"):
+        Place((0.0, 0.0))
+    assert Place((-0.14, 0.0), 0.03).target_xy == (-0.14, 0.0)  # 2 cm beyond the edge: within 3 cm of the rim
+    with pytest.raises(ValueError, match="target_xy"):
+        Place((-0.14, 0.0), 0.01)
+    with pytest.raises(ValueError, match=r"tolerance must be a distance in metres, in \(0, 0.5\] m, got 3"):
+        Place((-0.3, 0.0), 3)
+    assert Place((-0.3, 0.0), MAX_TOLERANCE).tolerance == 0.5
+    with pytest.raises(ValueError, match="min_distance must be a distance in metres"):
+        goal_from_dict({"kind": "move", "direction": [1, 0], "min_distance": 5})
 
 
 def test_goals_judge_outcomes():
@@ -269,8 +296,9 @@ def test_predictive_outcomes_move_each_neighbour_to_the_query_action():
             assert np.abs(outcomes.displacement[~lifted]).max() < 0.005
         else:  # as they were, the neighbours' actions blur the place by centimetres
             assert np.median(error[lifted]) > 0.01
-    place = [Place(tuple(0.2 * x[2:4]), 0.01) for x in Xq[small]]
-    p_moved, p_as_were = ([model.goal_probability(x[None], goal, (0.0, 0.0))[0]
+    on_table = np.array([-0.46, 0.0])  # a place is on the table: 20 cm around its middle
+    place = [Place(tuple(on_table + 0.2 * x[2:4]), 0.01) for x in Xq[small]]
+    p_moved, p_as_were = ([model.goal_probability(x[None], goal, on_table)[0]
                            for x, goal in zip(Xq[small], place, strict=True)] for model in (moved, as_were))
     assert np.mean(p_moved) > 0.8 > 0.5 > np.mean(p_as_were)
     np.testing.assert_allclose(moved.predict(Xq)[:, 0], moved.predictive_outcomes(Xq).share(
@@ -322,11 +350,12 @@ def test_an_outcome_that_ends_beyond_the_table_edge_counts_as_off_the_table():
         outcomes.off_beyond(np.zeros((3, 2)), (-0.76, y_low), (x_edge, y_high))
     with pytest.raises(ValueError, match="table"):
         Planner({"grasp": model}, table=((0.0, 0.0), (-1.0, 1.0)))
-    # toward's target is checked against the planner's table: another frame, another table
+    # toward's start is checked against the planner's table (a place's target against the scene's, Place): a start
+    # 6 cm beyond the scene table's edge is refused by default, taken on a larger table
     with pytest.raises(ValueError, match="on the table top"):
-        Planner({"grasp": model}).toward(small, (0.0, 0.0), (0.1, 0.0), 0.03, steps_left=1, reachable=None)
+        Planner({"grasp": model}).toward(small, (-0.1, 0.0), (-0.2, 0.0), 0.03, steps_left=1, reachable=None)
     assert Planner({"grasp": model}, table=((-1.0, -1.0), (1.0, 1.0))).toward(
-        small, (0.0, 0.0), (0.1, 0.0), 0.03, steps_left=1, reachable=None).behavior == "grasp"
+        small, (-0.1, 0.0), (-0.2, 0.0), 0.03, steps_left=1, reachable=None).behavior == "grasp"
 
 
 def test_place_goals_lie_on_the_table_where_the_goal_env_puts_its_goals():
@@ -477,15 +506,26 @@ def test_the_evaluation_takes_new_processes_not_those_joblib_kept_from_the_colle
     assert fresh and not fresh & kept
 
 
+def test_the_goal_episodes_are_counted_without_the_top_ups():
+    from affordance_learning.planning.experiment import TOP_UP_EPISODES
+    from affordance_learning.planning.experiment.run import _goal_episodes
+
+    # 3 goal episodes of 2 steps, then two behaviours' top-ups, each numbered from TOP_UP_EPISODES
+    frame = pd.DataFrame({"episode": [0, 0, 1, 1, 2, 2] + [TOP_UP_EPISODES + i for i in (0, 1, 2, 0, 1)]})
+    assert _goal_episodes(frame) == 3
+
+
 @pytest.mark.slow
 def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
-    from affordance_learning.planning.experiment import PlanSettings, oracle_params, run_plan
+    from dataclasses import replace
+
+    from affordance_learning.planning.experiment import QUICK, oracle_params, run_plan
     from affordance_learning.planning.report import write_plan_figures, write_plan_report
     from affordance_learning.planning.results import PlanResults
     from affordance_learning.planning.targets import TARGETS
 
-    settings = PlanSettings(episodes=40, max_episodes=40, objects=2, multi_episodes=2, candidates=8,
-                            som_clusters=2)
+    # the quick run's data (60 goal episodes, each behaviour topped up to 60 interactions, 25 trees), fewer objects
+    settings = replace(QUICK, objects=2, multi_episodes=2, candidates=8, som_clusters=2)
     plan = run_plan(tmp_path, seed=1, workers=1, settings=settings, camera=(40, 30), say=lambda text: None)
     results = json.loads((tmp_path / "results.json").read_text())
     assert PlanResults.from_dict(results) == plan  # the file reads back as the results it was written from
@@ -507,6 +547,17 @@ def test_affordance_plan_end_to_end_writes_results_report_and_figures(tmp_path):
     assert set(results["leave_one_shape_out"]) == {"sphere", "box", "horizontal_cylinder", "vertical_cylinder"}
     for policy in ("planner", "direction", "random"):
         assert 0 <= results["multi_step"][policy]["reach_failures"] <= 1
+        within = results["multi_step"][policy]["success_within"]  # 1, 3 and 5 cm: nested, as the distances are
+        assert [w["distance_m"] for w in within] == [0.01, 0.03, 0.05] and all(w["n"] == 2 for w in within)
+        assert within[0]["success"] <= within[1]["success"] <= within[2]["success"]
+        assert within[1]["success"] == results["multi_step"][policy]["success"]  # the goal env's own 3 cm
+    places = sum(g["kind"] == "place" for g in results["goals"])
+    for policy in ("planner", "oracle"):
+        within = results["place_success_within"][policy]
+        assert [w["n"] for w in within] == [places] * 3 and within[0]["success"] <= within[2]["success"]
+    assert plan.place_within("planner", 0.03).value == sum(  # the place goals' own tolerance: the same verdicts
+        g["planner"] for g in results["goals"] if g["kind"] == "place") / places
+    assert {"collect_goal_episodes", "collect_top_up_tap", "evaluate_single_step_cpu"} <= set(results["timings_s"])
     assert {"ece", "auroc"} <= set(results["calibration"])
     actions = len(BEHAVIOR_NAMES) * len(oracle_params())  # every goal: how many of the oracle's actions reached it
     for goal in results["goals"]:

@@ -233,6 +233,46 @@ def test_the_plan_report_shows_n_beside_every_rate_and_no_zero_for_nothing(tmp_p
         assert cell.count("n=") >= len(rates), cell
 
 
+def test_shares_within_1_3_and_5_cm_carry_their_n_and_read_too_few_below_the_minimum(tmp_path: Path) -> None:
+    from affordance_learning.common.typed_json import to_json
+    from affordance_learning.planning.experiment import within_shares
+    from affordance_learning.planning.targets import success_within
+
+    results = _plan_results(episodes=(MIN_EPISODES, 50))
+    # 40 place goals: 8 within 1 cm, 20 within 3 cm, 30 within 5 cm; the oracle every one within 5 cm
+    planner = [[i < 8, i < 20, i < 30] for i in range(40)]
+    results["place_success_within"] = {"planner": within_shares(planner),
+                                       "oracle": within_shares([[i < 20, i < 35, True] for i in range(40)])}
+    for policy in MULTI_POLICIES:  # each policy's episodes: 6 of 10 within 5 cm, too few for a verdict
+        results["multi_step"][policy]["success_within"] = within_shares([[False, i < 3, i < 6] for i in range(10)])
+    read = PlanResults.from_dict(to_json(PlanResults.from_dict(results)))  # results.json keeps them
+    assert read.place_within("planner", 0.05).value == 0.75 and read.place_within("planner", 0.01).n == 40
+    assert read.place_within("planner", 0.05).ci == wilson_interval(30, 40)
+    assert read.multi_step.policy("direction").within(0.03).value == 0.3
+    rows = {row.name: row for row in success_within(read)}
+    assert list(rows) == ["single-step place goals, planner", "single-step place goals, oracle",
+                          "multi-step targets, planner", "multi-step targets, direction", "multi-step targets, random"]
+    text = write_plan_report(read, tmp_path).read_text()
+    assert ("| single-step place goals, planner | 20.0 % [10, 35] (n=40 place goals) | 50.0 % [35, 65] (n=40 place "
+            "goals) | 75.0 % [60, 86] (n=40 place goals) |") in text
+    assert (f"| multi-step targets, planner | 0.0 % [0, 28] (n=10 episodes): {TOO_FEW} | 30.0 % [11, 60] (n=10 "
+            f"episodes): {TOO_FEW} | 60.0 % [31, 83] (n=10 episodes): {TOO_FEW} |") in text
+    # results written before these were recorded: no section, and nothing is made up
+    older = _plan_results()
+    assert success_within(older) == [] and "Within 1, 3 and 5 cm" not in write_plan_report(older, tmp_path).read_text()
+    assert PlanResults.from_dict(older).place_within("planner", 0.05).value is None
+
+
+def test_a_quick_run_says_so_in_its_report(tmp_path: Path) -> None:
+    results = _plan_results()
+    assert "quick run" not in write_plan_report(results, tmp_path).read_text()
+    plan_time = "affordance plan's time [min]"
+    assert evaluate_targets(results)[plan_time].word == MET  # 1 min of a full run
+    results["settings"] = {**results["settings"], "quick": True}
+    assert "**A quick run** (`affordance plan --quick`)" in write_plan_report(results, tmp_path).read_text()
+    assert evaluate_targets(results)[plan_time].word == TOO_FEW  # a quick run's time is not a full run's
+
+
 # --- the paper's claims ----------------------------------------------------------------------------------------
 def _grasp_results(straddle: list[tuple[int, int, list[float]]], trials: int = 20, rows: int = 1000) -> dict:
     """Grasp results with a critical size of 6 cm, a 1 x 3 map of (successes, failures, sizes) and a uniformity

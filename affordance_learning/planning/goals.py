@@ -18,6 +18,12 @@ one is.
   units of ``scale`` (the effects' spread in the training data, per feature).
 
 ``goal.to_dict()`` and :func:`goal_from_dict` round-trip through JSON.
+
+Distances and positions are metres in the robot's root frame, on the scene's table
+(:func:`affordance_env.table.table_extent`): a goal refuses what cannot be that (a distance longer than the table's
+diagonal, a place further from the table top than its tolerance, a tolerance of 0 or of more than
+:data:`MAX_TOLERANCE`), naming the value and the unit expected, so that ``Move((1, 0), 5)`` meant as 5 cm is not
+taken for 5 m.
 """
 
 from __future__ import annotations
@@ -28,12 +34,57 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from affordance_env.table import table_extent
 from affordance_env.values import float_array
 from affordance_learning.common.exceptions import InvalidValueError
 
 #: An outcome that leaves the table counts as this far from any place [m] when outcomes are ranked by how far they
 #: go towards a goal (:meth:`Goal.progress`).
 OFF_TABLE_DISTANCE = 1.0
+
+
+#: The most a place's tolerance may be [m]: half the table's 1 m width (``assets/scene.xml``); a tolerance beyond it
+#: takes in most of the table top, so that nearly anywhere places the object, and is a unit mistake (centimetres or
+#: millimetres given as metres) far more likely than a goal.
+MAX_TOLERANCE = 0.5
+
+
+def _table() -> tuple[tuple[float, float], tuple[float, float]]:
+    """The table top's (lower, upper) corners (x, y) [m] (:func:`affordance_env.table.table_extent`, read once)."""
+    return table_extent()
+
+
+def table_diagonal() -> float:
+    """The table top's diagonal [m]: the longest move an object can make on it."""
+    (x0, y0), (x1, y1) = _table()
+    return float(np.hypot(x1 - x0, y1 - y0))
+
+
+def _check_distance(name: str, value: Any, distance: float) -> float:
+    """``distance`` [m] if positive and no longer than the table's diagonal, else InvalidValueError naming it."""
+    longest = table_diagonal()
+    if not 0 < distance <= longest:
+        raise InvalidValueError(f"{name} must be a distance in metres on the table, in (0, {longest:.2f}] m (the "
+                                f"table's diagonal), got {value!r}.")
+    return distance
+
+
+def _check_tolerance(value: Any, tolerance: float) -> float:
+    """A place's ``tolerance`` [m] if in (0, :data:`MAX_TOLERANCE`], else InvalidValueError naming it."""
+    if not 0 < tolerance <= MAX_TOLERANCE:
+        raise InvalidValueError(f"tolerance must be a distance in metres, in (0, {MAX_TOLERANCE}] m, got {value!r}.")
+    return tolerance
+
+
+def _check_on_table(name: str, value: Any, xy: np.ndarray, tolerance: float) -> None:
+    """InvalidValueError naming ``value`` where ``xy`` [m] lies further than ``tolerance`` [m] from the table top
+    (no object resting on the table could be within ``tolerance`` of it)."""
+    (x0, y0), (x1, y1) = _table()
+    off = np.hypot(max(x0 - xy[0], 0.0, xy[0] - x1), max(y0 - xy[1], 0.0, xy[1] - y1))
+    if off > tolerance:
+        raise InvalidValueError(f"{name} must be (x, y) [m] on the table top, x in [{x0:.2f}, {x1:.2f}] and y in "
+                                f"[{y0:.2f}, {y1:.2f}] (the robot's root frame; within the tolerance {tolerance:g} m "
+                                f"of it), got {value!r}: {100 * off:.0f} cm off the table.")
 
 
 def _column(outcomes: Any, name: str) -> np.ndarray:
@@ -119,7 +170,7 @@ class Lift(Goal):
 @dataclass(frozen=True)
 class Move(Goal):
     """The object's centre moves at least ``min_distance`` [m] along ``direction`` (normalised) and stays on the
-    table."""
+    table; ``min_distance`` in (0, the table's diagonal] (:func:`table_diagonal`)."""
 
     direction: tuple[float, float]
     min_distance: float = 0.05
@@ -131,9 +182,8 @@ class Move(Goal):
         if np.linalg.norm(d) < 1e-9:
             raise InvalidValueError(f"direction must be a non-zero (x, y) vector, got {self.direction!r}.")
         object.__setattr__(self, "direction", tuple(float(v) for v in d / np.linalg.norm(d)))
-        distance = float(_finite("min_distance", self.min_distance))
-        if distance <= 0:
-            raise InvalidValueError(f"min_distance must be a positive distance [m], got {self.min_distance!r}.")
+        distance = _check_distance("min_distance", self.min_distance, float(_finite("min_distance",
+                                                                                      self.min_distance)))
         object.__setattr__(self, "min_distance", distance)
 
     def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
@@ -169,7 +219,8 @@ def check_start(start_xy: Any) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Place(Goal):
-    """The object comes to rest within ``tolerance`` [m] of ``target_xy`` [m], on the table."""
+    """The object comes to rest within ``tolerance`` [m] of ``target_xy`` [m], on the table: ``target_xy`` in the
+    robot's root frame, at most ``tolerance`` from the table top, and ``tolerance`` in (0, :data:`MAX_TOLERANCE`]."""
 
     target_xy: tuple[float, float]
     tolerance: float = 0.03
@@ -179,10 +230,10 @@ class Place(Goal):
     ranks_by_progress = True
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "target_xy", tuple(float(v) for v in _finite("target_xy", self.target_xy, (2,))))
-        tolerance = float(_finite("tolerance", self.tolerance))
-        if tolerance <= 0:
-            raise InvalidValueError(f"tolerance must be a positive distance [m], got {self.tolerance!r}.")
+        target = _finite("target_xy", self.target_xy, (2,))
+        tolerance = _check_tolerance(self.tolerance, float(_finite("tolerance", self.tolerance)))
+        _check_on_table("target_xy", self.target_xy, target, tolerance)
+        object.__setattr__(self, "target_xy", tuple(float(v) for v in target))
         object.__setattr__(self, "tolerance", tolerance)
 
     def reached(self, outcomes: Any, start_xy: Any = None) -> np.ndarray:
@@ -291,5 +342,5 @@ def describe(goal: Goal) -> str:
     return goal.kind
 
 
-__all__: Sequence[str] = ["OFF_TABLE_DISTANCE", "Goal", "Lift", "Move", "Percept", "Place", "Roll", "check_goal",
-                          "describe", "goal_from_dict"]
+__all__: Sequence[str] = ["MAX_TOLERANCE", "OFF_TABLE_DISTANCE", "Goal", "Lift", "Move", "Percept", "Place", "Roll",
+                          "check_goal", "describe", "goal_from_dict", "table_diagonal"]

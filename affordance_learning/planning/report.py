@@ -17,7 +17,7 @@ import numpy as np
 from affordance_learning.common.exceptions import InvalidValueError
 from affordance_learning.common.verdicts import Verdict
 from affordance_learning.planning.experiment import GOAL_KINDS, MULTI_POLICIES, POLICIES, share_text, wilson
-from affordance_learning.planning.results import PlanResults, Share
+from affordance_learning.planning.results import SUCCESS_DISTANCES_M, PlanResults, Share
 from affordance_learning.planning.targets import (
     MIN_CALIBRATION_ACTIONS,
     MIN_DECISIONS,
@@ -29,6 +29,8 @@ from affordance_learning.planning.targets import (
     evaluate_targets,
     policy_outcome,
     share_cell,
+    success_within,
+    within_cell,
 )
 
 
@@ -45,6 +47,10 @@ def write_plan_report(results: PlanResults | Mapping[str, Any], out: str | os.Pa
               + ", ".join(f"{b} {n}" for b, n in results.training.items())
               + f" (random actions from {results.episodes} goal episodes, objects over the workspaces). "
               f"Total time {results.total_time_s / 60:.1f} min.", ""]
+    if results.settings.get("quick"):
+        lines += ["**A quick run** (`affordance plan --quick`): the whole pipeline on few data, to see that it runs "
+                  "and what it writes. Its numbers are not the experiment's: wherever n is below a target's minimum "
+                  "the verdict reads *too few data*.", ""]
     oracle = results.oracle
     if oracle:
         lines += [f"Single step: {oracle.get('objects')} held-out objects ("
@@ -63,6 +69,18 @@ def write_plan_report(results: PlanResults | Mapping[str, Any], out: str | os.Pa
               f"actions for the calibration, {MIN_EPISODES} multi-step episodes ({MIN_TOWARD_ROBOT} toward the "
               f"robot) and {MIN_DECISIONS} decisions. Shares carry their Wilson 95 % interval and n.", "",
               *target_rows(evaluate_targets(results).values())]
+    within = success_within(results)
+    if within:
+        lines += ["", "## Within 1, 3 and 5 cm of the target", "",
+                  "The share that came to rest on the table within each distance of its target (5 cm is the success "
+                  "threshold of FetchPush and Meta-World, 3 cm the place goals' and the goal env's tolerance). A "
+                  "multi-step episode ends within 3 cm or after its last interaction, so its 1 cm share counts where "
+                  "the object came to rest, not what a policy aiming at 1 cm would reach. A measure, not a target: "
+                  f"read on at least {MIN_PLACEMENTS} place goals or {MIN_EPISODES} episodes, else *too few data*.",
+                  "", "| cases | " + " | ".join(f"within {100 * d:.0f} cm [95 % CI]" for d in SUCCESS_DISTANCES_M)
+                  + " |", "|---|" + "---|" * len(SUCCESS_DISTANCES_M)]
+        lines += [f"| {row.name} | " + " | ".join(within_cell(share, row.unit, row.minimum) for share in row.shares)
+                  + " |" for row in within]
     single = results.single_step
     lines += ["", f"## Single step ({policy_outcome(single, 'planner', 'single-step').reached.n} goals; "
               f"{policy_outcome(single, 'oracle', 'single-step').feasible.n} feasible)", "",

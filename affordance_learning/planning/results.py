@@ -61,6 +61,27 @@ class Share:
 NOTHING = Share(None)
 
 
+#: The distances [m] at which the results give the share of place goals and of multi-step targets reached: 1 cm,
+#: the 3 cm of the place goals' and the goal env's tolerance, and 5 cm, the success threshold of Gymnasium-Robotics'
+#: FetchPush (``distance_threshold=0.05``) and of Meta-World's push and pick-place tasks.
+SUCCESS_DISTANCES_M = (0.01, 0.03, 0.05)
+
+
+@dataclass(frozen=True)
+class WithinDistance:
+    """The share of ``n`` cases whose object came to rest on the table within ``distance_m`` [m] of its target, with
+    its Wilson 95 % interval (``success`` None for a share of nothing)."""
+
+    distance_m: float
+    success: float | None
+    success_ci: Interval
+    n: Count
+
+    @property
+    def share(self) -> Share:
+        return Share(self.success, self.n, self.success_ci)
+
+
 @dataclass(frozen=True)
 class PolicyOutcome:
     """How often one policy reached its goals (:func:`~affordance_learning.planning.experiment.summarize`): its
@@ -151,7 +172,10 @@ class MultiStepOutcome:
     """How one policy did over the multi-step episodes: the share reached (``success``, ``success_ci``, ``n``),
     the reach failures per interaction (a fraction), its ``interactions``, the episodes it gave up, the median
     distance left at the end [m], the share reached toward the robot (``*_toward_robot``; None and 0 in results
-    written before it was recorded), and, for the planner only, ``planner_by_type``, ``planner_episodes`` and
+    written before it was recorded), the share that ended within each of :data:`SUCCESS_DISTANCES_M` of the target
+    (``success_within``; an episode ends within the goal env's 3 cm or after its last interaction, so at 1 cm this
+    counts where it came to rest, not what a policy aiming at 1 cm would reach; empty in results written before
+    it was recorded), and, for the planner only, ``planner_by_type``, ``planner_episodes`` and
     ``planner_within_reach`` (read through :attr:`by_type`, :attr:`episodes` and :attr:`within_reach`)."""
 
     success: float | None
@@ -167,11 +191,17 @@ class MultiStepOutcome:
     planner_by_type: Mapping[str, Rate] | None = field(default=None, metadata=json_options("by_type", True))
     planner_episodes: tuple[Episode, ...] | None = field(default=None, metadata=json_options("episodes", True))
     planner_within_reach: Rate | None = field(default=None, metadata=json_options("within_reach", True))
+    success_within: tuple[WithinDistance, ...] = ()
 
     @property
     def reached(self) -> Share:
         """Its share of the episodes that reached their target."""
         return Share(self.success, self.n, self.success_ci)
+
+    def within(self, distance_m: float) -> Share:
+        """Its share of the episodes that ended with the object on the table within ``distance_m`` [m] of the target
+        (one of :data:`SUCCESS_DISTANCES_M`; :data:`NOTHING` in results written before it was recorded)."""
+        return _within(self.success_within, distance_m)
 
     @property
     def toward_robot(self) -> Share:
@@ -342,10 +372,16 @@ class PlanResults:
         placement_error_committed_median_m, placement_error_committed_n: The same over the place goals it acted on
             without abstaining (P(goal) at least its threshold); None and 0 without any, or in results written
             before it was recorded.
+        place_success_within: Per policy (the planner's and the oracle's), the share of the single-step place
+            goals whose object came to rest on the table within each of :data:`SUCCESS_DISTANCES_M` of the target
+            (the planner's one action; the oracle: any of its actions), n every place goal; empty in results written
+            before it was recorded.
         calibration: The calibration of the planner's predicted probabilities.
         decision_seconds: The planner's decision times, single-step and multi-step together (n 0 in results
             written before they were recorded).
-        timings_s: The time of each stage and the ``total`` [s].
+        timings_s: The time of each stage and the ``total`` [s]; where recorded, the collection's parts
+            (``collect_goal_episodes``, ``collect_top_up_<behaviour>``) and the CPU seconds the evaluation's
+            processes spent on the single step and on the multi-step episodes (``evaluate_*_cpu``).
         goals: The single-step goals, one record each (empty in results written without them).
     """
 
@@ -370,6 +406,7 @@ class PlanResults:
     placement_error_n: Count
     placement_error_committed_median_m: float | None = None
     placement_error_committed_n: Count = 0
+    place_success_within: Mapping[str, tuple[WithinDistance, ...]] = _by_default(_EMPTY)
     calibration: Calibration
     decision_seconds: DecisionTimes = DecisionTimes(median=None, p99=None, n=0)
     timings_s: Mapping[str, float]
@@ -406,10 +443,20 @@ class PlanResults:
         """The run's total time [s]."""
         return self.timings_s["total"]
 
+    def place_within(self, policy: str, distance_m: float) -> Share:
+        """The share of the single-step place goals that ``policy`` ("planner" or "oracle") brought within
+        ``distance_m`` [m] of the target (one of :data:`SUCCESS_DISTANCES_M`; :data:`NOTHING` where not recorded)."""
+        return _within(self.place_success_within.get(policy, ()), distance_m)
+
     @property
     def placement_error_committed(self) -> tuple[float | None, int]:
         """The median placement error [m] and n of the place goals the planner acted on without abstaining."""
         return self.placement_error_committed_median_m, self.placement_error_committed_n
+
+
+def _within(shares: tuple[WithinDistance, ...], distance_m: float) -> Share:
+    """The share of ``shares`` at ``distance_m`` [m]; :data:`NOTHING` where the results hold none."""
+    return next((w.share for w in shares if abs(w.distance_m - distance_m) < 1e-9), NOTHING)
 
 
 # --- older results ---------------------------------------------------------------------------------------------
@@ -445,6 +492,6 @@ def current_plan_results(results: Any) -> Mapping[str, Any]:
     return upgraded
 
 
-__all__ = ["NOTHING", "PLAN_RESULTS_FORMAT", "PLAN_RESULTS_VERSION", "UNITS", "Calibration", "CalibrationBin",
-           "DecisionTimes", "Episode", "GoalRecord", "MultiStep", "MultiStepOutcome", "PlanResults", "PolicyOutcome",
-           "Rate", "ReachFailures", "Share", "current_plan_results"]
+__all__ = ["NOTHING", "PLAN_RESULTS_FORMAT", "PLAN_RESULTS_VERSION", "SUCCESS_DISTANCES_M", "UNITS", "Calibration",
+           "CalibrationBin", "DecisionTimes", "Episode", "GoalRecord", "MultiStep", "MultiStepOutcome", "PlanResults",
+           "PolicyOutcome", "Rate", "ReachFailures", "Share", "WithinDistance", "current_plan_results"]

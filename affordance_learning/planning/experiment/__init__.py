@@ -26,7 +26,8 @@
      reached the goal most often in training, at the canonical action;
    - ``oracle``: whether any action of the oracle's set reached the goal. A goal it reaches is *feasible*.
 
-   Success is reported on every goal, on the feasible goals, and on the goals the oracle or the planner reached.
+   Success is reported on every goal, on the feasible goals, and on the goals the oracle or the planner reached;
+   for the place goals also within 1, 3 and 5 cm of the target (the planner's action, and any of the oracle's).
 4. Leaving each shape out: on the goals of step 3 whose object is of that shape, the planner of the models fitted
    without it, from the same snapshot (the oracle's verdict says which goals are feasible).
 5. Multi-step: episodes of the goal env (its targets, its tolerance, at most ``GOAL_MAX_EPISODE_STEPS``
@@ -36,9 +37,12 @@
    (``gave_up``) rather than run an interaction it knows would fail; an action that failed to reach is not chosen
    again from where it failed. Targets toward the robot (within 45 degrees of +x from the object) are counted
    apart; every ``TOWARD_ROBOT_EVERY``-th episode has one, on an object that leaves room for it
-   (:func:`~.goal_drawing.episode_start`).
+   (:func:`~.goal_drawing.episode_start`). Each policy's share of episodes that ended within 1, 3 and 5 cm of the
+   target is reported beside it (5 cm: FetchPush's and Meta-World's threshold).
 6. Calibration of P(goal) on the planner's chosen actions of step 3 (expected calibration error over 10 bins,
    AUROC), and, beside it, pooled over every action of the oracle's set for every goal.
+
+:data:`QUICK` (``affordance plan --quick``) runs all of it on few data, its verdicts then on too few.
 
 The goals of one object are judged against the same outcomes, so they are not independent: the Wilson intervals
 treat them as if they were, and the report gives the number of objects beside them. Every number is measured in
@@ -80,6 +84,7 @@ from affordance_learning.planning.experiment.settings import (
     PLACE_DISTANCE,
     PLACE_TOLERANCE,
     POLICIES,
+    QUICK,
     PlanSettings,
     evaluation_items,
     oracle_params,
@@ -93,7 +98,13 @@ from affordance_learning.planning.experiment.simulation import (
     reached,
 )
 from affordance_learning.planning.experiment.single_step import evaluate_object
-from affordance_learning.planning.experiment.statistics import calibrations, seconds_summary, summarize, wilson
+from affordance_learning.planning.experiment.statistics import (
+    calibrations,
+    seconds_summary,
+    summarize,
+    wilson,
+    within_shares,
+)
 from affordance_learning.planning.experiment.training import (
     TOP_UP_EPISODES,
     TOP_UP_MARGIN,
@@ -106,11 +117,11 @@ from affordance_learning.planning.experiment.training import (
 
 __all__ = ["DATASET_DIR", "DIRECTIONS", "EVAL_STREAM", "GOALS_PER_OBJECT", "GOAL_KINDS", "MOVE_DISTANCE",
            "MULTI_POLICIES", "ORACLE_LEVELS", "Outcomes", "PLACE_DISTANCE", "PLACE_TOLERANCE", "POLICIES", "PULLING",
-           "PlanSettings",
+           "PlanSettings", "QUICK",
            "RESULTS_FORMAT", "SomBaseline", "TOP_UP_EPISODES", "TOP_UP_MARGIN", "TOWARD_ROBOT_EVERY",
            "TOWARD_ROBOT_OBJECTS", "best_fixed", "calibration", "calibrations", "collect_training",
            "direction_heuristic", "draw_goal", "draw_goals", "episode_start", "evaluate_episode", "evaluate_object",
            "evaluation_env", "evaluation_items", "feasible_at", "fit_models", "goal_toward_robot", "load_training",
            "measured_outcome", "oracle_params", "place_target", "reach_failure", "reached", "record_episode",
            "run_plan", "seconds_summary", "share_text", "step_reach", "summarize", "top_up_path", "toward_robot",
-           "training_frames", "wilson", "within_reach"]
+           "training_frames", "wilson", "within_reach", "within_shares"]

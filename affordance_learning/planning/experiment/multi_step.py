@@ -27,9 +27,9 @@ PULLING = ("draw", "grasp")
 def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, camera: tuple[int, int],
                      frames: list | None = None, env=None) -> dict[str, Any]:
     """One multi-step episode of ``policy`` from reset seed ``item["seed"]``: reached, interactions, reach
-    failures, the final distance [m], the planner's decision times [s]; ``frames``, if given, gets a labelled picture
-    of the start and after each interaction. ``env``: the goal env to run it in (default: this worker's,
-    :func:`~.simulation.evaluation_env`)."""
+    failures, the final distance [m] and whether the object ended off the table, the planner's decision times [s];
+    ``frames``, if given, gets a labelled picture of the start and after each interaction. ``env``: the goal env to
+    run it in (default: this worker's, :func:`~.simulation.evaluation_env`)."""
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
 
     env = evaluation_env(camera) if env is None else env
@@ -79,7 +79,8 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
     pulls = ({name: bool(feasible_at(env, initial_state)(name, np.zeros(3))) for name in PULLING}
              if policy == "planner" and toward else None)
     return {"policy": policy, "success": success, "steps": steps, "reach_failures": len(failures), "failures": failures,
-            "final_distance": distance, "gave_up": gave_up, "type": info["object"]["type"],
+            "final_distance": distance, "off_table": info.get("outcome") == "off_table", "gave_up": gave_up,
+            "type": info["object"]["type"],
             "initial_distance": initial, "start_xy": start_xy, "target_xy": target_xy, "tolerance": tolerance,
             "toward_robot": toward, "pulls_at_start": pulls, "decision_s": decisions}
 

@@ -18,7 +18,6 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from affordance_env.dataset import load_dataset
 from affordance_env.goal_env import TapAffordanceGoalEnv
 from affordance_env.objects import OBJECT_TYPES
 from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
@@ -38,12 +37,25 @@ from affordance_learning.planning.experiment.settings import (
     oracle_params,
 )
 from affordance_learning.planning.experiment.single_step import evaluate_object
-from affordance_learning.planning.experiment.statistics import calibrations, seconds_summary, summarize, wilson
-from affordance_learning.planning.experiment.training import collect_training, fit_models, training_frames
+from affordance_learning.planning.experiment.statistics import (
+    calibrations,
+    seconds_summary,
+    summarize,
+    wilson,
+    within_shares,
+)
+from affordance_learning.planning.experiment.training import (
+    TOP_UP_EPISODES,
+    collect_training,
+    fit_models,
+    load_training,
+    training_frames,
+)
 from affordance_learning.planning.planner import Planner
 from affordance_learning.planning.results import (
     PLAN_RESULTS_FORMAT,
     PLAN_RESULTS_VERSION,
+    SUCCESS_DISTANCES_M,
     Episode,
     GoalRecord,
     MultiStep,
@@ -52,6 +64,7 @@ from affordance_learning.planning.results import (
     PolicyOutcome,
     Rate,
     ReachFailures,
+    WithinDistance,
 )
 
 #: The format ``results.json`` of ``affordance plan`` declares, and its version.
@@ -61,13 +74,17 @@ DATASET_DIR = "dataset"
 
 
 def _evaluate(task: tuple[str | None, Mapping[str, Any]], planner: Planner, shape_planners: Mapping[str, Planner],
-              som: SomBaseline | None, camera: tuple[int, int]):
-    """One task of the evaluation: ``(None, item)`` an object of the single step (:func:`evaluate_object`),
+              som: SomBaseline | None, camera: tuple[int, int]) -> tuple[Any, float]:
+    """One task of the evaluation and the CPU seconds its process spent on it (what it costs on a core of its own,
+    however loaded the machine): ``(None, item)`` an object of the single step (:func:`evaluate_object`),
     ``(policy, item)`` a multi-step episode of that policy (:func:`evaluate_episode`)."""
     policy, item = task
+    t = time.process_time()
     if policy is None:
-        return evaluate_object(item, planner, shape_planners, som, camera)
-    return evaluate_episode(item, planner, policy, camera)
+        done = evaluate_object(item, planner, shape_planners, som, camera)
+    else:
+        done = evaluate_episode(item, planner, policy, camera)
+    return done, time.process_time() - t
 
 
 @dataclass
@@ -85,7 +102,8 @@ class _Stages:
 
     def planner(self, frames: Mapping[str, pd.DataFrame]) -> Planner:
         """A planner over effect models fitted on ``frames``, with the run's sizes."""
-        return Planner(fit_models(frames, self.seed, n_jobs=self.workers), n_candidates=self.settings.candidates,
+        return Planner(fit_models(frames, self.seed, n_jobs=self.workers, n_estimators=self.settings.trees),
+                       n_candidates=self.settings.candidates,
                        threshold=self.settings.threshold, random_state=self.seed)
 
 
@@ -94,12 +112,19 @@ def _collect(run: _Stages) -> tuple[pd.DataFrame, dict[str, pd.DataFrame]]:
     settings = run.settings
     run.say(f"[1/5] collecting goal episodes with random actions into {run.out / DATASET_DIR} until every behaviour "
             f"has {settings.max_per_behavior} interactions (at most {settings.max_episodes} episodes)")
-    frame = collect_training(run.out / DATASET_DIR, settings, run.seed, run.workers, run.camera, run.say)
+    frame = collect_training(run.out / DATASET_DIR, settings, run.seed, run.workers, run.camera, run.say,
+                             run.timings)
     frames = training_frames(frame, settings.max_per_behavior)
     run.timings["collect"] = time.perf_counter() - run.start
-    run.say(f"      {frame['episode'].nunique()} episodes ({run.timings['collect']:.0f} s); "
+    run.say(f"      {_goal_episodes(frame)} goal episodes and their top-ups ({run.timings['collect']:.0f} s); "
             + ", ".join(f"{b} {len(f)}" for b, f in frames.items()) + " interactions for training")
     return frame, frames
+
+
+def _goal_episodes(frame: pd.DataFrame) -> int:
+    """The goal episodes of a training frame (:func:`~.training.load_training`), not counting the top-ups' single
+    interactions (numbered from ``TOP_UP_EPISODES``, each top-up from there)."""
+    return int(frame.loc[frame["episode"] < TOP_UP_EPISODES, "episode"].nunique())
 
 
 def _fit(run: _Stages, frame: pd.DataFrame, frames: Mapping[str, pd.DataFrame]
@@ -128,6 +153,10 @@ def _evaluate_all(run: _Stages, planner: Planner, shape_planners: Mapping[str, P
                             + [(policy, item) for policy in MULTI_POLICIES for item in multi_items],
                             run.workers, planner=planner, shape_planners=shape_planners, som=som, camera=run.camera)
     run.timings["evaluate"] = time.perf_counter() - t
+    # the CPU seconds the processes spent on each part, together (what the evaluation costs on one core)
+    run.timings["evaluate_single_step_cpu"] = sum(s for _, s in done[: len(items)])
+    run.timings["evaluate_multi_step_cpu"] = sum(s for _, s in done[len(items):])
+    done = [d for d, _ in done]
     objects, multi_done = done[: len(items)], done[len(items):]
     n = len(multi_items)
     return objects, [multi_done[i * n: (i + 1) * n] for i in range(len(MULTI_POLICIES))]
@@ -142,8 +171,17 @@ def _single_step(run: _Stages, objects: list) -> tuple[list[dict], dict[str, Pol
             f"(with step 5: {run.timings['evaluate']:.0f} s): "
             + ", ".join(f"{p} {share_text(single[p].success, single[p].n, single[p].success_ci)}"
                         for p in POLICIES)
-            + f"; {single['oracle'].n_feasible} goals feasible")
+            + f"; {single['oracle'].n_feasible} goals feasible; place goals within "
+            + _within_text(within_shares([r["planner_within"] for r in records if "planner_within" in r])))
     return records, single, fixed_choice
+
+
+def _within_text(shares: Sequence[WithinDistance]) -> str:
+    """Shares within each distance as the console shows them: ``"1 cm 10 %, 3 cm 30 %, 5 cm 45 % (n=240)"``."""
+    if not shares or not shares[0].n:
+        return "not measured (n=0)"
+    return (", ".join(f"{100 * w.distance_m:.0f} cm {100 * w.success:.0f} %" for w in shares)
+            + f" (n={shares[0].n})")
 
 
 def _leave_one_shape_out(run: _Stages, records: Sequence[Mapping[str, Any]]
@@ -162,7 +200,8 @@ def _leave_one_shape_out(run: _Stages, records: Sequence[Mapping[str, Any]]
 
 def _policy_summary(episodes: Sequence[Mapping[str, Any]], **planner_only: Any) -> MultiStepOutcome:
     """One policy's multi-step episodes: success (and toward the robot) with Wilson intervals, reach failures per
-    interaction, episodes given up, the median final distance [m]; ``planner_only``: the planner's details
+    interaction, episodes given up, the median final distance [m], the share that ended on the table within each
+    of :data:`SUCCESS_DISTANCES_M` of the target; ``planner_only``: the planner's details
     (:func:`_planner_episodes`)."""
     n = len(episodes)
     k = sum(e["success"] for e in episodes)
@@ -175,7 +214,9 @@ def _policy_summary(episodes: Sequence[Mapping[str, Any]], **planner_only: Any) 
         interactions=interactions, gave_up=sum(e["gave_up"] for e in episodes),
         median_final_distance_m=float(np.median([e["final_distance"] for e in episodes])),
         success_toward_robot=kt / len(toward) if toward else None,
-        success_toward_robot_ci=wilson(kt, len(toward)), n_toward_robot=len(toward), **planner_only)
+        success_toward_robot_ci=wilson(kt, len(toward)), n_toward_robot=len(toward),
+        success_within=within_shares([[not e["off_table"] and e["final_distance"] <= d for d in SUCCESS_DISTANCES_M]
+                                      for e in episodes]), **planner_only)
 
 
 def _episode(e: Mapping[str, Any], reach: Mapping[str, Mapping[str, float]], tolerance: float, most: int
@@ -218,19 +259,24 @@ def _multi_step(run: _Stages, by_policy: Sequence[Sequence[Mapping[str, Any]]], 
             + ", ".join(f"{p} {share_text(o.success, o.n, o.success_ci)}" for p, o in multi.policies.items())
             + "; toward the robot: planner " + share_text(multi.planner.success_toward_robot,
                                                            multi.planner.n_toward_robot,
-                                                           multi.planner.success_toward_robot_ci))
+                                                           multi.planner.success_toward_robot_ci)
+            + "; planner within " + _within_text(multi.planner.success_within))
     return multi
 
 
 def _placement(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
     """The median distance [m] of the object's end from a place goal's target, over the place goals the planner
-    acted on (the median's n), and over those it acted on without abstaining (P(goal) >= its threshold)."""
+    acted on (the median's n), and over those it acted on without abstaining (P(goal) >= its threshold); and the
+    share of every place goal that the planner and the oracle brought within each of :data:`SUCCESS_DISTANCES_M`."""
     placement = [r["placement_error"] for r in records if "placement_error" in r]
     committed = [r["placement_error"] for r in records if r.get("placement_committed")]
+    places = [r for r in records if "planner_within" in r]
     return {"placement_error_median_m": float(np.median(placement)) if placement else None,
             "placement_error_n": len(placement),
             "placement_error_committed_median_m": float(np.median(committed)) if committed else None,
-            "placement_error_committed_n": len(committed)}
+            "placement_error_committed_n": len(committed),
+            "place_success_within": _view({policy: within_shares([r[f"{policy}_within"] for r in places])
+                                           for policy in ("planner", "oracle")})}
 
 
 #: What results.json keeps of each single-step goal's record.
@@ -251,7 +297,7 @@ def _results(run: _Stages, frame: pd.DataFrame, frames: Mapping[str, pd.DataFram
     return PlanResults(
         seed=run.seed, settings=_view(asdict(run.settings)),
         training=_view({b: len(f) for b, f in frames.items()}),
-        training_episodes=int(frame["episode"].nunique()),
+        training_episodes=_goal_episodes(frame),
         workers=run.workers, cpu_count=os.cpu_count(),
         oracle=_view({"actions_per_behavior": len(oracle_params()), "levels": list(ORACLE_LEVELS),
                       "objects": n_objects, "goals_per_object": dict(GOALS_PER_OBJECT),
@@ -301,11 +347,12 @@ def run_plan(out: str | os.PathLike, seed: int = 0, workers: int = 2, settings: 
 def record_episode(out: str | os.PathLike, results: PlanResults | Mapping[str, Any], seed: int = 0
                    ) -> list[tuple[str, np.ndarray]]:
     """Pictures of one multi-step planner episode (the first of the evaluation's), with the models refitted from
-    ``out/dataset``: the start, then the scene after each interaction, titled with the behaviour."""
+    ``out/dataset`` and its top-ups (:func:`~.training.load_training`, as the run fitted them): the start, then
+    the scene after each interaction, titled with the behaviour."""
     settings = PlanSettings(**PlanResults.from_dict(results).settings)
-    frames = training_frames(load_dataset(Path(out) / DATASET_DIR), settings.max_per_behavior)
-    planner = Planner(fit_models(frames, seed), n_candidates=settings.candidates, threshold=settings.threshold,
-                      random_state=seed)
+    frames = training_frames(load_training(Path(out) / DATASET_DIR), settings.max_per_behavior)
+    planner = Planner(fit_models(frames, seed, n_estimators=settings.trees), n_candidates=settings.candidates,
+                      threshold=settings.threshold, random_state=seed)
     env = TapAffordanceGoalEnv(position_range="workspace", render_mode="rgb_array", render_width=320,
                                render_height=240)
     try:

@@ -63,14 +63,23 @@ class PlanSettings:
         candidates: The planner's parameter vectors per behaviour.
         threshold: The planner abstains below this P(goal).
         som_clusters: Effect categories of the ``som_categories`` baseline.
+        trees: Trees of each behaviour's effect model (its forest's ``n_estimators``).
+        quick: A quick run (:data:`QUICK`): the whole pipeline on too few data for the targets' verdicts, which
+            then read "too few data" wherever n is below a target's minimum; the console and the report say so.
 
-    Sizing (TapAffordanceGoal-v2, five behaviours, one core each): an object's single step costs 18-57 s (seed 0),
-    most of it the oracle (65 actions x 5 behaviours; a grasp 0.2-0.5 s, a stroke or a draw 0.02-0.06 s); a
-    multi-step episode about a second; a collected goal-episode interaction about 0.14 s (``feasible`` draws
-    included), a top-up one about 0.1 s. The
-    grasp gets about a fifth of the goal episodes' interactions: 1000 of them take about 1500 episodes, the
-    collection's largest part. Half of the goals were feasible in a reduced run (a third of a box's): 24 objects
-    give about 240 feasible goals, 6 objects of each shape.
+    Sizing (TapAffordanceGoal-v2, five behaviours, the run's 160 x 120 camera; CPU seconds on one core of a 2-core
+    machine, measured in one process): a goal episode 0.79 (25 episodes of 96 interactions, the ``feasible`` draws
+    included; 0.7-0.9 grasps an episode), a top-up interaction 0.06 (the strokes) or 0.10 (the draw); an effect
+    model 2.5 on 1000 interactions with 200 trees, five of them per planner and five planners (one, and one without
+    each shape); an object's single step 56 and 75 (seed 0's first two, a sphere and a box, with models of about 100
+    interactions per behaviour; profiled on the box: 86 % the oracle's 325 interactions, 94 % with the policies'
+    own, 58 % the grasps, 64 % MuJoCo's steps, 9 % the head's observations after each, 4 % the planners' choices); a
+    multi-step episode 0.9 (planner), 0.4 (direction), 0.6 (random). At these defaults that is about 1200 for the
+    collection, 80 for the fits and 1700 for the evaluation: about 25 minutes on two cores, and the evaluation alone
+    cannot be cut below about 12 minutes without its n falling below the targets' minimum (400 chosen actions need
+    20 objects of 20 goals). The grasp gets about a fifth of the goal episodes' interactions: 1000 of them take
+    about 1500 episodes, the collection's largest part. Half of the goals were feasible in a reduced run (a third of
+    a box's): 24 objects give about 240 feasible goals, 6 objects of each shape.
     """
 
     episodes: int = 1500
@@ -81,6 +90,8 @@ class PlanSettings:
     candidates: int = 64
     threshold: float = 0.5
     som_clusters: int = 6
+    trees: int = 200
+    quick: bool = False
 
     @property
     def goals(self) -> int:
@@ -98,3 +109,13 @@ def evaluation_items(seed: int, part: int, n: int) -> list[dict]:
         env_seed, rng_seed = (int(v) for v in ss.generate_state(2))
         items.append({"seed": env_seed, "rng": rng_seed, "index": i, "shape": OBJECT_TYPES[i % len(OBJECT_TYPES)]})
     return items
+
+
+#: The sizes of ``affordance plan --quick``: the whole pipeline in a few minutes, to see that it runs and what it
+#: writes, not to judge the targets (every n stays below their minimum). 60 goal episodes give 41 grasps, about 50
+#: interactions of each stroke and 30 draws (seed 0), topped up to 60; two held-out objects (a sphere and a box: an
+#: object's single step is most of a quick run, 56 and 75 CPU seconds for the first two of seed 0); 4 multi-step
+#: episodes per policy; 25 trees instead of 200 (a fit's time grows with the trees: 10.1 CPU seconds for 200, 5.3 for
+#: 100, on 4 behaviours of 1000 interactions).
+QUICK = PlanSettings(episodes=60, max_per_behavior=60, max_episodes=60, objects=2, multi_episodes=4, candidates=32,
+                     som_clusters=4, trees=25, quick=True)

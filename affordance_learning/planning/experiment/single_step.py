@@ -20,8 +20,9 @@ from affordance_learning.planning.experiment.simulation import (
     reach_failure,
     reached,
 )
-from affordance_learning.planning.goals import Goal
+from affordance_learning.planning.goals import Goal, Place
 from affordance_learning.planning.planner import Planner
+from affordance_learning.planning.results import SUCCESS_DISTANCES_M
 
 
 def _decide(planner: Planner, features, goal: Goal, start, feasible, outcomes: Outcomes
@@ -77,6 +78,10 @@ def evaluate_object(item: Mapping[str, Any], planner: Planner, shape_planners: M
         if error is not None:  # a goal of a place
             record["placement_error"] = error
             record["placement_committed"] = not choice.abstained
+        if isinstance(goal, Place):  # reached within each distance, by the planner's action and by any of the oracle's
+            within = [Place(goal.target_xy, d) for d in SUCCESS_DISTANCES_M]
+            record["planner_within"] = [done is not None and reached(g, done) for g in within]
+            record["oracle_within"] = [any(reached(g, info) for _, _, info in tried) for g in within]
         record["planner_grid"] = _decide(grid, features, goal, start, feasible, outcomes)[1]
         if left_out is not None:
             record["planner_left_out"] = _decide(left_out, features, goal, start, feasible, outcomes)[1]

@@ -1,5 +1,5 @@
-"""The evaluation's statistics: success per policy with Wilson intervals, calibration of the chosen actions, and
-decision times.
+"""The evaluation's statistics: success per policy with Wilson intervals, success within 1, 3 and 5 cm of a target,
+calibration of the chosen actions, and decision times.
 """
 
 from __future__ import annotations
@@ -10,7 +10,14 @@ from typing import Any
 import numpy as np
 
 from affordance_learning.common.statistics import calibration, wilson_interval
-from affordance_learning.planning.results import Calibration, CalibrationBin, DecisionTimes, PolicyOutcome
+from affordance_learning.planning.results import (
+    SUCCESS_DISTANCES_M,
+    Calibration,
+    CalibrationBin,
+    DecisionTimes,
+    PolicyOutcome,
+    WithinDistance,
+)
 
 
 def wilson(successes: int, n: int) -> tuple[float, float]:
@@ -55,6 +62,16 @@ def summarize(records: Sequence[Mapping[str, Any]], policies: Sequence[str]) -> 
             success_feasible_ci=wilson(kf, nf), n=n, n_feasible=nf, success_reached=ke / ne if ne else None,
             success_reached_ci=wilson(ke, ne), n_reached=ne)
     return out
+
+
+def within_shares(within: Sequence[Sequence[bool]]) -> tuple[WithinDistance, ...]:
+    """Per distance of :data:`~affordance_learning.planning.results.SUCCESS_DISTANCES_M`, the share of the cases
+    that ended within it of their target, with its Wilson interval; ``within``: per case, whether it did at each
+    distance, in that order."""
+    hits = np.asarray(within, dtype=bool).reshape(len(within), len(SUCCESS_DISTANCES_M))
+    n = len(hits)
+    return tuple(WithinDistance(d, int(k) / n if n else None, wilson(int(k), n), n)
+                 for d, k in zip(SUCCESS_DISTANCES_M, hits.sum(axis=0), strict=True))
 
 
 def seconds_summary(seconds: Sequence[float], choose: DecisionTimes | None = None,
