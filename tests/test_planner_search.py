@@ -174,3 +174,38 @@ def test_toward_first_moves_the_object_where_a_behaviour_can_act_toward_the_targ
     assert ahead.behavior == "tap" and ahead.expected_distance < 0.06  # a tap then a draw: 5 cm off
     assert planner.toward(features, start, target, 0.03, feasible=feasible, steps_left=3,
                           reachable=reachable).behavior == "tap"  # the horizon follows steps_left
+
+
+def test_refused_actions_leave_a_near_feasible_one_of_the_search_asked_before_a_worse_behaviour(placing):
+    # The search's best grasps are refused (a place beyond the arm's reach); a feasible one lies 0.54 from the
+    # first refused, nearer than REFUSAL_RADIUS: the search asks it before falling to a worse behaviour, the
+    # grid (whose candidates lie far apart) does not.
+    candidates = {"grasp": np.array([[0.5, -0.85, 1.0], [0.54, -0.89, -0.26], [0.29, -0.76, 0.51], [0.0, 0.0, 0.0]]),
+                  "tap": np.zeros((1, 3))}
+    likely = [(1.0, "grasp", 0), (0.9, "grasp", 1), (0.8, "grasp", 2)]  # as toward's sequences, then the nearest
+    rankings = [likely, [*likely, (0.1, "tap", 0), (0.0, "grasp", 3)]]
+    refused = {(0.5, -0.85, 1.0), (0.54, -0.89, -0.26)}
+
+    def feasible(name, params):
+        return tuple(np.round(params, 2)) not in refused
+
+    models = {"grasp": placing, "tap": placing}
+    found, checked = Planner(models)._search(rankings, feasible, set(), candidates)
+    assert found[-2:] == ("grasp", 2) and checked == 3
+    found, _ = Planner(models, optimizer="grid")._search(rankings, feasible, set(), candidates)
+    assert found[-2:] == ("tap", 0)
+
+
+def test_a_behaviour_refused_again_and_again_leaves_the_checks_to_the_others(placing):
+    far = np.array([[-0.9, -0.9, -0.9], [0.9, 0.9, 0.9], [-0.9, 0.9, 0.9], [0.9, -0.9, -0.9], [0.9, 0.9, -0.9],
+                    [-0.9, -0.9, 0.9], [0.0, 0.0, 0.0]])
+    candidates = {"draw": far, "tap": np.array([[0.5, 0.5, 0.5], [0.0, 0.0, 0.0]])}
+    ranked = [*((1.0 - 0.01 * k, "draw", k) for k in range(6)), (0.2, "tap", 0), (0.0, "draw", 6), (0.0, "tap", 1)]
+    asked = []
+
+    def feasible(name, params):  # the object is out of the draw's reach
+        asked.append(name)
+        return name != "draw"
+
+    found, checked = Planner({"draw": placing, "tap": placing})._search([ranked], feasible, set(), candidates)
+    assert found[-2:] == ("tap", 0) and asked.count("draw") == 3 and checked == 4

@@ -77,6 +77,24 @@ P_RESOLUTION = 0.05
 #: arm's reach, so that the checks go to other regions and other behaviours rather than to the refused one's
 #: neighbours.
 REFUSAL_RADIUS = 1.0
+#: The search's actions lie closer together than the grid's, and where its best ones are refused the feasible
+#: alternative often lies nearer than REFUSAL_RADIUS (a grasp's place refused at the edge of the arm's reach, a
+#: feasible one half a unit nearer the object): after a ranking's actions beyond REFUSAL_RADIUS of every refused
+#: one, a decision asks at most NEAR_REFUSAL_CHECKS more per behaviour of those beyond NEAR_REFUSAL_RADIUS. On
+#: ``examples/use_affordances.py``'s episode (seed 3) the first interaction is then a grasp that brings the
+#: cylinder 6 cm from its target (a push that moved it 1 cm without), and the episode reaches the target.
+NEAR_REFUSAL_RADIUS, NEAR_REFUSAL_CHECKS = 0.5, 2
+#: With the search, a behaviour of which a decision's checks refused this many actions gets no more of them
+#: (but for its canonical action, kept for last): where the object lies out of a behaviour's reach every action
+#: of it is refused, and its seeds (the first actions of :meth:`Planner.toward`, spread over the parameters)
+#: would take every check from the behaviours that can act.
+BEHAVIOR_REFUSALS = 3
+#: :meth:`Planner.toward` with the search ranks, besides its finalists, this many of the seeds per behaviour (the
+#: canonical action and the first Sobol points): first actions spread over the parameters, that bring the object
+#: elsewhere for a second interaction. On ``examples/use_affordances.py``'s episode (seed 3) 24 miss the grasp
+#: that brings the cylinder within reach of its target; all 64 cost about as much (``benchmarks/planner.py
+#: --objects 8 --goals 2 --toward 16 --search-only``: toward's median 112 ms with 24, 124 ms with 64).
+TOWARD_SEEDS = 64
 #: :meth:`Planner.choose` refines a goal with a distance (a move, a place): around the action it found, it scores
 #: REFINE_POINTS more within REFINE_RADIUS of it (per parameter, a scrambled Sobol set) and takes the best of them
 #: that ranks above it, asking ``feasible`` about REFINE_CHECKS of them at most. The Sobol candidates lie about
@@ -151,6 +169,12 @@ def _check_start(start_xy) -> np.ndarray:
     if start.shape != (2,):
         raise InvalidValueError(f"start_xy must be where the object is, one (x, y) [m], got shape {start.shape}.")
     return start
+
+
+def _distinct(params: np.ndarray) -> np.ndarray:
+    """``params`` (n, 3) without repeated rows, in their first order."""
+    _, first = np.unique(params, axis=0, return_index=True)
+    return params[np.sort(first)]
 
 
 def candidate_params(n: int, random_state: int = 0) -> np.ndarray:
@@ -484,7 +508,10 @@ class Planner:
         canonical actions not asked about yet are, the most promising behaviour first, whatever was refused near
         them (the behaviours' workspaces are made around their canonical actions). With fewer checks than
         behaviours, the ranked candidates get one and the canonical actions of the behaviours ranked first the
-        others. Without ``fallback`` no check is kept (a refinement around an action already found). Without
+        others. With the search, each ranking is gone through a second time for the actions within REFUSAL_RADIUS
+        but beyond :data:`NEAR_REFUSAL_RADIUS` of every refused one (:data:`NEAR_REFUSAL_CHECKS` per behaviour), and a
+        behaviour with :data:`BEHAVIOR_REFUSALS` refused gets no more checks but its canonical action's.
+        Without ``fallback`` no check is kept (a refinement around an action already found). Without
         ``feasible`` the first entry not excluded."""
         asked = {} if asked is None else asked
         refused: list[tuple[str, np.ndarray]] = [(n, candidates[n][k]) for (n, k), ok in asked.items() if not ok]
@@ -494,32 +521,49 @@ class Planner:
         def open_reserve() -> list[str]:
             return [n for n, k in canonical.items() if (n, k) not in asked and (n, k) not in excluded]
 
-        def ask(key, near_refused: bool = False) -> bool | None:
+        def ask(key, near_refused: bool = False, radius: float = REFUSAL_RADIUS) -> bool | None:
             """feasible's answer about ``key``, asking if need be; None where it may not be asked (within
-            REFUSAL_RADIUS of one refused, unless ``near_refused``)."""
+            ``radius`` of one refused, unless ``near_refused``)."""
             if key in asked:
                 return asked[key]
             params = candidates[key[0]][key[1]]
-            if not near_refused and any(n == key[0] and np.linalg.norm(params - other) < REFUSAL_RADIUS
+            if not near_refused and any(n == key[0] and np.linalg.norm(params - other) < radius
                                         for n, other in refused):
                 return None
+            if (not near_refused and self.optimizer != "grid"
+                    and sum(n == key[0] for n, _ in refused) >= BEHAVIOR_REFUSALS):
+                return None  # this behaviour likely cannot act here: the checks go to the others
             asked[key] = bool(feasible(key[0], params))
             if not asked[key]:
                 refused.append((key[0], params))
             return asked[key]
 
+        # The search's actions lie closer together than the grid's: where its best ones were refused, a ranked
+        # action near them is asked after the far ones (a second pass), rather than passed over for a worse
+        # ranking (a grasp's place refused at the arm's reach, a feasible one 0.5 nearer the object).
+        radii = (REFUSAL_RADIUS,) if self.optimizer == "grid" else (REFUSAL_RADIUS, NEAR_REFUSAL_RADIUS)
         for ranked in rankings:
-            for entry in ranked:
-                key = (entry[-2], entry[-1])
-                if key in excluded:
-                    continue
-                if feasible is None:
-                    return entry, 0
-                kept = min(len(open_reserve()) - (canonical.get(key[0]) == key[1]), self.max_checks - 1)
-                if key not in asked and len(asked) + kept >= self.max_checks:
-                    break  # the remaining checks are kept for the canonical actions not asked about
-                if ask(key):
-                    return entry, len(asked)
+            for radius in radii:
+                second: dict[str, int] = {}  # the second pass's checks per behaviour
+                for entry in ranked:
+                    key = (entry[-2], entry[-1])
+                    if key in excluded:
+                        continue
+                    if feasible is None:
+                        return entry, 0
+                    kept = min(len(open_reserve()) - (canonical.get(key[0]) == key[1]), self.max_checks - 1)
+                    if key not in asked and len(asked) + kept >= self.max_checks:
+                        break  # the remaining checks are kept for the canonical actions not asked about
+                    if radius < REFUSAL_RADIUS and key not in asked:
+                        if second.get(key[0], 0) >= NEAR_REFUSAL_CHECKS:
+                            continue
+                        n_before = len(asked)
+                        found = ask(key, radius=radius)
+                        second[key[0]] = second.get(key[0], 0) + (len(asked) - n_before)
+                    else:
+                        found = ask(key, radius=radius)
+                    if found:
+                        return entry, len(asked)
         if feasible is None:
             return None, 0
         last = {(e[-2], e[-1]): e for e in rankings[-1]} if rankings else {}
@@ -613,7 +657,9 @@ class Planner:
         enough to end within (the threshold) is taken at once; else the most valuable one, if its value reaches
         ``MIN_SEQUENCE_VALUE``; else the one whose predicted outcomes end nearest on average (less
         :data:`SPREAD_WEIGHT` times their spread). The actions are the optimiser's finalists for the place
-        (:meth:`choose`). Actions that failed on the object where it is (:meth:`note_failure`) are left out, and
+        (:meth:`choose`) and :data:`TOWARD_SEEDS` of its seeds (:attr:`params`, spread over the parameters: first
+        actions that bring the object elsewhere, for a second interaction from there). Actions that failed on the
+        object where it is (:meth:`note_failure`) are left out, and
         ``feasible`` is asked at most ``max_checks`` times (:meth:`_search`: every behaviour's canonical action
         gets a check where the ranked ones are refused); the choice names no action only where none of those
         was feasible.
@@ -633,6 +679,9 @@ class Planner:
         start = self._check_where(start_xy)
         features = self._inputs(features)[0, : self.n_features]
         candidates, evaluations = self._candidates(features, goal, start)
+        if self.optimizer != "grid":  # the seeds too: first actions that lead elsewhere, for the second interaction
+            seeds = self.params[:TOWARD_SEEDS]
+            candidates = {name: _distinct(np.vstack([found, seeds])) for name, found in candidates.items()}
         names = list(self.models)
         predicted, p1, distance, ends = {}, {}, {}, {}
         for name, model in self.models.items():
