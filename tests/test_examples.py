@@ -4,6 +4,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 
 
@@ -23,5 +25,9 @@ def test_tap_video_without_imageio_gives_its_help_and_one_line_naming_the_instal
     assert refused.returncode == 2 and refused.stdout == ""
     assert refused.stderr.count("\n") == 1 and 'pip install "tap-affordance[examples]"' in refused.stderr, \
         refused.stderr
+
+
+def test_tap_video_with_imageio_but_not_its_ffmpeg_says_which_is_missing():
+    pytest.importorskip("imageio")  # the examples extra; the test extra alone has no imageio
     no_ffmpeg = _tap_video("--episodes", "1", without=("imageio_ffmpeg",))  # imageio alone cannot write an mp4
     assert no_ffmpeg.returncode == 2 and "imageio_ffmpeg is missing" in no_ffmpeg.stderr, no_ffmpeg.stderr
