@@ -554,14 +554,13 @@ class Planner:
                     kept = min(len(open_reserve()) - (canonical.get(key[0]) == key[1]), self.max_checks - 1)
                     if key not in asked and len(asked) + kept >= self.max_checks:
                         break  # the remaining checks are kept for the canonical actions not asked about
-                    if radius < REFUSAL_RADIUS and key not in asked:
-                        if second.get(key[0], 0) >= NEAR_REFUSAL_CHECKS:
-                            continue
-                        n_before = len(asked)
-                        found = ask(key, radius=radius)
-                        second[key[0]] = second.get(key[0], 0) + (len(asked) - n_before)
-                    else:
-                        found = ask(key, radius=radius)
+                    near = radius < REFUSAL_RADIUS and key not in asked
+                    if near and second.get(key[0], 0) >= NEAR_REFUSAL_CHECKS:
+                        continue
+                    n_before = len(asked)
+                    found = ask(key, radius=radius)
+                    if near:
+                        second[key[0]] = second.get(key[0], 0) + len(asked) - n_before
                     if found:
                         return entry, len(asked)
         if feasible is None:
