@@ -13,7 +13,16 @@ from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_learning.planning.effect_model import ActionEffectModel
 from affordance_learning.planning.goals import Lift, Move, Percept, Place, Roll, goal_from_dict
 from affordance_learning.planning.outcomes import MOTION_COLUMNS
-from affordance_learning.planning.planner import REFUSAL_RADIUS, SCENE_TABLE, Planner, candidate_params
+from affordance_learning.planning.planner import (
+    MAX_CHECKS,
+    PROBE_RADIUS,
+    PROBES,
+    RANKED_CHECKS,
+    REFUSAL_RADIUS,
+    SCENE_TABLE,
+    Planner,
+    candidate_params,
+)
 
 
 def synthetic(n: int = 600, seed: int = 0, push: float = 0.12) -> tuple[np.ndarray, pd.DataFrame]:
@@ -232,10 +241,15 @@ def test_a_decision_asks_feasible_at_most_max_checks_times_and_breaks_ties_by_pr
     # behaviours; the canonical action, kept for last, is asked whatever was refused near it
     calls.clear()
     alone = Planner({"push": model}, n_candidates=64, max_checks=12)
-    assert alone.choose(features, goal, feasible=never).checked == len(calls) < 12
-    assert np.all(calls[-1] == 0.0)
-    ranked = calls[:-1]
+    assert alone.choose(features, goal, feasible=never).checked == len(calls) == 12
+    first = next(i for i, c in enumerate(calls) if np.all(c == 0.0))  # the canonical action ends the ranked ones
+    ranked, probes = calls[:first], calls[first + 1:]
+    assert 0 < first < 12 and probes
     assert all(np.linalg.norm(a - b) >= REFUSAL_RADIUS for i, a in enumerate(ranked) for b in ranked[:i])
+    # then actions spread over the parameters, each far from every one refused before it
+    assert all(any(np.array_equal(p, q) for q in PROBES) for p in probes)
+    assert all(min(np.linalg.norm(p - q) for q in calls[: first + 1 + i]) >= PROBE_RADIUS
+               for i, p in enumerate(probes))
     names = []
     assert planner.choose(features, goal, feasible=lambda name, params: names.append(name) or name == "draw"
                           ).behavior == "draw"
@@ -244,6 +258,23 @@ def test_a_decision_asks_feasible_at_most_max_checks_times_and_breaks_ties_by_pr
     assert best.probability == 0.0 and best.params[0] > 0.8
     with pytest.raises(ValueError, match="max_checks"):
         Planner({"push": model}, max_checks=0)
+
+
+def test_where_a_behaviour_reaches_one_corner_of_its_parameters_the_probes_find_it(model):
+    """A tap feasible only with its first parameter below -0.6 and its second above 0.6 (an object at the edge of
+    its reach): the ranked actions and the canonical ones miss it, the probes spread over the parameters find it;
+    without checks left for them the planner names no action."""
+    def corner(name, params):
+        return name == "tap" and params[0] < -0.6 and params[1] > 0.6
+
+    features, start, target = np.array([-0.3, 0.0, 0.0]), (-0.3, 0.0), (-0.2, 0.0)
+    models = {"push": model, "tap": model, "draw": model}
+    found = Planner(models).toward(features, start, target, 0.03, feasible=corner, reachable=None)
+    assert found.behavior == "tap" and corner("tap", found.params) and found.checked <= MAX_CHECKS
+    assert Planner(models).choose(features, Move((1.0, 0.0), 0.40), feasible=corner).behavior == "tap"
+    few = Planner(models, max_checks=RANKED_CHECKS).toward(features, start, target, 0.03, feasible=corner,
+                                                           reachable=None)
+    assert few.behavior is None and few.checked == RANKED_CHECKS and "spread over its parameters" in few.reason
 
 
 def test_goal_probabilities_from_sparse_weights_equal_the_dense_ones():

@@ -7,6 +7,7 @@ import copy
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from affordance_env.objects import OBJECT_TYPES
@@ -146,20 +147,43 @@ def test_single_step_and_multi_step_need_their_minimum_n() -> None:
 
 
 def test_placement_and_calibration_need_their_minimum_n() -> None:
-    placement, ece = "median placement error [m]", "calibration ECE"
+    placement, within, ece = ("place goals the oracle reaches: median error [m]",
+                              "place goals the oracle reaches: within 3 cm", "calibration ECE")
     results = _plan_results()
-    results["placement_error_n"], results["calibration"]["n"] = MIN_PLACEMENTS - 1, MIN_CALIBRATION_ACTIONS - 1
+    place = _goal(kind="place", placement_error=0.004)
+    results["goals"] = [place] * (MIN_PLACEMENTS - 1) + [_goal(kind="place", oracle=False, planner=False,
+                                                               placement_error=0.2)] * 40
+    results["calibration"]["n"] = MIN_CALIBRATION_ACTIONS - 1
     targets = evaluate_targets(results)
-    assert targets[placement].word == TOO_FEW
-    assert targets[ece].word == TOO_FEW
-    results["placement_error_n"], results["calibration"]["n"] = MIN_PLACEMENTS, MIN_CALIBRATION_ACTIONS
+    assert targets[placement].word == targets[within].word == targets[ece].word == TOO_FEW
+    results["goals"].append(place)
+    results["calibration"]["n"] = MIN_CALIBRATION_ACTIONS
     targets = evaluate_targets(results)
-    assert targets[placement].word == targets[ece].word == MET
-    # results written before placement_error_n: the place goals the planner acted on, counted from the goals
-    del results["placement_error_n"]
-    results["goals"] = [_goal(kind="place", planner_behavior="push")] * 12 + [_goal(kind="place",
-                                                                                  planner_behavior=None)] * 30
-    assert measured_targets(results)[placement].n == 12
+    assert targets[placement].word == targets[within].word == targets[ece].word == MET
+    assert measured_targets(results)[placement].n == MIN_PLACEMENTS  # the goals the oracle missed are not counted
+    # a goal the planner named no action for is missed by any distance: half of them move the median past 1 cm
+    results["goals"] += [_goal(kind="place", planner=False, planner_behavior=None, planner_p=0.0)] * MIN_PLACEMENTS
+    measured = measured_targets(results)
+    assert measured[placement].value == np.inf and measured[within].value == pytest.approx(0.5)
+    assert evaluate_targets(results)[placement].word == MISSED
+    # results written before the goals' errors: not measured, not met
+    results["goals"] = [{k: v for k, v in g.items() if k != "placement_error"} for g in results["goals"]]
+    assert evaluate_targets(results)[placement].word == NOT_MEASURED
+
+
+def test_an_episode_stopped_with_no_action_misses_only_where_the_oracle_found_a_feasible_one() -> None:
+    target = "multi-step episodes ended with no action while one was feasible"
+    results = _plan_results()
+    episode = {"type": "box", "start_xy": [-0.4, 0.0], "target_xy": [-0.3, 0.0], "success": False,
+               "gave_up": True, "within_reach": True, "feasible_at_stop": 0}
+    results["multi_step"]["planner"]["episodes"] = [episode] * 2 + [{**episode, "gave_up": False,
+                                                                     "feasible_at_stop": None}] * 78
+    assert evaluate_targets(results)[target].word == MET  # nothing could act where it stopped
+    results["multi_step"]["planner"]["episodes"][0] = {**episode, "feasible_at_stop": 12}
+    verdict = evaluate_targets(results)[target]
+    assert verdict.word == MISSED and "in 1 of them the oracle found feasible actions (12" in verdict.why
+    results["multi_step"]["planner"]["episodes"][1] = {**episode, "feasible_at_stop": None}  # not recorded
+    assert evaluate_targets(results)[target].word == NOT_MEASURED
 
 
 def _goal(**fields) -> dict:

@@ -63,10 +63,26 @@ SEEN_MARGIN = 0.05
 LOOKAHEAD_ROOTS, LOOKAHEAD_OUTCOMES, LOOKAHEAD_SECOND = 8, 4, 8
 #: A first action is chosen for its value over two interactions when that value is at least this.
 MIN_SEQUENCE_VALUE = 0.1
-#: Calls to ``feasible`` per decision at most: the candidates asked, from the best down, of which one per behaviour
-#: is kept for its canonical action (:meth:`Planner._search`). Each costs 2-70 ms (the grasp's the most); 12 keep
-#: a decision under a second where the most likely candidates are out of reach.
-MAX_CHECKS = 12
+#: Calls to ``feasible`` per decision at most (:meth:`Planner._search`): the ranked candidates and the canonical
+#: actions get at most :data:`RANKED_CHECKS` of them, the :data:`PROBES` the rest. A call costs 3-15 ms (the
+#: kinematics alone; measured on ``affordance plan``'s multi-step episodes), so that 24 keep a decision well under
+#: a second where every action it likes is out of reach.
+MAX_CHECKS = 24
+#: Of :data:`MAX_CHECKS`, the most that the ranked candidates and the canonical actions get, of which one per
+#: behaviour is kept for its canonical action.
+RANKED_CHECKS = 12
+#: Where none of the ranked candidates nor any canonical action is feasible, the planner asks about these actions,
+#: spread over the parameters (the six at 0.75 along each parameter's axis, then the eight corners at 0.75), every
+#: behaviour's, in the order the goal ranks them, until one is feasible or :data:`MAX_CHECKS` are spent; none within
+#: :data:`PROBE_RADIUS` of an action refused in the decision. A behaviour is often feasible in one region of its
+#: parameters only where the object lies at the edge of its reach (a tap only with its contact point shifted one
+#: way, a tap back only the other), far from the canonical action and from the finalists of a goal beyond it:
+#: on 64 of ``affordance plan``'s multi-step episodes (seed 0, the shipped models) the planner named no action in
+#: three, with 12 of the oracle's 325 actions feasible in one (taps, all with the second parameter at 0.75) and 24
+#: in another (taps back with it at -0.25 or less).
+PROBES = np.vstack([np.vstack([0.75 * np.eye(3)[i] * s for i in range(3) for s in (1.0, -1.0)]),
+                    0.75 * np.array([[a, b, c] for a in (1, -1) for b in (1, -1) for c in (1, -1)], float)])
+PROBE_RADIUS = 0.5
 #: :meth:`Planner.choose` ranks candidates by P(goal) in steps of this, then by their expected progress towards the
 #: goal: P is a weighted share of a few hundred training outcomes, and differences under a few per cent are its
 #: noise, whereas a place nearer the target is a real difference.
@@ -514,6 +530,7 @@ class Planner:
         Without ``fallback`` no check is kept (a refinement around an action already found). Without
         ``feasible`` the first entry not excluded."""
         asked = {} if asked is None else asked
+        limit = min(self.max_checks, RANKED_CHECKS)
         refused: list[tuple[str, np.ndarray]] = [(n, candidates[n][k]) for (n, k), ok in asked.items() if not ok]
         canonical = {name: int(np.flatnonzero(np.all(params == 0.0, axis=1))[0]) for name, params in
                      candidates.items() if fallback and np.any(np.all(params == 0.0, axis=1))}
@@ -551,8 +568,8 @@ class Planner:
                         continue
                     if feasible is None:
                         return entry, 0
-                    kept = min(len(open_reserve()) - (canonical.get(key[0]) == key[1]), self.max_checks - 1)
-                    if key not in asked and len(asked) + kept >= self.max_checks:
+                    kept = min(len(open_reserve()) - (canonical.get(key[0]) == key[1]), limit - 1)
+                    if key not in asked and len(asked) + kept >= limit:
                         break  # the remaining checks are kept for the canonical actions not asked about
                     near = radius < REFUSAL_RADIUS and key not in asked
                     if near and second.get(key[0], 0) >= NEAR_REFUSAL_CHECKS:
@@ -570,12 +587,54 @@ class Planner:
         for entry in rankings[-1] if rankings else ():
             order.setdefault(entry[-2], len(order))
         for name in sorted(open_reserve(), key=lambda n: order.get(n, len(order))):
-            if len(asked) >= self.max_checks:
+            if len(asked) >= limit:
                 break
             key = (name, canonical[name])
             if ask(key, near_refused=True) and key in last:  # the canonical action, whatever was refused near it
                 return last[key], len(asked)
         return None, len(asked)
+
+    def _probe(self, rank: Callable[[dict[str, np.ndarray]], list[tuple]], feasible, asked: dict[tuple[str, int], bool],
+               candidates: dict[str, np.ndarray], features: np.ndarray, start: np.ndarray | None):
+        """Where :meth:`_search` found nothing: a feasible one of the :data:`PROBES` of every behaviour, and the model
+        evaluations it made. The behaviours take turns, in the order of their best probe in ``rank(probes)``
+        (entries ending with behaviour and index in ``probes``); each asks about its probe farthest from the actions
+        of it refused so far (the better ranked of equally far ones), never one within :data:`PROBE_RADIUS` of
+        them (of equally far ones, the farthest from all of them on average, then the better ranked), until one is
+        feasible or :attr:`max_checks` are spent: where a behaviour reaches only one region of its parameters, the
+        checks go where it has not been refused yet. The probes join ``candidates`` (their
+        entries' indices follow the candidates'), and ``asked`` gets the answers."""
+        probes = {name: PROBES for name in candidates}
+        ranked = rank(probes)
+        offset = {name: len(params) for name, params in candidates.items()}
+        for name in candidates:
+            candidates[name] = np.vstack([candidates[name], PROBES])
+        excluded = self._excluded(features, start, candidates)
+        refused = {name: [candidates[n][k] for (n, k), ok in asked.items() if n == name and not ok]
+                   for name in candidates}
+        left = {}  # per behaviour, its probes (entry, index in candidates) not asked yet, best ranked first
+        for entry in ranked:
+            name, k = entry[-2], entry[-1] + offset[entry[-2]]
+            if (name, k) not in asked and (name, k) not in excluded:
+                left.setdefault(name, []).append((entry, k))
+        while left and len(asked) < self.max_checks:
+            for name in list(left):
+                if len(asked) >= self.max_checks:
+                    break
+                gaps = [np.linalg.norm(candidates[name][k] - np.array(refused[name]), axis=1) if refused[name]
+                        else np.full(1, np.inf) for _, k in left[name]]
+                # the farthest from the nearest refused action; of equally far ones, from all of them on average
+                i = max(range(len(gaps)), key=lambda j: (round(float(gaps[j].min()), 2), float(gaps[j].mean()), -j))
+                entry, k = left[name].pop(i)
+                if not left[name]:
+                    del left[name]
+                if gaps[i].min() < PROBE_RADIUS:
+                    continue
+                asked[(name, k)] = bool(feasible(name, candidates[name][k]))
+                if asked[(name, k)]:
+                    return (*entry[:-1], k), len(PROBES) * len(probes)
+                refused[name].append(candidates[name][k])
+        return None, len(PROBES) * len(probes)
 
     def _ranked(self, scores: Mapping[str, tuple[np.ndarray, np.ndarray]], goal: Goal) -> list[tuple]:
         """Every candidate (P, progress, behaviour, index), best first: by P(goal), for a goal that
@@ -591,8 +650,8 @@ class Planner:
     def _nothing(self, asked: int, evaluations: int) -> Choice:
         """The choice that names no action, and why."""
         if asked:
-            why = (f"none of the {asked} actions asked about was feasible (at most {self.max_checks} a decision, "
-                   "one kept for each behaviour's canonical action)")
+            why = (f"none of the {asked} actions asked about was feasible (the best ranked, each behaviour's "
+                   f"canonical action and actions spread over its parameters; at most {self.max_checks} a decision)")
         else:
             why = "every action scored failed on this object where it is before (note_failure)"
         return Choice(None, None, 0.0, True, checked=asked, value=0.0, reason=why, evaluations=evaluations)
@@ -616,6 +675,11 @@ class Planner:
         excluded = self._excluded(seen, start, candidates)
         asked: dict[tuple[str, int], bool] = {}
         best, checked = self._search([self._ranked(scores, goal)], feasible, excluded, candidates, asked)
+        if best is None and feasible is not None and checked < self.max_checks:
+            candidates = dict(candidates)
+            best, more = self._probe(lambda probes: self._ranked(self._score(features, goal, start_xy, probes), goal),
+                                     feasible, asked, candidates, seen, start)
+            checked, evaluations = len(asked), evaluations + more
         if best is None:
             return self._nothing(checked, evaluations)
         p, _, name, k = best
@@ -681,6 +745,35 @@ class Planner:
         if self.optimizer != "grid":  # the seeds too: first actions that lead elsewhere, for the second interaction
             seeds = self.params[:TOWARD_SEEDS]
             candidates = {name: _distinct(np.vstack([found, seeds])) for name, found in candidates.items()}
+        ranked, evaluations = self._toward_ranked(features, goal, start, candidates, steps_left, reachable,
+                                                  evaluations)
+        excluded = self._excluded(features, start, candidates)
+        asked: dict[tuple[str, int], bool] = {}
+        found, checked = self._search(ranked, feasible, excluded, candidates, asked)
+        if found is None and feasible is not None and checked < self.max_checks:
+            candidates = dict(candidates)
+
+            def rank(probes):  # the probes' rankings one after the other, each probe at its first place
+                first: dict[tuple[str, int], tuple] = {}
+                for ranking in self._toward_ranked(features, goal, start, probes, steps_left, reachable, 0)[0]:
+                    for entry in ranking:
+                        first.setdefault(entry[-2:], entry)
+                return list(first.values())
+
+            found, more = self._probe(rank, feasible, asked, candidates, features, start)
+            checked, evaluations = len(asked), evaluations + more
+        if found is None:
+            return self._nothing(checked, evaluations)
+        v, p, d, name, k = found
+        return Choice(name, candidates[name][k].copy(), p, p < self.threshold, d, checked, v,
+                      reason=_below(p, self.threshold), evaluations=evaluations)
+
+    def _toward_ranked(self, features: np.ndarray, goal: Place, start: np.ndarray, candidates: Mapping[str, np.ndarray],
+                       steps_left: int | None, reachable, evaluations: int) -> tuple[list[list[tuple]], int]:
+        """:meth:`toward`'s rankings of ``candidates`` (per behaviour): those likely enough to end within, the most
+        valuable over two interactions, the nearest on average, each of entries (value, P(within), expected
+        distance, behaviour, index); and ``evaluations`` plus the model evaluations made."""
+        target = np.asarray(goal.target_xy)
         names = list(self.models)
         predicted, p1, distance, ends = {}, {}, {}, {}
         for name, model in self.models.items():
@@ -706,13 +799,7 @@ class Planner:
         finish = sorted((e for e in entries if e[1] >= self.threshold), key=lambda e: (-e[1], e[2]))
         sequence = sorted((e for e in entries if e[0] >= MIN_SEQUENCE_VALUE), key=lambda e: (-e[0], e[2]))
         nearest = sorted(entries, key=lambda e: (e[2], -e[0]))
-        excluded = self._excluded(features, start, candidates)
-        found, checked = self._search([finish, sequence, nearest], feasible, excluded, candidates)
-        if found is None:
-            return self._nothing(checked, evaluations)
-        v, p, d, name, k = found
-        return Choice(name, candidates[name][k].copy(), p, p < self.threshold, d, checked, v,
-                      reason=_below(p, self.threshold), evaluations=evaluations)
+        return [finish, sequence, nearest], evaluations
 
     def _look_ahead(self, features, goal, predicted, ends, p1, distance, value, reachable, candidates) -> int:
         """Add to ``value`` (P(within) of each first action) the chance of a second interaction (see

@@ -139,8 +139,11 @@ class Episode:
         final_distance: Its distance to the target at the end [m] (None where not recorded).
         steps: Its interactions (None where not recorded).
         success: Whether it got there.
-        gave_up: Whether the planner stopped because none of the candidates it asked ``feasible`` about (at most
+        gave_up: Whether the planner stopped because none of the actions it asked ``feasible`` about (at most
             its ``max_checks``) was reachable.
+        feasible_at_stop: Where it stopped so: how many of the oracle's actions (every behaviour's) were feasible
+            there (0: no behaviour could act, and stopping was right); None where it did not stop, or in results
+            written before it was recorded.
         reach_failures: Its interactions that failed to reach (None where not recorded).
         failures: The messages of its interactions that failed to reach.
         toward_robot: Whether its target lay toward the robot (within 45 degrees of +x from the object).
@@ -160,6 +163,7 @@ class Episode:
     steps: Count | None = None
     success: bool
     gave_up: bool
+    feasible_at_stop: Count | None = None
     reach_failures: Count | None = None
     failures: tuple[str, ...] = ()
     toward_robot: bool = False
@@ -302,6 +306,8 @@ class GoalRecord:
             recorded.
         planner_left_out: Whether the planner fitted without the object's type reached it; None in results
             written before it was recorded.
+        placement_error: For a place goal the planner acted on: how far from the target its action left the
+            object [m]; None for other goals, where it named no action, or in results written before it was recorded.
     """
 
     kind: str
@@ -315,6 +321,7 @@ class GoalRecord:
     oracle: bool
     oracle_hits: Count | None = None
     planner_left_out: bool | None = None
+    placement_error: float | None = None
 
 
 @dataclass(frozen=True, kw_only=True)

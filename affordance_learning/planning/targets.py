@@ -33,22 +33,23 @@ from affordance_learning.planning.results import NOTHING, SUCCESS_DISTANCES_M, G
 
 #: The left-out shapes' bound on their feasible goals (the target "each left-out shape, success on its feasible
 #: goals").
-SHAPE_BOUND = 0.75
+SHAPE_BOUND = 0.80
 
 
 # The least data a verdict is given on; below it the verdict is "too few (n=...)". A share's Wilson 95 % interval
 # is shown beside it, so a verdict close to its bound can be read as the near thing it is.
-#: Feasible single-step goals: a share near the 92 % target is then known within +-4 points (Wilson 95 %).
+#: Feasible single-step goals: a share near the 95 % target is then known within +-3 points (Wilson 95 %).
 MIN_FEASIBLE_GOALS = 200
 
 
 #: Feasible goals of each left-out shape: from 30, one goal is at most 3 points of the share and the interval around
-#: 75 % is about +-15 points; with fewer, both grow fast (one goal met or missed the target before).
+#: 80 % is about +-14 points; with fewer, both grow fast (one goal met or missed the target before).
 MIN_FEASIBLE_PER_SHAPE = 30
 
 
-#: Place goals the planner acted on, for the median placement error: at 30 the median's 95 % interval already spans
-#: the 10th to the 21st of the sorted errors; with fewer it is set by a handful of goals.
+#: Place goals the oracle reaches, for the planner's median placement error and its share within 3 cm: at 30 the
+#: median's 95 % interval already spans the 10th to the 21st of the sorted errors; with fewer it is set by a
+#: handful of goals.
 MIN_PLACEMENTS = 30
 
 
@@ -63,7 +64,7 @@ MIN_CALIBRATION_ACTIONS = 400
 MIN_EPISODES = 60
 
 
-#: Multi-step episodes whose target lies toward the robot: around 75 %, +-19 points.
+#: Multi-step episodes whose target lies toward the robot: around 80 %, +-18 points.
 MIN_TOWARD_ROBOT = 15
 
 
@@ -330,6 +331,7 @@ METRES = Unit(lambda m: f"{100 * m.value:.1f} cm (n={m.n} {m.unit})", lambda b: 
 SECONDS = Unit(lambda m: f"{1000 * m.value:.0f} ms (n={m.n} {m.unit})", lambda b: f"{1000 * b:.0f} ms")
 MINUTES = Unit(lambda m: f"{m.value:.1f} min ({m.unit})", lambda b: f"{b:.0f} min")
 SCORE = Unit(lambda m: f"{m.value:.3f} (n={m.n} {m.unit})", lambda b: f"{b}")
+COUNT = Unit(lambda m: f"{m.value:.0f} of {m.n} {m.unit}", lambda b: f"{b:.0f}")
 
 
 @dataclass(frozen=True)
@@ -392,14 +394,29 @@ def _single_step_gap_why(results: PlanResults) -> str:
 
 
 def _placement_why(results: PlanResults) -> str:
-    place = _reached(results.single_step_by_goal.get("place", {}), "oracle")
-    median, n = results.placement_error_committed
-    committed = ("" if median is None else
-                 f"; on the {n} place goals it did not abstain from (P >= its threshold) the median error is "
-                 f"{100 * median:.1f} cm")
-    return (f"place goals are reached in {share_cell(place)} of cases even by the oracle: most targets 5-15 cm "
-            "away are beyond what one interaction does to the object (a grasp holds only objects under about "
-            "7 cm), and the planner acts on every place goal, also where it predicts it will miss" + committed)
+    """Why the planner misses place goals that the oracle reaches: how near its actions left the object, and at
+    what P it chose them."""
+    places = _oracle_places(results)
+    if not places or all(g.placement_error is None for g in places):
+        place = _reached(results.single_step_by_goal.get("place", {}), "oracle")
+        return f"the oracle reached {share_cell(place)} of the place goals; the goals' errors were not recorded"
+    threshold = float(results.settings.get("threshold", 0.5))
+    acted = [g for g in places if g.placement_error is not None]
+    missed = [g for g in acted if not g.planner]
+    sure = [g for g in missed if g.planner_p >= threshold]
+    within5 = sum(g.placement_error <= 0.05 for g in missed)
+    text = (f"of the {len(places)} place goals the oracle reaches, the planner acted on {len(acted)} and left the "
+            f"object within 3 cm in {len(acted) - len(missed)}")
+    if missed:
+        text += (f"; of the {len(missed)} it missed, {within5} ended within 5 cm (median error "
+                 f"{100 * np.median([g.placement_error for g in missed]):.1f} cm), {len(missed) - len(sure)} were "
+                 f"chosen at P below its threshold {threshold:g} (it expected to miss), and by behaviour "
+                 + ", ".join(f"{b} {n}" for b, n in Counter(g.planner_behavior for g in missed).most_common()))
+    hits = [g.oracle_hits for g in missed if g.oracle_hits is not None]
+    if hits:
+        text += (f"; the missed were reached by a median of {np.median(hits):g} of the oracle's actions, the "
+                 f"reached by {np.median([g.oracle_hits for g in acted if g.planner and g.oracle_hits]):g}")
+    return text
 
 
 def _left_out_listing_why(results: PlanResults) -> str:
@@ -480,6 +497,51 @@ def _plan_time_why(results: PlanResults) -> str:
 
 
 # --- the targets ----------------------------------------------------------------------------------------------
+def _oracle_places(results: PlanResults) -> list[GoalRecord]:
+    """The single-step place goals that some action of the oracle's reached."""
+    return [g for g in results.goals if g.kind == "place" and g.oracle]
+
+
+def _placement_error(results: PlanResults) -> Measured:
+    """The planner's median placement error on the place goals the oracle reaches [m], a goal it named no action
+    for counting as missed by any distance; not measured in results without the goals' errors."""
+    places = _oracle_places(results)
+    unit = "place goals the oracle reaches"
+    if not places or all(g.placement_error is None for g in places):
+        return Measured(None, len(places), unit)
+    errors = [np.inf if g.placement_error is None else g.placement_error for g in places]
+    return Measured(float(np.median(errors)), len(errors), unit)
+
+
+def _placed_within(results: PlanResults) -> Measured:
+    """The share of the place goals the oracle reaches that the planner's action reached (within the place's
+    tolerance, 3 cm)."""
+    places = _oracle_places(results)
+    k, n = sum(g.planner for g in places), len(places)
+    return Measured(k / n if n else None, n, "place goals the oracle reaches", wilson(k, n))
+
+
+def _stopped_while_feasible(results: PlanResults) -> Measured:
+    """The planner's multi-step episodes that ended with no action where some action of the oracle's was feasible;
+    not measured where a stop's feasible actions were not recorded."""
+    episodes = _multi(results).episodes
+    stops = [e for e in episodes if e.gave_up]
+    if any(e.feasible_at_stop is None for e in stops):
+        return Measured(None, len(episodes), "episodes", detail=f"{len(stops)} stops, what was feasible there "
+                        "not recorded")
+    return Measured(float(sum(e.feasible_at_stop > 0 for e in stops)), len(episodes), "episodes")
+
+
+def _stops_why(results: PlanResults) -> str:
+    stops = [e for e in _multi(results).episodes if e.gave_up]
+    early = [e for e in stops if (e.feasible_at_stop or 0) > 0]
+    actions = results.oracle.get("actions_per_behavior")
+    of = f"of its {actions * len(results.training)} actions" if actions else "of its actions"
+    return (f"the planner stopped with no action in {len(stops)} episodes; in {len(early)} of them the oracle "
+            f"found feasible actions ({', '.join(str(e.feasible_at_stop) for e in early)} {of}) where none of "
+            f"those the planner asked about (at most {MAX_CHECKS}) was")
+
+
 def _multi(results: PlanResults):
     return results.multi_step.policy("planner")
 
@@ -508,15 +570,20 @@ def _plan_time(results: PlanResults) -> Measured:
     return Measured(results.total_time_s / 60, 1, f"run {workers}")
 
 
+def _quick_time(results: PlanResults) -> Measured:
+    """A quick run's time [min] (``affordance plan --quick``); a full run is none (n=0)."""
+    workers = f"on {results.workers or '?'} workers"
+    return Measured(results.total_time_s / 60, int(bool(results.settings.get("quick"))),
+                    f"quick run {workers}" if results.settings.get("quick") else "runs of --quick")
+
+
 _TARGET_LIST = (
-    Target("single-step success on feasible goals", ">=", 0.92, MIN_FEASIBLE_GOALS,
+    Target("single-step success on feasible goals", ">=", 0.95, MIN_FEASIBLE_GOALS,
            lambda r: _measured(_single(r).feasible, "feasible goals"), why=_single_step_gap_why),
-    Target("single-step success over the oracle's", ">=", 0.95, MIN_FEASIBLE_GOALS,
-           lambda r: Measured(r.planner_over_oracle, _single(r).feasible.n, "feasible goals"),
-           why=_single_step_gap_why),
-    Target("median placement error [m]", "<=", 0.02, MIN_PLACEMENTS,
-           lambda r: Measured(r.placement_error_median_m, r.placement_error_n, "place goals acted on"), METRES,
-           _placement_why),
+    Target("place goals the oracle reaches: median error [m]", "<=", 0.01, MIN_PLACEMENTS, _placement_error,
+           METRES, _placement_why),
+    Target("place goals the oracle reaches: within 3 cm", ">=", 0.90, MIN_PLACEMENTS, _placed_within,
+           why=_placement_why),
     Target("each left-out shape, success on its feasible goals", ">=", SHAPE_BOUND, MIN_FEASIBLE_PER_SHAPE,
            lambda r: _worst_shape(r), why=_left_out_listing_why),
     Target("each left-out shape, planner minus best fixed behaviour", ">=", 0.0, MIN_FEASIBLE_PER_SHAPE,
@@ -529,8 +596,10 @@ _TARGET_LIST = (
            _calibration_why(True)),
     Target("multi-step targets reached", ">=", 0.85, MIN_EPISODES,
            lambda r: _measured(_multi(r).reached, "episodes"), why=lambda r: multi_step_why(r)),
-    Target("multi-step targets toward the robot reached", ">=", 0.75, MIN_TOWARD_ROBOT,
+    Target("multi-step targets toward the robot reached", ">=", 0.80, MIN_TOWARD_ROBOT,
            lambda r: _measured(_multi(r).toward_robot, "episodes toward the robot"), why=_toward_robot_why),
+    Target("multi-step episodes ended with no action while one was feasible", "<=", 0.0, MIN_EPISODES,
+           _stopped_while_feasible, COUNT, _stops_why),
     Target("multi-step reach failures per interaction", "<=", 0.01, MIN_EPISODES, _reach_failures,
            why=_reach_failures_why),
     Target("decision time, median [s]", "<=", 0.1, MIN_DECISIONS, _seconds("median"), SECONDS,
@@ -538,6 +607,7 @@ _TARGET_LIST = (
     Target("decision time, 99th percentile [s]", "<=", 1.0, MIN_DECISIONS, _seconds("p99"), SECONDS,
            _decision_time_why),
     Target("affordance plan's time [min]", "<=", 15.0, 1, lambda r: _plan_time(r), MINUTES, _plan_time_why),
+    Target("affordance plan --quick's time [min]", "<=", 3.0, 1, _quick_time, MINUTES, _plan_time_why),
 )
 #: Every target of the planner by name, in the order the report lists them.
 TARGETS: Mapping[str, Target] = {t.name: t for t in _TARGET_LIST}

@@ -15,6 +15,7 @@ from affordance_env.objects import OBJECT_TYPES
 from affordance_env.registry import BEHAVIOR_NAMES
 from affordance_learning.planning.experiment.baselines import direction_heuristic
 from affordance_learning.planning.experiment.goal_drawing import episode_start, toward_robot
+from affordance_learning.planning.experiment.settings import oracle_params
 from affordance_learning.planning.experiment.simulation import evaluation_env, feasible_at, reach_failure
 from affordance_learning.planning.planner import FAILURE_RADIUS, Planner
 
@@ -27,7 +28,8 @@ PULLING = ("draw", "grasp")
 def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, camera: tuple[int, int],
                      frames: list | None = None, env=None) -> dict[str, Any]:
     """One multi-step episode of ``policy`` from reset seed ``item["seed"]``: reached, interactions, reach
-    failures, the final distance [m] and whether the object ended off the table, the planner's decision times [s];
+    failures, the final distance [m] and whether the object ended off the table, the planner's decision times [s],
+    whether it stopped with no action and how many of the oracle's actions were feasible there;
     ``frames``, if given, gets a labelled picture of the start and after each interaction. ``env``: the goal env to
     run it in (default: this worker's, :func:`~.simulation.evaluation_env`)."""
     from affordance_env.registration import GOAL_MAX_EPISODE_STEPS
@@ -37,7 +39,7 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
     obs, info = episode_start(env, item, rng)
     initial_state = env.get_state()
     tolerance = env.goal_tolerance
-    steps, failures, success, gave_up, decisions = 0, [], False, False, []
+    steps, failures, success, gave_up, decisions, feasible_at_stop = 0, [], False, False, [], None
     distance = initial = float(info["distance"])
     start_xy, target_xy = (np.asarray(obs[key], dtype=float).tolist() for key in ("achieved_goal", "desired_goal"))
     if frames is not None:
@@ -54,6 +56,9 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
             env.set_state(state)  # feasible may have put it back: the same state, to be sure
             if choice.behavior is None:  # none of the actions asked about is reachable: stop rather than fail
                 gave_up = True
+                # the oracle's judgement of that stop: how many of its actions, every behaviour's, were feasible
+                feasible_at_stop = sum(bool(feasible_at(env, state)(b, params)) for b in BEHAVIOR_NAMES
+                                       for params in oracle_params())
                 break
             behavior, params = choice.behavior, choice.params
         elif policy == "direction":
@@ -80,6 +85,7 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
              if policy == "planner" and toward else None)
     return {"policy": policy, "success": success, "steps": steps, "reach_failures": len(failures), "failures": failures,
             "final_distance": distance, "off_table": info.get("outcome") == "off_table", "gave_up": gave_up,
+            "feasible_at_stop": feasible_at_stop,
             "type": info["object"]["type"],
             "initial_distance": initial, "start_xy": start_xy, "target_xy": target_xy, "tolerance": tolerance,
             "toward_robot": toward, "pulls_at_start": pulls, "decision_s": decisions}

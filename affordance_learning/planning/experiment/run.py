@@ -226,7 +226,8 @@ def _episode(e: Mapping[str, Any], reach: Mapping[str, Mapping[str, float]], tol
     pulls = e["pulls_at_start"]
     return Episode(type=e["type"], start_xy=tuple(e["start_xy"]), target_xy=tuple(e["target_xy"]),
                    initial_distance=e["initial_distance"], final_distance=e["final_distance"], steps=e["steps"],
-                   success=e["success"], gave_up=e["gave_up"], reach_failures=e["reach_failures"],
+                   success=e["success"], gave_up=e["gave_up"], feasible_at_stop=e.get("feasible_at_stop"),
+                   reach_failures=e["reach_failures"],
                    failures=tuple(e["failures"]), toward_robot=e["toward_robot"],
                    pulls_at_start=None if pulls is None else MappingProxyType(dict(pulls)),
                    within_reach=e["type"] in reach and within_reach(e["start_xy"], e["target_xy"], reach[e["type"]],
@@ -281,7 +282,7 @@ def _placement(records: Sequence[Mapping[str, Any]]) -> dict[str, Any]:
 
 #: What results.json keeps of each single-step goal's record.
 GOAL_FIELDS = ("kind", "type", "object", "size", "goal", "planner", "planner_p", "planner_behavior", "oracle",
-               "oracle_hits", "planner_left_out")
+               "oracle_hits", "planner_left_out", "placement_error")
 
 
 def _results(run: _Stages, frame: pd.DataFrame, frames: Mapping[str, pd.DataFrame], objects: list,
