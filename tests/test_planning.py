@@ -221,6 +221,18 @@ def test_the_planner_never_chooses_again_an_action_that_failed_where_the_object_
     assert np.array_equal(planner.choose(features, goal, start).params, first.params)
 
 
+def test_a_behaviour_that_failed_whatever_its_parameters_is_left_out_where_the_object_still_is(model):
+    """note_failure with params None (a grasp that held nothing): no action of that behaviour is chosen again on
+    the object there, by choose or toward; the other behaviours still are, and elsewhere it is again."""
+    planner = Planner({"push": model, "tap": model}, n_candidates=32)
+    features, start, goal = np.array([-0.3, 1.0, 0.0]), np.array([-0.45, 0.0]), Move((1.0, 0.0), 0.15)
+    assert planner.choose(features, goal, start).behavior == "tap"  # the same model: the registry's first
+    planner.note_failure("tap", None, start)
+    assert planner.choose(features, goal, start).behavior == "push"
+    assert planner.toward(features, start, (-0.35, 0.0), 0.03, steps_left=1, reachable=None).behavior == "push"
+    assert planner.choose(features, goal, start + 0.05).behavior == "tap"
+
+
 def test_a_decision_asks_feasible_at_most_max_checks_times_and_breaks_ties_by_progress(model):
     calls = []
 

@@ -315,22 +315,26 @@ class Planner:
         self._offsets = REFINE_RADIUS * (2.0 * local - 1.0)
         #: How many feature values each method's ``features`` must have: the models' inputs but the parameters.
         self.n_features = next(iter(inputs.values())) - self.params.shape[1]
-        #: The actions that failed to reach, each (behaviour, params, where the object was (x, y) or None, its
-        #: features): :meth:`note_failure`.
-        self.failures: list[tuple[str, np.ndarray, np.ndarray | None, np.ndarray]] = []
+        #: The actions that failed to reach, each (behaviour, params or None for all of them, where the object was
+        #: (x, y) or None, its features): :meth:`note_failure`.
+        self.failures: list[tuple[str, np.ndarray | None, np.ndarray | None, np.ndarray]] = []
 
     # --- what failed ---------------------------------------------------------------------------------------------
     def note_failure(self, behavior: str, params, start_xy=None, features=None) -> None:
         """Remember that ``behavior`` with ``params`` failed on the object at ``start_xy`` [m] (or, without a
         position, seen with ``features``): it failed to reach it, or left it where it was. No later decision on that
-        object there chooses it, or an action of ``behavior`` within :data:`REFUSAL_RADIUS` of it, again."""
+        object there chooses it, or an action of ``behavior`` within :data:`REFUSAL_RADIUS` of it, again.
+        ``params`` None: every action of ``behavior`` failed there (a grasp that held nothing: its parameters
+        name where to put the object down, and the hand takes it as the canonical grasp does whatever they are)."""
         if behavior not in self.models:
             raise InvalidValueError(f"Unknown behavior {behavior!r}: the planner's are {', '.join(self.models)}.")
-        params = float_array("params", params, (self.params.shape[1],), error=InvalidValueError,
-                             expected=f"the behaviour's {self.params.shape[1]} finite parameters")
+        if params is not None:
+            params = float_array("params", params, (self.params.shape[1],), error=InvalidValueError,
+                                 expected=f"the behaviour's {self.params.shape[1]} finite parameters, or None")
         where = None if start_xy is None else _check_start(start_xy)
-        seen = np.zeros(0) if features is None else self._inputs(features, params[None])[0, : self.n_features]
-        self.failures.append((str(behavior), params.copy(), where, seen))
+        seen = (np.zeros(0) if features is None
+                else self._inputs(features, self.params[:1])[0, : self.n_features])
+        self.failures.append((str(behavior), None if params is None else params.copy(), where, seen))
 
     def _check_where(self, start_xy) -> np.ndarray:
         """``start_xy``, where the object is: one (x, y) [m], on the table top (:attr:`table`, widened by
@@ -358,7 +362,8 @@ class Planner:
             else:
                 here = seen.shape == features.shape and np.allclose(seen, features, rtol=1e-3, atol=1e-6)
             if here:
-                near = np.flatnonzero(np.linalg.norm(candidates[name] - params, axis=1) < REFUSAL_RADIUS)
+                near = (np.arange(len(candidates[name])) if params is None
+                        else np.flatnonzero(np.linalg.norm(candidates[name] - params, axis=1) < REFUSAL_RADIUS))
                 out.update((name, int(k)) for k in near)
         return out
 
@@ -498,7 +503,8 @@ class Planner:
             out = np.zeros(len(params), dtype=bool)
             for other, failed_params in failed:
                 if other == name:
-                    out |= np.linalg.norm(params - failed_params, axis=1) < REFUSAL_RADIUS
+                    out |= (True if failed_params is None
+                            else np.linalg.norm(params - failed_params, axis=1) < REFUSAL_RADIUS)
             return out
 
         return excluded_near

@@ -472,8 +472,13 @@ def _reach_failures_why(results: PlanResults) -> str:
 
 
 def _decision_time_why(results: PlanResults) -> str:
-    return ("a decision scores every candidate of every behaviour and asks the kinematics (``feasible``, "
-            "2-70 ms a call) about the best ones; the slowest are those whose best candidates are out of reach")
+    times = results.decision_seconds
+    parts = [f"{name}'s median {1000 * t.median:.0f} ms and 99th percentile {1000 * t.p99:.0f} ms (n={t.n})"
+             for name, t in (("choose", times.choose), ("toward", times.toward)) if t is not None and t.n]
+    return ((", ".join(parts) + "; " if parts else "") + "a decision scores about 1,300 actions of the five "
+            "behaviours on the effect models' trees, toward's over two interactions, and asks the kinematics "
+            "(``feasible``, 3-20 ms a call) about the best ones; the slowest are those whose best actions are out "
+            "of reach")
 
 
 def _plan_time_why(results: PlanResults) -> str:
@@ -572,9 +577,9 @@ def _plan_time(results: PlanResults) -> Measured:
 
 def _quick_time(results: PlanResults) -> Measured:
     """A quick run's time [min] (``affordance plan --quick``); a full run is none (n=0)."""
-    workers = f"on {results.workers or '?'} workers"
-    return Measured(results.total_time_s / 60, int(bool(results.settings.get("quick"))),
-                    f"quick run {workers}" if results.settings.get("quick") else "runs of --quick")
+    if not results.settings.get("quick"):
+        return Measured(None, 0, "runs of --quick", detail="a full run: `affordance plan --quick` measures it")
+    return Measured(results.total_time_s / 60, 1, f"quick run on {results.workers or '?'} workers")
 
 
 _TARGET_LIST = (

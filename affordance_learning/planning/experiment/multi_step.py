@@ -72,7 +72,9 @@ def evaluate_episode(item: Mapping[str, Any], planner: Planner, policy: str, cam
         # An action that failed to reach, or left the object where it was, would do so again from there: noted
         moved = float(np.linalg.norm(np.asarray(obs["achieved_goal"]) - np.asarray(start)))
         if policy == "planner" and (reach_failure(info) or (not terminated and moved < FAILURE_RADIUS)):
-            planner.note_failure(behavior, params, start)
+            # a grasp that held nothing would hold nothing wherever it was to put the object down
+            held_nothing = behavior == "grasp" and not reach_failure(info) and not info["success"]
+            planner.note_failure(behavior, None if held_nothing else params, start)
         distance = float(info["distance"])
         if frames is not None:
             frames.append((f"{behavior}: {100 * distance:.1f} cm to go", env.render()))
