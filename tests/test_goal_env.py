@@ -137,6 +137,34 @@ def test_feasible_from_a_snapshot_answers_for_it_and_leaves_the_env_as_it_was(en
     assert answers == {b: env.feasible(b, params) for b in BEHAVIOR_NAMES}
 
 
+def test_an_outcome_from_a_snapshot_is_the_steps_bit_for_bit_and_leaves_the_env_as_it_was(env):
+    """outcome(): what step() would do from the snapshot, on every key that does not come of the observation after
+    it, and the env (world, episode, generator) as it was; a kinematic failure is an outcome too."""
+    env.reset(seed=2, options={"object_type": "sphere", "size": 0.06, "position": (-0.30, 0.05)})
+    start = env.get_state()
+    env.step({"behavior": "push", "params": np.zeros(3)})  # the ball is now elsewhere
+    now = env.get_state()
+    shared = ("failure", "rolled", "outcome", "success", "displacement", "behavior")
+    for behavior, params in (("tap", np.array([0.3, -0.2, 0.5], np.float32)),
+                             ("grasp", np.array([0.25, -0.5, 0.0], np.float32))):
+        got = env.outcome(behavior, params, state=start)
+        after = env.get_state()
+        for field in ("qpos", "qvel"):  # nothing moved
+            np.testing.assert_array_equal(getattr(after.world.physics[1], field),
+                                          getattr(now.world.physics[1], field))
+        assert after.obs is now.obs and after.steps == now.steps and after.rng == now.rng
+        env.set_state(start)
+        *_, info = env.step({"behavior": behavior, "params": params})
+        assert {k: info[k] for k in shared} == {k: got[k] for k in shared}
+        np.testing.assert_array_equal(got["effect"], info["effect"])
+        for key in ("initial_pose", "final_pose"):
+            np.testing.assert_array_equal(got["object"][key], info["object"][key])
+        assert not {"is_success", "distance", "true_position"} & set(got)
+        env.set_state(now)
+    with pytest.raises(ValueError, match="behavior"):
+        env.outcome("kick", np.zeros(3))
+
+
 def test_the_object_pose_has_the_same_key_after_reset_and_after_step(env):
     _, info = env.reset(seed=3)
     assert set(info["object"]) >= {"pose"}

@@ -524,7 +524,8 @@ class Planner:
         ``candidates``, the last of them every candidate), that is not ``excluded`` and that ``feasible`` accepts;
         and how many times ``feasible`` was asked.
 
-        ``feasible`` is asked at most ``max_checks`` times, never about a ranked candidate within
+        ``feasible`` is asked at most :data:`RANKED_CHECKS` times (or ``max_checks``, if fewer), never about a ranked
+        candidate within
         :data:`REFUSAL_RADIUS` of one it refused, and one check is kept for the canonical action (the candidate of
         zeros, where there is one) of every behaviour: where the ranked candidates run out of checks, the
         canonical actions not asked about yet are, the most promising behaviour first, whatever was refused near
@@ -605,8 +606,8 @@ class Planner:
         """Where :meth:`_search` found nothing: a feasible one of the :data:`PROBES` of every behaviour, and the model
         evaluations it made. The behaviours take turns, in the order of their best probe in ``rank(probes)``
         (entries ending with behaviour and index in ``probes``); each asks about its probe farthest from the actions
-        of it refused so far (the better ranked of equally far ones), never one within :data:`PROBE_RADIUS` of
-        them (of equally far ones, the farthest from all of them on average, then the better ranked), until one is
+        of it refused so far, never one within :data:`PROBE_RADIUS` of them (of equally far ones, the farthest from
+        all of them on average, then the better ranked), until one is
         feasible or :attr:`max_checks` are spent: where a behaviour reaches only one region of its parameters, the
         checks go where it has not been refused yet. The probes join ``candidates`` (their
         entries' indices follow the candidates'), and ``asked`` gets the answers."""
@@ -632,10 +633,11 @@ class Planner:
                 # the farthest from the nearest refused action; of equally far ones, from all of them on average
                 i = max(range(len(gaps)), key=lambda j: (round(float(gaps[j].min()), 2), float(gaps[j].mean()), -j))
                 entry, k = left[name].pop(i)
+                if gaps[i].min() < PROBE_RADIUS:  # the farthest is near a refused one: so are all the others
+                    del left[name]
+                    continue
                 if not left[name]:
                     del left[name]
-                if gaps[i].min() < PROBE_RADIUS:
-                    continue
                 asked[(name, k)] = bool(feasible(name, candidates[name][k]))
                 if asked[(name, k)]:
                     return (*entry[:-1], k), len(PROBES) * len(probes)
@@ -667,12 +669,12 @@ class Planner:
                feasible: Callable[[str, np.ndarray], bool] | None = None) -> Choice:
         """The most likely feasible action for ``goal`` on the object seen with ``features`` at ``start_xy``, not
         one that failed there (:meth:`note_failure`), ranked as :meth:`_ranked` says among the optimiser's
-        finalists (module docstring); ``feasible`` is asked at most ``max_checks`` times (:meth:`_search`), and
-        where none of those is feasible the choice names no action (``behavior`` and ``params`` None, with a
-        ``reason``). With ``optimizer="grid"`` and a goal with a distance (:class:`Move`, :class:`Place`), the
-        actions around the one found are scored too (:data:`REFINE_POINTS` within :data:`REFINE_RADIUS`), and the
-        best of them that ranks above it is taken if feasible (at most :data:`REFINE_CHECKS` asked, within
-        ``max_checks``)."""
+        finalists (module docstring); ``feasible`` is asked at most ``max_checks`` times (:meth:`_search`, then
+        where none of those is feasible the :data:`PROBES`: :meth:`_probe`), and where none of those is feasible
+        the choice names no action (``behavior`` and ``params`` None, with a ``reason``). With ``optimizer="grid"``
+        and a goal with a distance (:class:`Move`, :class:`Place`), the actions around the one found are scored
+        too (:data:`REFINE_POINTS` within :data:`REFINE_RADIUS`), and the best of them that ranks above it is taken
+        if feasible (at most :data:`REFINE_CHECKS` asked, within ``max_checks``)."""
         start = self._check_goal(goal, start_xy)
         seen = self._inputs(features)[0, : self.n_features]
         candidates, evaluations = self._candidates(seen, goal, start)
@@ -730,8 +732,8 @@ class Planner:
         actions that bring the object elsewhere, for a second interaction from there). Actions that failed on the
         object where it is (:meth:`note_failure`) are left out, and
         ``feasible`` is asked at most ``max_checks`` times (:meth:`_search`: every behaviour's canonical action
-        gets a check where the ranked ones are refused); the choice names no action only where none of those
-        was feasible.
+        gets a check where the ranked ones are refused; then the :data:`PROBES`, :meth:`_probe`); the choice names
+        no action only where none of those was feasible.
 
         Args:
             steps_left: Interactions left in the episode, this one included; None: more than one.
@@ -759,15 +761,18 @@ class Planner:
         if found is None and feasible is not None and checked < self.max_checks:
             candidates = dict(candidates)
 
+            spent = [0]  # the look-ahead's evaluations over the probes
+
             def rank(probes):  # the probes' rankings one after the other, each probe at its first place
                 first: dict[tuple[str, int], tuple] = {}
-                for ranking in self._toward_ranked(features, goal, start, probes, steps_left, reachable, 0)[0]:
+                rankings, spent[0] = self._toward_ranked(features, goal, start, probes, steps_left, reachable, 0)
+                for ranking in rankings:
                     for entry in ranking:
                         first.setdefault(entry[-2:], entry)
                 return list(first.values())
 
             found, more = self._probe(rank, feasible, asked, candidates, features, start)
-            checked, evaluations = len(asked), evaluations + more
+            checked, evaluations = len(asked), evaluations + spent[0]  # the probes scored, look-ahead included
         if found is None:
             return self._nothing(checked, evaluations)
         v, p, d, name, k = found

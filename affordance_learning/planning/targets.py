@@ -413,9 +413,10 @@ def _placement_why(results: PlanResults) -> str:
                  f"chosen at P below its threshold {threshold:g} (it expected to miss), and by behaviour "
                  + ", ".join(f"{b} {n}" for b, n in Counter(g.planner_behavior for g in missed).most_common()))
     hits = [g.oracle_hits for g in missed if g.oracle_hits is not None]
+    reached = [g.oracle_hits for g in acted if g.planner and g.oracle_hits is not None]
     if hits:
-        text += (f"; the missed were reached by a median of {np.median(hits):g} of the oracle's actions, the "
-                 f"reached by {np.median([g.oracle_hits for g in acted if g.planner and g.oracle_hits]):g}")
+        text += f"; the missed were reached by a median of {np.median(hits):g} of the oracle's actions"
+        text += f", the reached by {np.median(reached):g}" if reached else ""
     return text
 
 

@@ -61,8 +61,8 @@ def _trimmed(info: Mapping[str, Any]) -> dict[str, Any]:
 
 class Outcomes:
     """The interactions run on one object from one snapshot, each once: ``run(behavior, params)`` runs it the
-    first time and returns what it did (a trimmed step ``info``) every time after (the env repeats an interaction
-    bit for bit from a snapshot)."""
+    first time and returns what it did (a trimmed step ``info``, from the env's ``outcome``: no observation after
+    it) every time after (the env repeats an interaction bit for bit from a snapshot)."""
 
     def __init__(self, env, state) -> None:
         self.env, self.state = env, state
@@ -71,8 +71,6 @@ class Outcomes:
     def run(self, behavior: str, params: np.ndarray) -> dict[str, Any]:
         params = np.asarray(params, dtype=np.float32)
         key = (behavior, params.tobytes())
-        if key not in self.done:
-            self.env.set_state(self.state)
-            *_, info = self.env.step({"behavior": behavior, "params": params})
-            self.done[key] = _trimmed(info)
+        if key not in self.done:  # what it did, without the observation after it (the env's outcome())
+            self.done[key] = _trimmed(self.env.outcome(behavior, params, state=self.state))
         return self.done[key]
