@@ -120,7 +120,7 @@ def test_the_plans_records_read_through_it() -> None:
     read = from_json(GoalRecord, goal, name="plan results")
     assert read == GoalRecord(kind="roll", type="sphere", object=3, planner=True, planner_p=0.8,
                               planner_behavior="tap", oracle=True, size=0.05)
-    assert to_json(read) == {**goal, "oracle_hits": None, "planner_left_out": None}
+    assert to_json(read) == {**goal, "oracle_hits": None, "planner_left_out": None, "placement_error": None}
     with pytest.raises(InvalidValueError, match=r"plan results\['planner'\] must be true or false, got 'false'"):
         from_json(GoalRecord, {**goal, "planner": "false"}, name="plan results")
     episode = Episode(type="box", start_xy=(-0.3, 0.0), target_xy=(-0.2, 0.1), success=False, within_reach=True,
