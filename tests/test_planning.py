@@ -283,7 +283,14 @@ def test_where_a_behaviour_reaches_one_corner_of_its_parameters_the_probes_find_
     models = {"push": model, "tap": model, "draw": model}
     found = Planner(models).toward(features, start, target, 0.03, feasible=corner, reachable=None)
     assert found.behavior == "tap" and corner("tap", found.params) and found.checked <= MAX_CHECKS
-    assert Planner(models).choose(features, Move((1.0, 0.0), 0.40), feasible=corner).behavior == "tap"
+    chosen = Planner(models).choose(features, Move((1.0, 0.0), 0.40), feasible=corner)
+    assert chosen.behavior == "tap" and corner("tap", chosen.params) and chosen.checked <= MAX_CHECKS
+    # where nothing is feasible: every behaviour's probes in turn, every one not near one refused, never more
+    calls = []
+    nothing = Planner(models).toward(features, start, target, 0.03, reachable=None,
+                                     feasible=lambda name, params: calls.append(name) and False)
+    assert nothing.behavior is None and nothing.checked == len(calls) <= MAX_CHECKS
+    assert set(calls[RANKED_CHECKS:]) == set(models) and len(calls) > RANKED_CHECKS + 2 * len(PROBES)
     few = Planner(models, max_checks=RANKED_CHECKS).toward(features, start, target, 0.03, feasible=corner,
                                                            reachable=None)
     assert few.behavior is None and few.checked == RANKED_CHECKS and "spread over its parameters" in few.reason

@@ -63,13 +63,8 @@ SEEN_MARGIN = 0.05
 LOOKAHEAD_ROOTS, LOOKAHEAD_OUTCOMES, LOOKAHEAD_SECOND = 8, 4, 8
 #: A first action is chosen for its value over two interactions when that value is at least this.
 MIN_SEQUENCE_VALUE = 0.1
-#: Calls to ``feasible`` per decision at most (:meth:`Planner._search`): the ranked candidates and the canonical
-#: actions get at most :data:`RANKED_CHECKS` of them, the :data:`PROBES` the rest. A call costs 3-15 ms (the
-#: kinematics alone; measured on ``affordance plan``'s multi-step episodes), so that 24 keep a decision well under
-#: a second where every action it likes is out of reach.
-MAX_CHECKS = 24
-#: Of :data:`MAX_CHECKS`, the most that the ranked candidates and the canonical actions get, of which one per
-#: behaviour is kept for its canonical action.
+#: Of the calls to ``feasible`` per decision (:meth:`Planner._search`), the most that the ranked candidates and
+#: the canonical actions get, of which one per behaviour is kept for its canonical action.
 RANKED_CHECKS = 12
 #: Where none of the ranked candidates nor any canonical action is feasible, the planner asks about these actions,
 #: spread over the parameters (the six at 0.75 along each parameter's axis, then the eight corners at 0.75), every
@@ -83,6 +78,13 @@ RANKED_CHECKS = 12
 PROBES = np.vstack([np.vstack([0.75 * np.eye(3)[i] * s for i in range(3) for s in (1.0, -1.0)]),
                     0.75 * np.array([[a, b, c] for a in (1, -1) for b in (1, -1) for c in (1, -1)], float)])
 PROBE_RADIUS = 0.5
+#: Calls to ``feasible`` per decision at most: :data:`RANKED_CHECKS`, then every behaviour's :data:`PROBES` (82
+#: for the five behaviours). A call costs 3-20 ms (the kinematics alone, the grasp's the most; measured on
+#: ``affordance plan``'s multi-step episodes), so that a decision that asks them all, where nothing is feasible,
+#: still takes under a second; with 24 (12 probes for five behaviours) one episode of 64 (``affordance plan --seed
+#: 1``) stopped where taps with the second parameter at 0.75 and the first at 0.25 or less were feasible: the two
+#: taps its probes could ask about were corners outside that region.
+MAX_CHECKS = RANKED_CHECKS + len(PROBES) * len(BEHAVIOR_NAMES)
 #: :meth:`Planner.choose` ranks candidates by P(goal) in steps of this, then by their expected progress towards the
 #: goal: P is a weighted share of a few hundred training outcomes, and differences under a few per cent are its
 #: noise, whereas a place nearer the target is a real difference.

@@ -74,16 +74,18 @@ class PlanSettings:
     Sizing (TapAffordanceGoal-v2, five behaviours, the run's 160 x 120 camera; CPU seconds on one core of a 2-core
     machine, measured in one process): a goal episode 0.79 (25 episodes of 96 interactions, the ``feasible`` draws
     included; 0.7-0.9 grasps an episode), a top-up interaction 0.06 (the strokes) or 0.10 (the draw); an effect
-    model 2.5 on 1000 interactions with 200 trees, five of them per planner and five planners (one, and one without
-    each shape); an object's single step 56 and 75 (seed 0's first two, a sphere and a box, with models of about 100
-    interactions per behaviour; profiled on the box: 86 % the oracle's 325 interactions, 94 % with the policies'
-    own, 58 % the grasps, 64 % MuJoCo's steps, 9 % the head's observations after each, 4 % the planners' choices); a
-    multi-step episode 0.9 (planner), 0.4 (direction), 0.6 (random). At these defaults that is about 1200 for the
-    collection, 80 for the fits and 1700 for the evaluation: about 25 minutes on two cores, and the evaluation alone
-    cannot be cut below about 12 minutes without its n falling below the targets' minimum (400 chosen actions need
-    20 objects of 20 goals). The grasp gets about a fifth of the goal episodes' interactions: 1000 of them take
-    about 1500 episodes, the collection's largest part. Half of the goals were feasible in a reduced run (a third of
-    a box's): 24 objects give about 240 feasible goals, 6 objects of each shape.
+    model 2.5 on 1000 interactions with 200 trees (about half with 100), five of them per planner and five planners
+    (one, and one without each shape); an object's single step 56 and 75 (seed 0's first two, a sphere and a box,
+    with models of about 100 interactions per behaviour; profiled on the box: 86 % the oracle's 325 interactions,
+    94 % with the policies' own, 58 % the grasps, 64 % MuJoCo's steps, 9 % the head's observations after each,
+    which the oracle now skips (the env's ``outcome``), 4 % the planners' choices); a multi-step episode 0.9
+    (planner), 0.4 (direction), 0.6 (random). At these defaults ``affordance plan --seed 0`` took 15.2 min on two
+    cores, twice: collecting 5.9 and 6.7 min (1595 goal episodes), fitting 0.2, evaluating 9.1 and 8.3 (the
+    processes' own 17.7 and 16.2 CPU minutes, the second with the oracle's observations skipped). The evaluation
+    cannot be cut much without its n falling below the targets' minimum (400 chosen actions need 20 objects of 20
+    goals). The grasp gets about a fifth of the goal episodes' interactions: 1000 of them take about 1600 episodes,
+    the collection's largest part. Half of the goals were feasible in a reduced run (a third of a box's): 24
+    objects give about 240 feasible goals, 6 objects of each shape.
     """
 
     episodes: int = 1500
