@@ -79,9 +79,10 @@ class PlanSettings:
     with models of about 100 interactions per behaviour; profiled on the box: 86 % the oracle's 325 interactions,
     94 % with the policies' own, 58 % the grasps, 64 % MuJoCo's steps, 9 % the head's observations after each,
     which the oracle now skips (the env's ``outcome``), 4 % the planners' choices); a multi-step episode 0.9
-    (planner), 0.4 (direction), 0.6 (random). At these defaults ``affordance plan --seed 0`` took 15.2 min on two
-    cores, twice: collecting 5.9 and 6.7 min (1595 goal episodes), fitting 0.2, evaluating 9.1 and 8.3 (the
-    processes' own 17.7 and 16.2 CPU minutes, the second with the oracle's observations skipped). The evaluation
+    (planner), 0.4 (direction), 0.6 (random). At these defaults ``affordance plan --seed 0`` took 15.2, 15.2 and
+    12.7 min on two cores (the machine's speed varies from day to day): collecting 5.6-6.7 min (1595 goal
+    episodes), fitting 0.2, evaluating 7.0-9.1 (the processes' own 17.7 CPU minutes, 16.2 with the oracle's
+    observations skipped on the same machine); ``--seed 1`` 12.3 min. The evaluation
     cannot be cut much without its n falling below the targets' minimum (400 chosen actions need 20 objects of 20
     goals). The grasp gets about a fifth of the goal episodes' interactions: 1000 of them take about 1600 episodes,
     the collection's largest part. Half of the goals were feasible in a reduced run (a third of a box's): 24
