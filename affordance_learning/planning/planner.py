@@ -603,18 +603,19 @@ class Planner:
                 return last[key], len(asked)
         return None, len(asked)
 
-    def _probe(self, rank: Callable[[dict[str, np.ndarray]], list[tuple]], feasible, asked: dict[tuple[str, int], bool],
-               candidates: dict[str, np.ndarray], features: np.ndarray, start: np.ndarray | None):
+    def _probe(self, rank: Callable[[dict[str, np.ndarray]], tuple[list[tuple], int]], feasible,
+               asked: dict[tuple[str, int], bool], candidates: dict[str, np.ndarray], features: np.ndarray,
+               start: np.ndarray | None):
         """Where :meth:`_search` found nothing: a feasible one of the :data:`PROBES` of every behaviour, and the model
-        evaluations it made. The behaviours take turns, in the order of their best probe in ``rank(probes)``
-        (entries ending with behaviour and index in ``probes``); each asks about its probe farthest from the actions
+        evaluations ranking them took. The behaviours take turns, in the order of their best probe in
+        ``rank(probes)`` (entries ending with behaviour and index in ``probes``, and the model evaluations it
+        made); each asks about its probe farthest from the actions
         of it refused so far, never one within :data:`PROBE_RADIUS` of them (of equally far ones, the farthest from
         all of them on average, then the better ranked), until one is
         feasible or :attr:`max_checks` are spent: where a behaviour reaches only one region of its parameters, the
         checks go where it has not been refused yet. The probes join ``candidates`` (their
         entries' indices follow the candidates'), and ``asked`` gets the answers."""
-        probes = {name: PROBES for name in candidates}
-        ranked = rank(probes)
+        ranked, evaluations = rank({name: PROBES for name in candidates})
         offset = {name: len(params) for name, params in candidates.items()}
         for name in candidates:
             candidates[name] = np.vstack([candidates[name], PROBES])
@@ -642,9 +643,9 @@ class Planner:
                     del left[name]
                 asked[(name, k)] = bool(feasible(name, candidates[name][k]))
                 if asked[(name, k)]:
-                    return (*entry[:-1], k), len(PROBES) * len(probes)
+                    return (*entry[:-1], k), evaluations
                 refused[name].append(candidates[name][k])
-        return None, len(PROBES) * len(probes)
+        return None, evaluations
 
     def _ranked(self, scores: Mapping[str, tuple[np.ndarray, np.ndarray]], goal: Goal) -> list[tuple]:
         """Every candidate (P, progress, behaviour, index), best first: by P(goal), for a goal that
@@ -687,7 +688,8 @@ class Planner:
         best, checked = self._search([self._ranked(scores, goal)], feasible, excluded, candidates, asked)
         if best is None and feasible is not None and checked < self.max_checks:
             candidates = dict(candidates)
-            best, more = self._probe(lambda probes: self._ranked(self._score(features, goal, start_xy, probes), goal),
+            best, more = self._probe(lambda probes: (self._ranked(self._score(features, goal, start_xy, probes), goal),
+                                                     sum(map(len, probes.values()))),
                                      feasible, asked, candidates, seen, start)
             checked, evaluations = len(asked), evaluations + more
         if best is None:
@@ -763,18 +765,16 @@ class Planner:
         if found is None and feasible is not None and checked < self.max_checks:
             candidates = dict(candidates)
 
-            spent = [0]  # the look-ahead's evaluations over the probes
-
             def rank(probes):  # the probes' rankings one after the other, each probe at its first place
                 first: dict[tuple[str, int], tuple] = {}
-                rankings, spent[0] = self._toward_ranked(features, goal, start, probes, steps_left, reachable, 0)
+                rankings, spent = self._toward_ranked(features, goal, start, probes, steps_left, reachable, 0)
                 for ranking in rankings:
                     for entry in ranking:
                         first.setdefault(entry[-2:], entry)
-                return list(first.values())
+                return list(first.values()), spent
 
             found, more = self._probe(rank, feasible, asked, candidates, features, start)
-            checked, evaluations = len(asked), evaluations + spent[0]  # the probes scored, look-ahead included
+            checked, evaluations = len(asked), evaluations + more
         if found is None:
             return self._nothing(checked, evaluations)
         v, p, d, name, k = found
