@@ -604,21 +604,20 @@ class Planner:
         return None, len(asked)
 
     def _probe(self, rank: Callable[[dict[str, np.ndarray]], tuple[list[tuple], int]], feasible,
-               asked: dict[tuple[str, int], bool], candidates: dict[str, np.ndarray], features: np.ndarray,
-               start: np.ndarray | None):
-        """Where :meth:`_search` found nothing: a feasible one of the :data:`PROBES` of every behaviour, and the model
-        evaluations ranking them took. The behaviours take turns, in the order of their best probe in
-        ``rank(probes)`` (entries ending with behaviour and index in ``probes``, and the model evaluations it
-        made); each asks about its probe farthest from the actions
-        of it refused so far, never one within :data:`PROBE_RADIUS` of them (of equally far ones, the farthest from
-        all of them on average, then the better ranked), until one is
-        feasible or :attr:`max_checks` are spent: where a behaviour reaches only one region of its parameters, the
-        checks go where it has not been refused yet. The probes join ``candidates`` (their
-        entries' indices follow the candidates'), and ``asked`` gets the answers."""
+               asked: dict[tuple[str, int], bool], candidates: Mapping[str, np.ndarray], features: np.ndarray,
+               start: np.ndarray | None) -> tuple[tuple | None, int, dict[str, np.ndarray]]:
+        """Where :meth:`_search` found nothing: a feasible one of the :data:`PROBES` of every behaviour (or None),
+        the model evaluations ranking them took, and ``candidates`` with the probes after each behaviour's (the
+        entry's index is into these). ``rank(probes)`` gives the probes' entries, best first (each ending with
+        behaviour and index in ``probes``), and the model evaluations it made. The behaviours take turns, in the
+        order of their best probe; each asks about its probe farthest from its actions refused so far (of equally
+        far ones, the farthest from all of them on average, then the better ranked), never one within
+        :data:`PROBE_RADIUS` of them, until one is feasible or :attr:`max_checks` are spent: where a behaviour
+        reaches only one region of its parameters, the checks go where it has not been refused yet. ``asked`` gets
+        the answers."""
         ranked, evaluations = rank({name: PROBES for name in candidates})
         offset = {name: len(params) for name, params in candidates.items()}
-        for name in candidates:
-            candidates[name] = np.vstack([candidates[name], PROBES])
+        candidates = {name: np.vstack([params, PROBES]) for name, params in candidates.items()}
         excluded = self._excluded(features, start, candidates)
         refused = {name: [candidates[n][k] for (n, k), ok in asked.items() if n == name and not ok]
                    for name in candidates}
@@ -643,9 +642,9 @@ class Planner:
                     del left[name]
                 asked[(name, k)] = bool(feasible(name, candidates[name][k]))
                 if asked[(name, k)]:
-                    return (*entry[:-1], k), evaluations
+                    return (*entry[:-1], k), evaluations, candidates
                 refused[name].append(candidates[name][k])
-        return None, evaluations
+        return None, evaluations, candidates
 
     def _ranked(self, scores: Mapping[str, tuple[np.ndarray, np.ndarray]], goal: Goal) -> list[tuple]:
         """Every candidate (P, progress, behaviour, index), best first: by P(goal), for a goal that
@@ -687,10 +686,10 @@ class Planner:
         asked: dict[tuple[str, int], bool] = {}
         best, checked = self._search([self._ranked(scores, goal)], feasible, excluded, candidates, asked)
         if best is None and feasible is not None and checked < self.max_checks:
-            candidates = dict(candidates)
-            best, more = self._probe(lambda probes: (self._ranked(self._score(features, goal, start_xy, probes), goal),
-                                                     sum(map(len, probes.values()))),
-                                     feasible, asked, candidates, seen, start)
+            def rank(probes):  # the probes ranked as the candidates are, each scored once
+                return self._ranked(self._score(features, goal, start_xy, probes), goal), sum(map(len, probes.values()))
+
+            best, more, candidates = self._probe(rank, feasible, asked, candidates, seen, start)
             checked, evaluations = len(asked), evaluations + more
         if best is None:
             return self._nothing(checked, evaluations)
@@ -763,8 +762,6 @@ class Planner:
         asked: dict[tuple[str, int], bool] = {}
         found, checked = self._search(ranked, feasible, excluded, candidates, asked)
         if found is None and feasible is not None and checked < self.max_checks:
-            candidates = dict(candidates)
-
             def rank(probes):  # the probes' rankings one after the other, each probe at its first place
                 first: dict[tuple[str, int], tuple] = {}
                 rankings, spent = self._toward_ranked(features, goal, start, probes, steps_left, reachable, 0)
@@ -773,7 +770,7 @@ class Planner:
                         first.setdefault(entry[-2:], entry)
                 return list(first.values()), spent
 
-            found, more = self._probe(rank, feasible, asked, candidates, features, start)
+            found, more, candidates = self._probe(rank, feasible, asked, candidates, features, start)
             checked, evaluations = len(asked), evaluations + more
         if found is None:
             return self._nothing(checked, evaluations)
